@@ -1,0 +1,210 @@
+//! Initial states (MODEL.md §6): cell positions (random, hexagonal or given) and discs with a
+//! tanh profile of width λ, smaller than the target radius.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use crate::lattice::Lattice;
+use crate::patch::{Cells, PatchShape};
+use crate::PhaseFieldError;
+
+/// The largest fraction of the domain the initial discs may cover.
+///
+/// Random sequential adsorption of discs jams near 54.7 % coverage; beyond half the domain
+/// placement becomes very slow or impossible, so the same bound applies to every layout.
+pub const MAX_INITIAL_COVERAGE: f64 = 0.5;
+
+/// How cells are placed initially.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Layout {
+    /// Uniformly random centres, reproducible from the seed, with no two initial discs
+    /// overlapping (random sequential adsorption).
+    Random {
+        /// Seed of the ChaCha8 generator.
+        seed: u64,
+    },
+    /// A (near-)hexagonal packing filling the domain row by row.
+    Hexagonal,
+    /// Centres given by the user.
+    Positions(Vec<[f64; 2]>),
+}
+
+/// Checks that `n_cells` discs of radius `disc_radius` fit in the domain.
+///
+/// # Errors
+/// [`PhaseFieldError::TooManyCells`] when they would cover more than [`MAX_INITIAL_COVERAGE`].
+pub fn check_fits(lattice: Lattice, n_cells: usize, disc_radius: f64) -> Result<(), PhaseFieldError> {
+    let covered = n_cells as f64 * std::f64::consts::PI * disc_radius * disc_radius;
+    let max_cells = (MAX_INITIAL_COVERAGE * lattice.len() as f64
+        / (std::f64::consts::PI * disc_radius * disc_radius))
+        .floor() as usize;
+    if covered > MAX_INITIAL_COVERAGE * lattice.len() as f64 {
+        return Err(PhaseFieldError::TooManyCells {
+            n_cells,
+            max_cells,
+            disc_radius,
+        });
+    }
+    Ok(())
+}
+
+/// The centres of `n_cells` cells for a layout, with initial discs of radius `disc_radius`.
+///
+/// # Errors
+/// [`PhaseFieldError::TooManyCells`] if the discs do not fit, and
+/// [`PhaseFieldError::BadPositions`] for given positions of the wrong count or off the domain.
+pub fn positions(
+    lattice: Lattice,
+    n_cells: usize,
+    disc_radius: f64,
+    layout: &Layout,
+) -> Result<Vec<[f64; 2]>, PhaseFieldError> {
+    match layout {
+        Layout::Positions(p) => {
+            if p.len() != n_cells {
+                return Err(PhaseFieldError::BadPositions(format!(
+                    "{} positions given for {} cells",
+                    p.len(),
+                    n_cells
+                )));
+            }
+            for (i, q) in p.iter().enumerate() {
+                if !(q[0].is_finite() && q[1].is_finite())
+                    || q[0] < 0.0
+                    || q[1] < 0.0
+                    || q[0] >= lattice.lx as f64
+                    || q[1] >= lattice.ly as f64
+                {
+                    return Err(PhaseFieldError::BadPositions(format!(
+                        "position {i} = [{}, {}] lies outside the domain [0, {}) × [0, {})",
+                        q[0], q[1], lattice.lx, lattice.ly
+                    )));
+                }
+            }
+            Ok(p.clone())
+        }
+        Layout::Random { seed } => {
+            check_fits(lattice, n_cells, disc_radius)?;
+            let mut rng = ChaCha8Rng::seed_from_u64(*seed);
+            let mut out: Vec<[f64; 2]> = Vec::with_capacity(n_cells);
+            let min_dist = 2.0 * disc_radius;
+            let max_tries = 10_000 * (n_cells + 1);
+            let mut tries = 0;
+            while out.len() < n_cells {
+                tries += 1;
+                if tries > max_tries {
+                    return Err(PhaseFieldError::TooManyCells {
+                        n_cells,
+                        max_cells: out.len(),
+                        disc_radius,
+                    });
+                }
+                let p = [
+                    rng.random_range(0.0..lattice.lx as f64),
+                    rng.random_range(0.0..lattice.ly as f64),
+                ];
+                if out.iter().all(|q| lattice.distance(*q, p) >= min_dist) {
+                    out.push(p);
+                }
+            }
+            Ok(out)
+        }
+        Layout::Hexagonal => {
+            check_fits(lattice, n_cells, disc_radius)?;
+            // Rows of spacing dy = dx·√3/2 with the aspect ratio of the domain.
+            let (lx, ly) = (lattice.lx as f64, lattice.ly as f64);
+            let per_cell = lx * ly / n_cells as f64;
+            let dx = (2.0 * per_cell / 3f64.sqrt()).sqrt();
+            let mut n_cols = ((lx / dx).round() as usize).max(1);
+            let mut n_rows = n_cells.div_ceil(n_cols);
+            if n_cols * n_rows < n_cells {
+                n_cols += 1;
+                n_rows = n_cells.div_ceil(n_cols);
+            }
+            let (sx, sy) = (lx / n_cols as f64, ly / n_rows as f64);
+            let mut out = Vec::with_capacity(n_cells);
+            'rows: for r in 0..n_rows {
+                for c in 0..n_cols {
+                    if out.len() == n_cells {
+                        break 'rows;
+                    }
+                    let shift = if r % 2 == 1 { 0.5 } else { 0.0 };
+                    out.push(lattice.wrap_point([
+                        (c as f64 + 0.25 + shift) * sx,
+                        (r as f64 + 0.5) * sy,
+                    ]));
+                }
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// Cells shaped as discs `φ = (1 − tanh((d − r₀)/λ))/2` of radius `r₀ = disc_radius` around
+/// `centres`, each patch centred on the node nearest to its centre.
+pub fn discs(
+    lattice: Lattice,
+    shape: PatchShape,
+    centres: &[[f64; 2]],
+    disc_radius: f64,
+    lambda: f64,
+) -> Cells {
+    let mut cells = Cells::zeros(lattice, shape, centres);
+    let (phi, map, shape) = cells.split_mut();
+    let (nx, ny) = (shape.nx, shape.ny);
+    for (i, c) in centres.iter().enumerate() {
+        let xs = map.cell_x(shape, i);
+        let ys = map.cell_y(shape, i);
+        let cell = &mut phi[i * nx * ny..(i + 1) * nx * ny];
+        for (a, &x) in xs.iter().enumerate() {
+            let dx = lattice.delta_x(c[0], x as f64);
+            for (b, &y) in ys.iter().enumerate() {
+                let dy = lattice.delta_y(c[1], y as f64);
+                let d = dx.hypot(dy);
+                cell[a * ny + b] = 0.5 * (1.0 - ((d - disc_radius) / lambda).tanh());
+            }
+        }
+    }
+    cells
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn random_positions_are_reproducible_and_separated() {
+        let lattice = Lattice::new(100, 100);
+        let a = positions(lattice, 60, 4.0, &Layout::Random { seed: 7 }).unwrap();
+        let b = positions(lattice, 60, 4.0, &Layout::Random { seed: 7 }).unwrap();
+        let c = positions(lattice, 60, 4.0, &Layout::Random { seed: 8 }).unwrap();
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        for i in 0..a.len() {
+            for j in 0..i {
+                assert!(lattice.distance(a[i], a[j]) >= 8.0);
+            }
+        }
+    }
+
+    #[test]
+    fn hexagonal_places_every_cell_inside() {
+        let lattice = Lattice::new(100, 100);
+        let p = positions(lattice, 60, 4.0, &Layout::Hexagonal).unwrap();
+        assert_eq!(p.len(), 60);
+        let mut dmin = f64::MAX;
+        for i in 0..p.len() {
+            for j in 0..i {
+                dmin = dmin.min(lattice.distance(p[i], p[j]));
+            }
+        }
+        assert!(dmin > 10.0, "cells too close: {dmin}");
+    }
+
+    #[test]
+    fn too_many_cells_is_an_error() {
+        let lattice = Lattice::new(50, 50);
+        let e = positions(lattice, 200, 4.0, &Layout::Random { seed: 1 }).unwrap_err();
+        assert!(matches!(e, PhaseFieldError::TooManyCells { .. }));
+    }
+}

@@ -1,0 +1,432 @@
+//! Per-cell periodic patches (subdomains) and the structure-of-arrays storage of all cells.
+//!
+//! Each cell's field `φ_i` is stored on a patch of `nx × ny` nodes.
+//! In subdomain mode the patch is square with side `2m + 1` (m is the *margin*) and follows
+//! the cell's centre of mass; in full-domain mode it is the whole lattice and never moves.
+//!
+//! A patch is periodic in itself (the paper's supplementary "domain decomposition" section).
+//! Storage column `a` of cell `i` holds lattice column
+//! `x = origin_x + ((a - offset_x) mod nx)  (mod lx)`, and likewise for rows.
+//! When the patch moves by `d` nodes only `origin` and `offset` change: no value is copied,
+//! and the columns that wrap around keep the values they had on the far edge (near zero when
+//! the margin is large enough).
+//!
+//! All cells' values are one contiguous `Vec<f64>` with stride `patch_len`; within a patch the
+//! storage index is `a * ny + b` (x slow, y contiguous, as on the [`Lattice`]).
+
+use crate::lattice::Lattice;
+use crate::PhaseFieldError;
+
+/// The shape of every cell's patch and the periodic neighbour tables of its stencils.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PatchShape {
+    /// Patch nodes along x.
+    pub nx: usize,
+    /// Patch nodes along y.
+    pub ny: usize,
+    /// The margin `m` (patch side `2m + 1`), or `None` in full-domain mode.
+    pub margin: Option<usize>,
+    /// `xm[a]`: the storage column left of `a`, periodic in the patch.
+    pub xm: Vec<usize>,
+    /// `xp[a]`: the storage column right of `a`, periodic in the patch.
+    pub xp: Vec<usize>,
+}
+
+impl PatchShape {
+    /// A square patch of side `2 * margin + 1`, or the full lattice when `margin == 0`.
+    ///
+    /// # Errors
+    /// [`PhaseFieldError::PatchTooLarge`] when `2 * margin + 1` exceeds a side of the lattice.
+    pub fn new(lattice: Lattice, margin: usize) -> Result<Self, PhaseFieldError> {
+        if margin == 0 {
+            return Ok(Self::with_size(lattice.lx, lattice.ly, None));
+        }
+        let side = 2 * margin + 1;
+        if side > lattice.lx || side > lattice.ly {
+            return Err(PhaseFieldError::PatchTooLarge {
+                margin,
+                side,
+                lx: lattice.lx,
+                ly: lattice.ly,
+            });
+        }
+        Ok(Self::with_size(side, side, Some(margin)))
+    }
+
+    fn with_size(nx: usize, ny: usize, margin: Option<usize>) -> Self {
+        let xm = (0..nx).map(|a| (a + nx - 1) % nx).collect();
+        let xp = (0..nx).map(|a| (a + 1) % nx).collect();
+        Self {
+            nx,
+            ny,
+            margin,
+            xm,
+            xp,
+        }
+    }
+
+    /// Nodes in one patch.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Always false.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// True in full-domain mode.
+    pub fn is_full_domain(&self) -> bool {
+        self.margin.is_none()
+    }
+}
+
+/// The values of the five-point stencil around one node.
+#[derive(Debug, Clone, Copy)]
+pub struct Stencil {
+    /// Centre value.
+    pub c: f64,
+    /// Value at `x - 1`.
+    pub xm: f64,
+    /// Value at `x + 1`.
+    pub xp: f64,
+    /// Value at `y - 1`.
+    pub ym: f64,
+    /// Value at `y + 1`.
+    pub yp: f64,
+}
+
+impl Stencil {
+    /// Central difference `∂x f = (f[x+1] − f[x−1]) / 2`.
+    #[inline(always)]
+    pub fn dx(&self) -> f64 {
+        0.5 * (self.xp - self.xm)
+    }
+    /// Central difference `∂y f = (f[y+1] − f[y−1]) / 2`.
+    #[inline(always)]
+    pub fn dy(&self) -> f64 {
+        0.5 * (self.yp - self.ym)
+    }
+    /// Five-point Laplacian `f[x+1] + f[x−1] + f[y+1] + f[y−1] − 4 f`.
+    #[inline(always)]
+    pub fn laplacian(&self) -> f64 {
+        self.xp + self.xm + self.yp + self.ym - 4.0 * self.c
+    }
+}
+
+/// Calls `f(k, stencil)` for every node `k = a * ny + b` of one patch, with periodic wrap
+/// inside the patch.
+///
+/// # Panics
+/// If `phi.len() != shape.len()`.
+#[inline(always)]
+pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShape, mut f: F) {
+    let ny = shape.ny;
+    assert_eq!(phi.len(), shape.len());
+    for a in 0..shape.nx {
+        let row = &phi[a * ny..(a + 1) * ny];
+        let row_m = &phi[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
+        let row_p = &phi[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
+        let k0 = a * ny;
+        if ny == 1 {
+            f(
+                k0,
+                Stencil {
+                    c: row[0],
+                    xm: row_m[0],
+                    xp: row_p[0],
+                    ym: row[0],
+                    yp: row[0],
+                },
+            );
+            continue;
+        }
+        f(
+            k0,
+            Stencil {
+                c: row[0],
+                xm: row_m[0],
+                xp: row_p[0],
+                ym: row[ny - 1],
+                yp: row[1],
+            },
+        );
+        for b in 1..ny - 1 {
+            f(
+                k0 + b,
+                Stencil {
+                    c: row[b],
+                    xm: row_m[b],
+                    xp: row_p[b],
+                    ym: row[b - 1],
+                    yp: row[b + 1],
+                },
+            );
+        }
+        f(
+            k0 + ny - 1,
+            Stencil {
+                c: row[ny - 1],
+                xm: row_m[ny - 1],
+                xp: row_p[ny - 1],
+                ym: row[ny - 2],
+                yp: row[0],
+            },
+        );
+    }
+}
+
+/// Where each cell's patch sits on the lattice: origins, offsets and the storage-to-lattice
+/// coordinate tables derived from them.
+#[derive(Debug, Clone)]
+pub struct PatchMap {
+    /// Lattice coordinates of each patch's logical first column and row.
+    pub origin: Vec<[usize; 2]>,
+    /// Storage indices of each patch's logical first column and row.
+    pub offset: Vec<[usize; 2]>,
+    /// `lat_x[i * nx + a]`: lattice x of storage column `a` of cell `i`.
+    pub lat_x: Vec<u32>,
+    /// `lat_y[i * ny + b]`: lattice y of storage row `b` of cell `i`.
+    pub lat_y: Vec<u32>,
+}
+
+impl PatchMap {
+    /// Lattice x of each storage column of cell `i`.
+    #[inline]
+    pub fn cell_x<'a>(&'a self, shape: &PatchShape, i: usize) -> &'a [u32] {
+        &self.lat_x[i * shape.nx..(i + 1) * shape.nx]
+    }
+    /// Lattice y of each storage row of cell `i`.
+    #[inline]
+    pub fn cell_y<'a>(&'a self, shape: &PatchShape, i: usize) -> &'a [u32] {
+        &self.lat_y[i * shape.ny..(i + 1) * shape.ny]
+    }
+
+    fn refresh_tables(&mut self, lattice: Lattice, shape: &PatchShape, i: usize) {
+        let [ox, oy] = self.origin[i];
+        let [fx, fy] = self.offset[i];
+        let (nx, ny) = (shape.nx, shape.ny);
+        for a in 0..nx {
+            let u = (a + nx - fx) % nx;
+            self.lat_x[i * nx + a] = ((ox + u) % lattice.lx) as u32;
+        }
+        for b in 0..ny {
+            let v = (b + ny - fy) % ny;
+            self.lat_y[i * ny + b] = ((oy + v) % lattice.ly) as u32;
+        }
+    }
+}
+
+/// The phase fields of all cells, in structure-of-arrays layout.
+#[derive(Debug, Clone)]
+pub struct Cells {
+    lattice: Lattice,
+    shape: PatchShape,
+    n_cells: usize,
+    phi: Vec<f64>,
+    map: PatchMap,
+}
+
+impl Cells {
+    /// `n_cells` cells with all-zero fields, each patch centred on `centres[i]`.
+    ///
+    /// # Panics
+    /// If `centres.len() != n_cells`.
+    pub fn zeros(lattice: Lattice, shape: PatchShape, centres: &[[f64; 2]]) -> Self {
+        let n_cells = centres.len();
+        let mut map = PatchMap {
+            origin: vec![[0, 0]; n_cells],
+            offset: vec![[0, 0]; n_cells],
+            lat_x: vec![0; n_cells * shape.nx],
+            lat_y: vec![0; n_cells * shape.ny],
+        };
+        for i in 0..n_cells {
+            map.origin[i] = Self::origin_for(lattice, &shape, centres[i]);
+            map.refresh_tables(lattice, &shape, i);
+        }
+        Self {
+            lattice,
+            phi: vec![0.0; n_cells * shape.len()],
+            shape,
+            n_cells,
+            map,
+        }
+    }
+
+    /// The patch origin that centres the patch on the node nearest to `centre`.
+    fn origin_for(lattice: Lattice, shape: &PatchShape, centre: [f64; 2]) -> [usize; 2] {
+        match shape.margin {
+            None => [0, 0],
+            Some(m) => [
+                lattice.wrap_x(centre[0].round() as i64 - m as i64),
+                lattice.wrap_y(centre[1].round() as i64 - m as i64),
+            ],
+        }
+    }
+
+    /// Moves the patch of cell `cell_idx` so that it is centred on the node nearest to
+    /// `centre`. Only the origin and the offset change; no value is copied.
+    /// Returns the shift `[dx, dy]` in nodes. A no-op in full-domain mode.
+    pub fn recentre(&mut self, cell_idx: usize, centre: [f64; 2]) -> [i64; 2] {
+        let Some(_) = self.shape.margin else {
+            return [0, 0];
+        };
+        let new = Self::origin_for(self.lattice, &self.shape, centre);
+        let old = self.map.origin[cell_idx];
+        let d = [
+            min_image_int(new[0] as i64 - old[0] as i64, self.lattice.lx as i64),
+            min_image_int(new[1] as i64 - old[1] as i64, self.lattice.ly as i64),
+        ];
+        if d == [0, 0] {
+            return d;
+        }
+        let (nx, ny) = (self.shape.nx as i64, self.shape.ny as i64);
+        let off = self.map.offset[cell_idx];
+        self.map.offset[cell_idx] = [
+            (off[0] as i64 + d[0]).rem_euclid(nx) as usize,
+            (off[1] as i64 + d[1]).rem_euclid(ny) as usize,
+        ];
+        self.map.origin[cell_idx] = new;
+        self.map.refresh_tables(self.lattice, &self.shape, cell_idx);
+        d
+    }
+
+    /// The lattice.
+    pub fn lattice(&self) -> Lattice {
+        self.lattice
+    }
+    /// The patch shape shared by all cells.
+    pub fn shape(&self) -> &PatchShape {
+        &self.shape
+    }
+    /// Number of cells.
+    pub fn n_cells(&self) -> usize {
+        self.n_cells
+    }
+    /// Nodes per patch.
+    pub fn patch_len(&self) -> usize {
+        self.shape.len()
+    }
+    /// All cells' values, cell after cell.
+    pub fn phi(&self) -> &[f64] {
+        &self.phi
+    }
+    /// All cells' values, mutably.
+    pub fn phi_mut(&mut self) -> &mut [f64] {
+        &mut self.phi
+    }
+    /// One cell's patch values in storage order.
+    pub fn cell_phi(&self, cell_idx: usize) -> &[f64] {
+        let n = self.shape.len();
+        &self.phi[cell_idx * n..(cell_idx + 1) * n]
+    }
+    /// Where the patches are.
+    pub fn map(&self) -> &PatchMap {
+        &self.map
+    }
+    /// The values (mutable) and the patch map (shared) at once, for kernels that write
+    /// fields while reading positions.
+    pub fn split_mut(&mut self) -> (&mut [f64], &PatchMap, &PatchShape) {
+        (&mut self.phi, &self.map, &self.shape)
+    }
+
+    /// The value of cell `cell_idx` at lattice node `(x, y)`, zero off its patch.
+    pub fn value_at(&self, cell_idx: usize, x: usize, y: usize) -> f64 {
+        let (nx, ny) = (self.shape.nx, self.shape.ny);
+        let [ox, oy] = self.map.origin[cell_idx];
+        let u = (x + self.lattice.lx - ox) % self.lattice.lx;
+        let v = (y + self.lattice.ly - oy) % self.lattice.ly;
+        if u >= nx || v >= ny {
+            return 0.0;
+        }
+        let [fx, fy] = self.map.offset[cell_idx];
+        let a = (u + fx) % nx;
+        let b = (v + fy) % ny;
+        self.cell_phi(cell_idx)[a * ny + b]
+    }
+
+    /// The patch of cell `cell_idx` unrolled into logical order: element `u * ny + v` is the
+    /// value at lattice node `(origin_x + u, origin_y + v)` (periodic). Writes into `out`.
+    ///
+    /// # Panics
+    /// If `out.len() != patch_len()`.
+    pub fn unrolled_into(&self, cell_idx: usize, out: &mut [f64]) {
+        let (nx, ny) = (self.shape.nx, self.shape.ny);
+        assert_eq!(out.len(), nx * ny);
+        let [fx, fy] = self.map.offset[cell_idx];
+        let phi = self.cell_phi(cell_idx);
+        for u in 0..nx {
+            let a = (u + fx) % nx;
+            for v in 0..ny {
+                let b = (v + fy) % ny;
+                out[u * ny + v] = phi[a * ny + b];
+            }
+        }
+    }
+
+    /// Scatters cell `cell_idx` onto a lattice-sized field (adds `φ_i` to `out`).
+    pub fn add_to_lattice(&self, cell_idx: usize, out: &mut [f64]) {
+        let ny = self.shape.ny;
+        let lx = self.map.cell_x(&self.shape, cell_idx);
+        let ly = self.map.cell_y(&self.shape, cell_idx);
+        let phi = self.cell_phi(cell_idx);
+        for (a, &x) in lx.iter().enumerate() {
+            for (b, &y) in ly.iter().enumerate() {
+                out[self.lattice.index(x as usize, y as usize)] += phi[a * ny + b];
+            }
+        }
+    }
+}
+
+fn min_image_int(d: i64, l: i64) -> i64 {
+    let w = d.rem_euclid(l);
+    if 2 * w >= l {
+        w - l
+    } else {
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recentre_moves_without_copying_and_keeps_lattice_positions() {
+        let lattice = Lattice::new(40, 30);
+        let shape = PatchShape::new(lattice, 3).unwrap();
+        let mut cells = Cells::zeros(lattice, shape, &[[1.0, 2.0]]);
+        // Mark every node with a value encoding its lattice position.
+        let (nx, ny) = (7, 7);
+        let xs: Vec<u32> = cells.map().cell_x(cells.shape(), 0).to_vec();
+        let ys: Vec<u32> = cells.map().cell_y(cells.shape(), 0).to_vec();
+        for a in 0..nx {
+            for b in 0..ny {
+                cells.phi_mut()[a * ny + b] = (xs[a] * 1000 + ys[b]) as f64;
+            }
+        }
+        let before = cells.phi().to_vec();
+        // Move across both periodic edges by more than one node.
+        let d = cells.recentre(0, [38.2, 28.6]);
+        assert_eq!(d, [-3, -3]);
+        assert_eq!(cells.phi(), &before[..], "no value may be copied");
+        let xs2 = cells.map().cell_x(cells.shape(), 0).to_vec();
+        let ys2 = cells.map().cell_y(cells.shape(), 0).to_vec();
+        // Nodes still inside the patch keep their lattice coordinates.
+        let mut kept = 0;
+        for a in 0..nx {
+            for b in 0..ny {
+                let v = cells.phi()[a * ny + b] as u32;
+                if (xs2[a], ys2[b]) == (v / 1000, v % 1000) {
+                    kept += 1;
+                }
+            }
+        }
+        assert_eq!(kept, 4 * 4);
+        // The patch is centred on the rounded centre.
+        assert_eq!(cells.map().origin[0], [35, 26]);
+        assert_eq!(xs2[(cells.map().offset[0][0] + 3) % nx], 38);
+        assert_eq!(ys2[(cells.map().offset[0][1] + 3) % ny], 29);
+    }
+}
