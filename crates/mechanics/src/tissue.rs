@@ -1,0 +1,349 @@
+//! The state of a monolayer ([`Tissue`]), its scratch memory ([`Workspace`]) and the time step.
+//!
+//! One evaluation of the right-hand side `R(φ)` (MODEL.md §3–4) runs four passes:
+//! 1. per cell, in parallel: area `A_i = Σ φ_i²` and deformation tensor `S_i`;
+//! 2. scatter onto the lattice, stripe-parallel in cell order: `s1, s2, s3, s4, sA, Q_xx, Q_xy`;
+//! 3. per lattice row, in parallel: the pressure `P`;
+//! 4. per cell, in parallel: the force `F_i = Σ_x [P ∇φ_i + ζ Q·∇φ_i]`, the velocity
+//!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
+
+use phasefield::{for_each_stencil, Cells, ComTable, Lattice};
+use rayon::prelude::*;
+
+use crate::params::{ModelParams, PressureKind, StepParams};
+use crate::scatter::scatter;
+use crate::StepError;
+
+/// Components of the global (lattice-wide) sums, per node.
+pub const N_GLOBAL: usize = 7;
+/// Index of `s1 = Σ φ_i` in a global node record.
+pub const G_S1: usize = 0;
+/// Index of `s2 = Σ φ_i²`.
+pub const G_S2: usize = 1;
+/// Index of `s3 = Σ φ_i³`.
+pub const G_S3: usize = 2;
+/// Index of `s4 = Σ φ_i⁴`.
+pub const G_S4: usize = 3;
+/// Index of `sA = Σ φ_i A_i`.
+pub const G_SA: usize = 4;
+/// Index of `Q_xx = Σ φ_i S_i,xx`.
+pub const G_QXX: usize = 5;
+/// Index of `Q_xy = Σ φ_i S_i,xy`.
+pub const G_QXY: usize = 6;
+
+/// Per-cell quantities derived from the fields by one evaluation.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CellState {
+    /// Area `A_i = Σ_x φ_i²`.
+    pub area: f64,
+    /// Deformation tensor `[S_xx, S_xy]` (MODEL.md §3; `S_yy = −S_xx`).
+    pub shape: [f64; 2],
+    /// Interface force `F_i`.
+    pub force: [f64; 2],
+    /// Velocity `v_i = F_i / ξ`.
+    pub velocity: [f64; 2],
+    /// Smallest `φ_i` on the patch.
+    pub phi_min: f64,
+    /// Largest `φ_i` on the patch.
+    pub phi_max: f64,
+}
+
+/// A monolayer: the fields of all cells, the parameters and the clock.
+#[derive(Debug, Clone)]
+pub struct Tissue {
+    /// The phase fields.
+    pub cells: Cells,
+    /// The model parameters (ζ may be changed between steps, e.g. after relaxation).
+    pub params: ModelParams,
+    /// Model time.
+    pub time: f64,
+    /// Steps taken.
+    pub step: u64,
+    /// Centre of mass of every cell (updated after every step).
+    pub centre: Vec<[f64; 2]>,
+}
+
+/// Scratch memory for [`Tissue::step`]: built once, reused, never serialised.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    phi_old: Vec<f64>,
+    k1: Vec<f64>,
+    k2: Vec<f64>,
+    /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices).
+    pub global: Vec<f64>,
+    /// Pressure on the lattice.
+    pub pressure: Vec<f64>,
+    /// Per-cell derived quantities of the last evaluation.
+    pub cell_state: Vec<CellState>,
+    /// A two-component lattice buffer for derived fields (e.g. the tissue velocity).
+    pub field2: Vec<f64>,
+    com: ComTable,
+}
+
+impl Workspace {
+    /// Scratch memory for a tissue of this size.
+    pub fn new(cells: &Cells) -> Self {
+        let n = cells.n_cells() * cells.patch_len();
+        let lattice = cells.lattice();
+        Self {
+            phi_old: vec![0.0; n],
+            k1: vec![0.0; n],
+            k2: vec![0.0; n],
+            global: vec![0.0; lattice.len() * N_GLOBAL],
+            pressure: vec![0.0; lattice.len()],
+            cell_state: vec![CellState::default(); cells.n_cells()],
+            field2: vec![0.0; lattice.len() * 2],
+            com: ComTable::new(lattice),
+        }
+    }
+}
+
+impl Tissue {
+    /// A tissue from initial fields; centres of mass are computed and patches centred on them.
+    pub fn new(cells: Cells, params: ModelParams) -> Self {
+        let mut t = Self {
+            centre: vec![[0.0; 2]; cells.n_cells()],
+            cells,
+            params,
+            time: 0.0,
+            step: 0,
+        };
+        let com = ComTable::new(t.cells.lattice());
+        t.update_centres(&com);
+        t
+    }
+
+    /// The lattice.
+    pub fn lattice(&self) -> Lattice {
+        self.cells.lattice()
+    }
+
+    fn update_centres(&mut self, com: &ComTable) {
+        let cells = &self.cells;
+        let shape = cells.shape();
+        self.centre.par_iter_mut().enumerate().for_each(|(i, c)| {
+            *c = com.centre_of_mass(
+                cells.cell_phi(i),
+                shape,
+                cells.map().cell_x(shape, i),
+                cells.map().cell_y(shape, i),
+            );
+        });
+        for i in 0..self.cells.n_cells() {
+            self.cells.recentre(i, self.centre[i]);
+        }
+    }
+
+    /// Evaluates the derived quantities of the current state (areas, shapes, forces,
+    /// velocities, the global sums and the pressure) into `ws`, without stepping.
+    pub fn refresh(&self, ws: &mut Workspace) {
+        let Workspace {
+            k2,
+            global,
+            pressure,
+            cell_state,
+            ..
+        } = ws;
+        evaluate(&self.params, &self.cells, self.cells.phi(), k2, global, pressure, cell_state);
+    }
+
+    /// Advances the state by one time step `dt` with `npc` Heun corrector passes.
+    ///
+    /// Allocates nothing. The state is checked at the start of the step, before anything is
+    /// overwritten: on error the tissue is left at the last good state.
+    ///
+    /// # Errors
+    /// [`StepError::NonFinite`] if a cell's area or force is not finite, and
+    /// [`StepError::Unstable`] if a field has left `[−PHI_BOUND, 1 + PHI_BOUND]`.
+    pub fn step(&mut self, ws: &mut Workspace, step_params: &StepParams) -> Result<(), StepError> {
+        let dt = step_params.dt;
+        let Workspace {
+            phi_old,
+            k1,
+            k2,
+            global,
+            pressure,
+            cell_state,
+            com,
+            ..
+        } = ws;
+        evaluate(&self.params, &self.cells, self.cells.phi(), k1, global, pressure, cell_state);
+        self.check(cell_state, dt)?;
+        let phi = self.cells.phi_mut();
+        phi_old.copy_from_slice(phi);
+        phi.par_iter_mut()
+            .zip(phi_old.par_iter().zip(k1.par_iter()))
+            .for_each(|(p, (o, r))| *p = o + dt * r);
+        for _ in 0..step_params.npc {
+            evaluate(&self.params, &self.cells, self.cells.phi(), k2, global, pressure, cell_state);
+            let phi = self.cells.phi_mut();
+            phi.par_iter_mut()
+                .zip(phi_old.par_iter())
+                .zip(k1.par_iter().zip(k2.par_iter()))
+                .for_each(|((p, o), (r1, r2))| *p = o + 0.5 * dt * (r1 + r2));
+        }
+        self.step += 1;
+        self.time += dt;
+        self.update_centres(com);
+        Ok(())
+    }
+
+    fn check(&self, cell_state: &[CellState], dt: f64) -> Result<(), StepError> {
+        for (i, c) in cell_state.iter().enumerate() {
+            let finite = c.area.is_finite()
+                && c.force[0].is_finite()
+                && c.force[1].is_finite()
+                && c.phi_min.is_finite()
+                && c.phi_max.is_finite();
+            if !finite {
+                return Err(StepError::NonFinite {
+                    step: self.step,
+                    time: self.time,
+                    cell_idx: i,
+                });
+            }
+            if c.phi_min < -PHI_BOUND || c.phi_max > 1.0 + PHI_BOUND {
+                return Err(StepError::Unstable {
+                    step: self.step,
+                    time: self.time,
+                    cell_idx: i,
+                    phi: if c.phi_min < -PHI_BOUND { c.phi_min } else { c.phi_max },
+                    dt,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How far outside `[0, 1]` a phase field may go before the step is declared unstable.
+///
+/// Central-difference advection lets φ reach about −0.05 and 1.5 at ζ = 0.01 in stable runs
+/// (reference code, `../shared/reference`); a value beyond `−2` or `3` only occurs on the way
+/// to a blow-up.
+pub const PHI_BOUND: f64 = 2.0;
+
+/// One evaluation of the right-hand side `R(φ)` into `rhs`, with every intermediate quantity
+/// (global sums, pressure, per-cell state) left in the buffers for inspection.
+pub fn evaluate(
+    params: &ModelParams,
+    cells: &Cells,
+    phi: &[f64],
+    rhs: &mut [f64],
+    global: &mut [f64],
+    pressure: &mut [f64],
+    cell_state: &mut [CellState],
+) {
+    let shape = cells.shape();
+    let plen = shape.len();
+    let lattice = cells.lattice();
+    let energy = params.energy;
+    let zeta = params.zeta;
+
+    // 1. Per cell: area, deformation tensor, range.
+    cell_state
+        .par_iter_mut()
+        .zip(phi.par_chunks(plen))
+        .for_each(|(st, cell)| {
+            let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for_each_stencil(cell, shape, |_, s| {
+                let (dx, dy) = (s.dx(), s.dy());
+                area += s.c * s.c;
+                sxx += 0.5 * (dy * dy - dx * dx);
+                sxy -= dx * dy;
+                lo = lo.min(s.c);
+                hi = hi.max(s.c);
+            });
+            st.area = area;
+            st.shape = [sxx, sxy];
+            st.phi_min = lo;
+            st.phi_max = hi;
+        });
+
+    // 2. Global sums.
+    {
+        let cs: &[CellState] = cell_state;
+        scatter::<N_GLOBAL, _>(cells, phi, global, |i, _, p| {
+            let c = &cs[i];
+            let p2 = p * p;
+            [p, p2, p2 * p, p2 * p2, p * c.area, p * c.shape[0], p * c.shape[1]]
+        });
+    }
+
+    // 3. Pressure.
+    let ly = lattice.ly;
+    let lx = lattice.lx;
+    let g: &[f64] = global;
+    match params.pressure {
+        PressureKind::Paper => {
+            let a0 = energy.target_area();
+            let (c_rep, c_ch, c_lap, c_area) = (
+                2.0 * energy.kappa / energy.lambda,
+                8.0 * energy.gamma / energy.lambda,
+                2.0 * energy.gamma * energy.lambda,
+                4.0 * energy.mu / a0,
+            );
+            pressure.par_chunks_mut(ly).enumerate().for_each(|(x, row)| {
+                let xm = (x + lx - 1) % lx;
+                let xp = (x + 1) % lx;
+                for y in 0..ly {
+                    let ym = if y == 0 { ly - 1 } else { y - 1 };
+                    let yp = if y + 1 == ly { 0 } else { y + 1 };
+                    let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
+                    let s1 = |xx: usize, yy: usize| g[(xx * ly + yy) * N_GLOBAL + G_S1];
+                    let lap = s1(xm, y) + s1(xp, y) + s1(x, ym) + s1(x, yp) - 4.0 * n[G_S1];
+                    row[y] = c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
+                        - c_ch * (n[G_S1] - 3.0 * n[G_S2] + 2.0 * n[G_S3])
+                        + c_lap * lap
+                        + c_area * (n[G_S1] - n[G_SA] / a0);
+                }
+            });
+        }
+        PressureKind::Interaction => {
+            let c_rep = 2.0 * energy.kappa / energy.lambda;
+            pressure.par_chunks_mut(ly).enumerate().for_each(|(x, row)| {
+                for y in 0..ly {
+                    let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
+                    row[y] = c_rep * (n[G_S2] * n[G_S2] - n[G_S4]);
+                }
+            });
+        }
+    }
+
+    // 4. Forces, velocities and the right-hand side.
+    let pr: &[f64] = pressure;
+    let map = cells.map();
+    let ny = shape.ny;
+    let xi = params.xi;
+    rhs.par_chunks_mut(plen)
+        .zip(phi.par_chunks(plen))
+        .zip(cell_state.par_iter_mut())
+        .enumerate()
+        .for_each(|(i, ((out, cell), st))| {
+            let xs = map.cell_x(shape, i);
+            let ys = map.cell_y(shape, i);
+            let node = |k: usize| (xs[k / ny] as usize) * ly + ys[k % ny] as usize;
+            let (mut fx, mut fy) = (0.0, 0.0);
+            for_each_stencil(cell, shape, |k, s| {
+                let n = node(k);
+                let p = pr[n];
+                let (qxx, qxy) = (g[n * N_GLOBAL + G_QXX], g[n * N_GLOBAL + G_QXY]);
+                let (dx, dy) = (s.dx(), s.dy());
+                fx += p * dx + zeta * (qxx * dx + qxy * dy);
+                fy += p * dy + zeta * (qxy * dx - qxx * dy);
+            });
+            let (vx, vy) = (fx / xi, fy / xi);
+            st.force = [fx, fy];
+            st.velocity = [vx, vy];
+            let area = st.area;
+            for_each_stencil(cell, shape, |k, s| {
+                let n = node(k);
+                let others = g[n * N_GLOBAL + G_S2] - s.c * s.c;
+                let dfdphi = energy.ch(s.c, s.laplacian())
+                    + energy.area(s.c, area)
+                    + energy.rep(s.c, others);
+                out[k] = -(vx * s.dx() + vy * s.dy()) - dfdphi;
+            });
+        });
+}
