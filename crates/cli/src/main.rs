@@ -1,0 +1,82 @@
+//! The `monolayer` binary: `monolayer run SCENE --out DIR`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use monolayer_cli::{run, scene::Scene};
+
+/// Multi-phase-field simulations of cell monolayers (Mueller, Yeomans & Doostmohammadi, PRL 2019).
+#[derive(Parser)]
+#[command(name = "monolayer", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene file and write the series, frames and resolved scene into a directory.
+    Run {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// The output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Worker threads (default: all cores). Results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Override a scene value, e.g. `--set model.zeta=0.005` (repeatable).
+        #[arg(long = "set", value_name = "SECTION.KEY=VALUE")]
+        set: Vec<String>,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run {
+            scene,
+            out,
+            threads,
+            set,
+            quiet,
+        } => {
+            let text = std::fs::read_to_string(&scene)
+                .with_context(|| format!("cannot read scene file {}", scene.display()))?;
+            let parsed = Scene::parse(&text, &set).with_context(|| format!("in scene {}", scene.display()))?;
+            parsed.validate().with_context(|| format!("in scene {}", scene.display()))?;
+            let mut pool = rayon::ThreadPoolBuilder::new();
+            if let Some(n) = threads {
+                anyhow::ensure!(n >= 1, "--threads must be at least 1");
+                pool = pool.num_threads(n);
+            }
+            let pool = pool.build()?;
+            let info = pool.install(|| run::run(&parsed, &out, quiet))?;
+            if !quiet {
+                eprintln!(
+                    "done: {} steps in {:.2} s, {} frames in {}",
+                    info.steps,
+                    info.wall_s,
+                    info.frames,
+                    out.display()
+                );
+            }
+            Ok(())
+        }
+    }
+}

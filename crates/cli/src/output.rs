@@ -1,0 +1,129 @@
+//! Output files of a run: the resolved scene, `series.csv` and `frames/frame_STEP.npz`.
+//!
+//! Frames are NumPy `.npz` archives (zip of `.npy` arrays, deflate-compressed), readable with
+//! `numpy.load` and no custom code. Arrays in a frame:
+//!
+//! | name | shape | meaning |
+//! |---|---|---|
+//! | `step`, `time`, `zeta` | `()` | clock and activity |
+//! | `lattice` | `(2,)` int64 | `[lx, ly]` |
+//! | `centre` | `(N, 2)` | centre of mass `[x, y]` |
+//! | `velocity` | `(N, 2)` | `v_i` |
+//! | `force` | `(N, 2)` | `F_i` |
+//! | `area` | `(N,)` | `Σ φ_i²` |
+//! | `shape_tensor` | `(N, 2)` | `[S_xx, S_xy]` (`S_yy = −S_xx`) |
+//! | `origin` | `(N, 2)` int64 | lattice node of each patch's element `[0, 0]` |
+//! | `phi` | `(N, nx, ny)` | `phi[i, u, v]` is `φ_i` at node `((origin_x+u) % lx, (origin_y+v) % ly)` |
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use mechanics::{Observables, Tissue, Workspace};
+use npyz::WriterBuilder;
+
+/// The header of `series.csv`.
+pub const SERIES_HEADER: &str =
+    "step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max,cell_speed_rms,phi_min,phi_max";
+
+/// Writes `series.csv` row by row, flushing each row so that a run that stops keeps them.
+pub struct SeriesWriter {
+    out: BufWriter<File>,
+}
+
+impl SeriesWriter {
+    /// Creates `dir/series.csv` with its header.
+    pub fn create(dir: &Path) -> Result<Self> {
+        let path = dir.join("series.csv");
+        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+        let mut out = BufWriter::new(f);
+        writeln!(out, "{SERIES_HEADER}")?;
+        out.flush()?;
+        Ok(Self { out })
+    }
+
+    /// Appends one row.
+    pub fn row(&mut self, tissue: &Tissue, o: &Observables) -> Result<()> {
+        writeln!(
+            self.out,
+            "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}",
+            tissue.step,
+            tissue.time,
+            tissue.params.zeta,
+            o.v_rms,
+            o.s_rms,
+            o.area_mean,
+            o.area_min,
+            o.area_max,
+            o.cell_speed_rms,
+            o.phi_min,
+            o.phi_max
+        )?;
+        self.out.flush()?;
+        Ok(())
+    }
+}
+
+fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(shape: &[u64], data: impl IntoIterator<Item = T>) -> Result<Vec<u8>> {
+    let mut buf = Vec::new();
+    {
+        let mut w = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(shape)
+            .writer(&mut buf)
+            .begin_nd()?;
+        w.extend(data)?;
+        w.finish()?;
+    }
+    Ok(buf)
+}
+
+/// Writes one frame (see the module docs); `ws` must hold the derived quantities of the
+/// current state (call [`Tissue::observe`] or [`Tissue::refresh`] first).
+pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBuf> {
+    let frames = dir.join("frames");
+    std::fs::create_dir_all(&frames)?;
+    let path = frames.join(format!("frame_{:08}.npz", tissue.step));
+    let tmp = path.with_extension("npz.partial");
+    let n = tissue.cells.n_cells();
+    let shape = tissue.cells.shape();
+    let (nx, ny) = (shape.nx, shape.ny);
+    let cs = &ws.cell_state;
+    let lattice = tissue.lattice();
+    let mut phi = vec![0.0; n * nx * ny];
+    for (i, chunk) in phi.chunks_exact_mut(nx * ny).enumerate() {
+        tissue.cells.unrolled_into(i, chunk);
+    }
+    let n64 = n as u64;
+    let arrays: Vec<(&str, Vec<u8>)> = vec![
+        ("step", npy(&[], [tissue.step as i64])?),
+        ("time", npy(&[], [tissue.time])?),
+        ("zeta", npy(&[], [tissue.params.zeta])?),
+        ("lattice", npy(&[2], [lattice.lx as i64, lattice.ly as i64])?),
+        ("centre", npy(&[n64, 2], tissue.centre.iter().flatten().copied())?),
+        ("velocity", npy(&[n64, 2], cs.iter().flat_map(|c| c.velocity))?),
+        ("force", npy(&[n64, 2], cs.iter().flat_map(|c| c.force))?),
+        ("area", npy(&[n64], cs.iter().map(|c| c.area))?),
+        ("shape_tensor", npy(&[n64, 2], cs.iter().flat_map(|c| c.shape))?),
+        (
+            "origin",
+            npy(&[n64, 2], tissue.cells.map().origin.iter().flat_map(|o| [o[0] as i64, o[1] as i64]))?,
+        ),
+        ("phi", npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?),
+    ];
+    {
+        let f = File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+        let mut zip = zip::ZipWriter::new(BufWriter::new(f));
+        let opts = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Deflated)
+            .compression_level(Some(1));
+        for (name, bytes) in arrays {
+            zip.start_file(format!("{name}.npy"), opts)?;
+            zip.write_all(&bytes)?;
+        }
+        zip.finish()?.flush()?;
+    }
+    std::fs::rename(&tmp, &path)?;
+    Ok(path)
+}
