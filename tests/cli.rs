@@ -1,0 +1,1 @@
+//! The `monolayer` binary end to end.

@@ -1,0 +1,7 @@
+//! One integration-test binary for the whole workspace, with topical modules.
+
+mod cli;
+mod mechanics_tests;
+mod phasefield_tests;
+mod regression;
+mod strategies;

@@ -1,0 +1,1 @@
+//! Forces, symmetries and the stepper.

@@ -1,0 +1,1 @@
+//! Long-ish runs against measured behaviour (relaxation of the paper's scene).
