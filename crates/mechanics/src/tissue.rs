@@ -2,9 +2,11 @@
 //!
 //! One evaluation of the right-hand side `R(φ)` (MODEL.md §3–4) runs four passes:
 //! 1. per cell, in parallel: area `A_i = Σ φ_i²` and deformation tensor `S_i`;
-//! 2. scatter onto the lattice, stripe-parallel in cell order: `s1, s2, s3, s4, sA, Q_xx, Q_xy`;
+//! 2. scatter onto the lattice, stripe-parallel in cell order:
+//!    `s1, s2, s3, s4, sA, Q_xx, Q_xy, Σ∇²φ_i`;
 //! 3. per lattice row, in parallel: the pressure `P`;
-//! 4. per cell, in parallel: the force `F_i = Σ_x [P ∇φ_i + ζ Q·∇φ_i]`, the velocity
+//! 4. per cell, in parallel: the force `F_i = Σ_x [(P − P_i^self) ∇φ_i + ζ Q·∇φ_i]` (see
+//!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
 use phasefield::{for_each_stencil, Cells, ComTable, Lattice};
@@ -15,7 +17,7 @@ use crate::scatter::scatter;
 use crate::StepError;
 
 /// Components of the global (lattice-wide) sums, per node.
-pub const N_GLOBAL: usize = 7;
+pub const N_GLOBAL: usize = 8;
 /// Index of `s1 = Σ φ_i` in a global node record.
 pub const G_S1: usize = 0;
 /// Index of `s2 = Σ φ_i²`.
@@ -30,6 +32,10 @@ pub const G_SA: usize = 4;
 pub const G_QXX: usize = 5;
 /// Index of `Q_xy = Σ φ_i S_i,xy`.
 pub const G_QXY: usize = 6;
+/// Index of `Σ ∇²φ_i`, each Laplacian taken on the cell's own periodic patch. It equals the
+/// lattice Laplacian `∇² s1` in full-domain storage; on patches it is the form whose self
+/// term `Σ_x ∇²φ_i ∂φ_i` vanishes exactly, so that an isolated cell feels no force.
+pub const G_LAP: usize = 7;
 
 /// Per-cell quantities derived from the fields by one evaluation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -241,13 +247,15 @@ pub fn evaluate(
     let zeta = params.zeta;
 
     // 1. Per cell: area, deformation tensor, range.
+    // The Laplacians go into `rhs` as scratch; pass 4 overwrites them.
     cell_state
         .par_iter_mut()
-        .zip(phi.par_chunks(plen))
-        .for_each(|(st, cell)| {
+        .zip(phi.par_chunks(plen).zip(rhs.par_chunks_mut(plen)))
+        .for_each(|(st, (cell, lap))| {
             let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
             let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for_each_stencil(cell, shape, |_, s| {
+            for_each_stencil(cell, shape, |k, s| {
+                lap[k] = s.laplacian();
                 let (dx, dy) = (s.dx(), s.dy());
                 area += s.c * s.c;
                 sxx += 0.5 * (dy * dy - dx * dx);
@@ -264,16 +272,25 @@ pub fn evaluate(
     // 2. Global sums.
     {
         let cs: &[CellState] = cell_state;
-        scatter::<N_GLOBAL, _>(cells, phi, global, |i, _, p| {
+        let lap: &[f64] = rhs;
+        scatter::<N_GLOBAL, _>(cells, phi, global, |i, k, p| {
             let c = &cs[i];
             let p2 = p * p;
-            [p, p2, p2 * p, p2 * p2, p * c.area, p * c.shape[0], p * c.shape[1]]
+            [
+                p,
+                p2,
+                p2 * p,
+                p2 * p2,
+                p * c.area,
+                p * c.shape[0],
+                p * c.shape[1],
+                lap[i * plen + k],
+            ]
         });
     }
 
     // 3. Pressure.
     let ly = lattice.ly;
-    let lx = lattice.lx;
     let g: &[f64] = global;
     match params.pressure {
         PressureKind::Paper => {
@@ -285,17 +302,11 @@ pub fn evaluate(
                 4.0 * energy.mu / a0,
             );
             pressure.par_chunks_mut(ly).enumerate().for_each(|(x, row)| {
-                let xm = (x + lx - 1) % lx;
-                let xp = (x + 1) % lx;
                 for y in 0..ly {
-                    let ym = if y == 0 { ly - 1 } else { y - 1 };
-                    let yp = if y + 1 == ly { 0 } else { y + 1 };
                     let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
-                    let s1 = |xx: usize, yy: usize| g[(xx * ly + yy) * N_GLOBAL + G_S1];
-                    let lap = s1(xm, y) + s1(xp, y) + s1(x, ym) + s1(x, yp) - 4.0 * n[G_S1];
                     row[y] = c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
                         - c_ch * (n[G_S1] - 3.0 * n[G_S2] + 2.0 * n[G_S3])
-                        + c_lap * lap
+                        + c_lap * n[G_LAP]
                         + c_area * (n[G_S1] - n[G_SA] / a0);
                 }
             });
@@ -316,6 +327,15 @@ pub fn evaluate(
     let map = cells.map();
     let ny = shape.ny;
     let xi = params.xi;
+    // The paper's P contains cell i's own double-well term −(8γ/λ) φ_i(1−φ_i)(1−2φ_i). Its
+    // contribution to F_i is the integral of a gradient, zero in the continuum, but its central
+    // difference sum is not zero on the lattice and would propel isolated cells (|v| ~ 5e-4).
+    // It is removed here; the other self terms (∇²φ_i ∇φ_i and φ_i ∇φ_i) already sum to zero
+    // exactly on a periodic patch.
+    let c_self = match params.pressure {
+        PressureKind::Paper => 8.0 * energy.gamma / energy.lambda,
+        PressureKind::Interaction => 0.0,
+    };
     rhs.par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
         .zip(cell_state.par_iter_mut())
@@ -327,7 +347,7 @@ pub fn evaluate(
             let (mut fx, mut fy) = (0.0, 0.0);
             for_each_stencil(cell, shape, |k, s| {
                 let n = node(k);
-                let p = pr[n];
+                let p = pr[n] + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
                 let (qxx, qxy) = (g[n * N_GLOBAL + G_QXX], g[n * N_GLOBAL + G_QXY]);
                 let (dx, dy) = (s.dx(), s.dy());
                 fx += p * dx + zeta * (qxx * dx + qxy * dy);
