@@ -2,6 +2,7 @@
 
 mod cli;
 mod mechanics_tests;
+mod patch_tests;
 mod phasefield_tests;
 mod regression;
 mod strategies;
