@@ -148,7 +148,7 @@ fn two_overlapping_cells_move_apart_with_equal_and_opposite_velocities() {
             advance(&mut t, &mut ws, 50, &HEUN);
             assert!(t.centre[1][0] - t.centre[0][0] > d0);
             // A generic pair, on no symmetry axis: equal and opposite to the net-force bound.
-            let (t2, mut ws2) = tissue(discs(100, 12, &[[40.3, 47.1], [51.2, 53.9]], 8.0), zeta, pressure);
+            let (mut t2, mut ws2) = tissue(discs(100, 12, &[[40.3, 47.1], [51.2, 53.9]], 8.0), zeta, pressure);
             t2.refresh(&mut ws2);
             let (f0, f1) = (ws2.cell_state[0].force, ws2.cell_state[1].force);
             let rel = (f0[0] + f1[0]).hypot(f0[1] + f1[1]) / (f0[0].hypot(f0[1]) + f1[0].hypot(f1[1]));
@@ -174,7 +174,7 @@ fn net_force_vanishes_on_mirror_symmetric_clusters() {
         for pressure in PRESSURES {
             // Symmetric under x -> 92 - x and y -> 92 - y.
             let c = [[40.0, 40.0], [52.0, 40.0], [40.0, 52.0], [52.0, 52.0], [46.0, 46.0]];
-            let (t, mut ws) = tissue(discs(100, 12, &c, 7.0), zeta, pressure);
+            let (mut t, mut ws) = tissue(discs(100, 12, &c, 7.0), zeta, pressure);
             t.refresh(&mut ws);
             let r = net_force_ratio(&ws);
             assert!(r < 1e-13, "zeta={zeta} {pressure:?}: {r}");

@@ -51,7 +51,7 @@ pub use tissue::{
 #[non_exhaustive]
 pub enum StepError {
     /// A field or force became NaN or infinite.
-    #[error("cell {cell_idx} became non-finite at step {step} (t = {time}); the time step is too large or the parameters are unstable: reduce [integrator] dt")]
+    #[error("cell {cell_idx} became non-finite at step {step} (t = {time:.3}); the time step is too large or the parameters are unstable: reduce [integrator] dt")]
     NonFinite {
         /// Step at which it was found.
         step: u64,
@@ -61,7 +61,7 @@ pub enum StepError {
         cell_idx: usize,
     },
     /// A field left the band of values that stable runs stay in.
-    #[error("cell {cell_idx} reached φ = {phi:.3} at step {step} (t = {time}), outside [-{b}, {}]: the integration is blowing up; reduce [integrator] dt (now {dt}), e.g. to {}", 1.0 + PHI_BOUND, dt / 2.0, b = PHI_BOUND)]
+    #[error("cell {cell_idx} reached φ = {phi:.3} at step {step} (t = {time:.3}), outside [-{b}, {}]: the integration is blowing up; reduce [integrator] dt (now {dt}), e.g. to {}", 1.0 + PHI_BOUND, dt / 2.0, b = PHI_BOUND)]
     Unstable {
         /// Step at which it was found.
         step: u64,

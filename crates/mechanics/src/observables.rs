@@ -27,7 +27,7 @@ pub struct Observables {
 impl Tissue {
     /// Refreshes the derived quantities into `ws` and computes the observables of the current
     /// state. Leaves the tissue velocity field `Σ φ_i v_i` in `ws.field2` (`[vx, vy]` per node).
-    pub fn observe(&self, ws: &mut Workspace) -> Observables {
+    pub fn observe(&mut self, ws: &mut Workspace) -> Observables {
         self.refresh(ws);
         let Workspace {
             cell_state, field2, ..

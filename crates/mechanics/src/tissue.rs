@@ -124,7 +124,8 @@ impl Tissue {
         self.cells.lattice()
     }
 
-    fn update_centres(&mut self, com: &ComTable) {
+    /// Recomputes every centre of mass from the current patch values.
+    fn compute_centres(&mut self, com: &ComTable) {
         let cells = &self.cells;
         let shape = cells.shape();
         self.centre.par_iter_mut().enumerate().for_each(|(i, c)| {
@@ -135,14 +136,25 @@ impl Tissue {
                 cells.map().cell_y(shape, i),
             );
         });
+    }
+
+    /// Recomputes the centres and moves each patch onto its cell's centre.
+    fn update_centres(&mut self, com: &ComTable) {
+        self.compute_centres(com);
         for i in 0..self.cells.n_cells() {
             self.cells.recentre(i, self.centre[i]);
         }
     }
 
     /// Evaluates the derived quantities of the current state (areas, shapes, forces,
-    /// velocities, the global sums and the pressure) into `ws`, without stepping.
-    pub fn refresh(&self, ws: &mut Workspace) {
+    /// velocities, the global sums and the pressure) into `ws`, without stepping, and
+    /// recomputes the centres of mass from the patches as they are now.
+    ///
+    /// After a step, [`Tissue::centre`] holds the centres that placed the patches; when a patch
+    /// has just moved, the row or column that wrapped around carries far-edge values (MODEL.md
+    /// §5), so the centre of the stored values can differ from it by the neglected tail.
+    pub fn refresh(&mut self, ws: &mut Workspace) {
+        self.compute_centres(&ws.com);
         let Workspace {
             k2,
             global,

@@ -1,0 +1,183 @@
+//! The `monolayer` binary end to end: output files, reproducibility across thread counts, and
+//! every bad-scene case with its message and exit status.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_monolayer"))
+}
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name)
+}
+
+fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut c = bin();
+    c.arg("run").arg(scene).arg("--out").arg(out).arg("--quiet");
+    for e in extra {
+        c.arg(e);
+    }
+    c.output().expect("the binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A short version of the paper scene: 4 TU relaxation, 6 TU activity.
+const SHORT: [&str; 8] = [
+    "--set",
+    "run.relax_time=4",
+    "--set",
+    "run.time=6",
+    "--set",
+    "run.output_every=2",
+    "--set",
+    "run.series_every=1",
+];
+
+#[test]
+fn a_run_writes_scene_series_and_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(&scene_path("paper.toml"), dir.path(), &SHORT);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let series = std::fs::read_to_string(dir.path().join("series.csv")).unwrap();
+    let mut lines = series.lines();
+    assert!(lines.next().unwrap().starts_with("step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max"));
+    // 10 TU at dt = 0.2 with a row every TU: rows at t = 0, 1, ..., 10.
+    assert_eq!(lines.count(), 11);
+    let frames: Vec<_> = std::fs::read_dir(dir.path().join("frames")).unwrap().collect();
+    assert_eq!(frames.len(), 6, "frames at t = 0, 2, ..., 10");
+    // The resolved scene parses back and has every default filled in.
+    let resolved = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+    let scene = monolayer_cli::scene::Scene::parse(&resolved, &[]).unwrap();
+    assert_eq!(scene.run.time, 6.0);
+    assert_eq!(scene.integrator.margin, 12);
+}
+
+/// The README's three-line snippet, run by NumPy itself. CI installs NumPy; elsewhere the test
+/// says so and passes only if NumPy is missing *and* we are not in CI.
+#[test]
+fn frames_load_in_numpy_without_custom_code() {
+    let have_numpy = Command::new("python3").args(["-c", "import numpy"]).status().map(|s| s.success()).unwrap_or(false);
+    if !have_numpy {
+        assert!(std::env::var("CI").is_err(), "CI must install numpy (see .ci/run)");
+        eprintln!("numpy not installed: skipping the NumPy check");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(&scene_path("paper.toml"), dir.path(), &SHORT);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let script = format!(
+        r#"
+import numpy as np
+f = np.load("{}/frames/frame_00000050.npz")
+phi, origin, lx_ly = f["phi"], f["origin"], f["lattice"]
+assert phi.shape == (60, 25, 25), phi.shape
+assert f["centre"].shape == (60, 2) and f["velocity"].shape == (60, 2) and f["area"].shape == (60,)
+assert abs(float(f["time"]) - 10.0) < 1e-9
+# The area in the frame is the sum of phi^2 over the patch.
+assert np.allclose((phi ** 2).sum(axis=(1, 2)), f["area"], rtol=1e-12)
+# Patch element [u, v] sits at lattice node (origin + [u, v]) mod L: its centre of mass agrees.
+L = lx_ly.astype(float)
+for i in range(60):
+    u, v = np.meshgrid(np.arange(25), np.arange(25), indexing="ij")
+    for s, idx in ((0, u), (1, v)):
+        z = (phi[i] * np.exp(2j * np.pi * ((origin[i, s] + idx) % L[s]) / L[s])).sum()
+        c = (np.angle(z) / (2 * np.pi) * L[s]) % L[s]
+        d = (c - f["centre"][i, s] + L[s] / 2) % L[s] - L[s] / 2
+        assert abs(d) < 1e-9, (i, s, c, f["centre"][i, s])
+print("ok")
+"#,
+        dir.path().display()
+    );
+    let py = Command::new("python3").args(["-c", &script]).output().unwrap();
+    assert!(py.status.success(), "{}", String::from_utf8_lossy(&py.stderr));
+}
+
+#[test]
+fn the_same_seed_gives_identical_output_with_one_and_two_threads() {
+    let a = tempfile::tempdir().unwrap();
+    let b = tempfile::tempdir().unwrap();
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        let mut args = SHORT.to_vec();
+        args.extend(["--threads", threads, "--set", "model.zeta=0.01"]);
+        let o = run(&scene_path("paper.toml"), dir.path(), &args);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let read = |d: &Path, f: &str| std::fs::read(d.join(f)).unwrap();
+    assert_eq!(read(a.path(), "series.csv"), read(b.path(), "series.csv"));
+    for t in ["00000000", "00000030", "00000050"] {
+        let f = format!("frames/frame_{t}.npz");
+        assert_eq!(read(a.path(), &f), read(b.path(), &f), "{f}");
+    }
+}
+
+/// Writes a scene to a temporary file, runs it and returns (exit success, stderr).
+fn run_text(text: &str, extra: &[&str]) -> (bool, String, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let o = run(&path, &dir.path().join("out"), extra);
+    (o.status.success(), stderr(&o), dir)
+}
+
+const GOOD: &str = r#"
+[domain]
+lx = 100
+ly = 100
+[cells]
+count = 60
+radius = 8.0
+[run]
+time = 1.0
+output_every = 1.0
+"#;
+
+/// Each bad scene: the binary exits non-zero and names the key and a fix.
+#[test]
+fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
+    let cases: &[(&str, &[&str], &[&str])] = &[
+        ("unknown key", &["--set", "model.zetta=0.01"], &["zetta", "expected one of"]),
+        ("unknown section", &["--set", "physics.zeta=0.01"], &["physics"]),
+        ("negative radius", &["--set", "cells.radius=-3"], &["[cells] radius", "must be positive"]),
+        ("margin smaller than the radius", &["--set", "integrator.margin=5"], &["[integrator] margin", "use margin"]),
+        ("patch larger than the domain", &["--set", "integrator.margin=60"], &["[integrator] margin", "at most 49"]),
+        ("more cells than fit", &["--set", "cells.count=1000"], &["[cells] count", "do not fit", "fewer cells"]),
+        ("unstable dt", &["--set", "integrator.dt=5"], &["[integrator] dt", "unstable", "use dt ≤"]),
+        ("zero dt", &["--set", "integrator.dt=0"], &["[integrator] dt", "positive"]),
+        ("negative lambda", &["--set", "model.lambda=-1"], &["[model] lambda"]),
+        ("wrong type", &["--set", "cells.count=\"many\""], &["count"]),
+        ("positions without init", &["--set", "cells.positions=[[1.0, 2.0]]"], &["[cells] positions", "init = \"positions\""]),
+        ("positions off the domain", &["--set", "cells.init=\"positions\"", "--set", "cells.count=1", "--set", "cells.positions=[[150.0, 2.0]]"], &["[cells] positions", "outside the domain"]),
+        ("bad override", &["--set", "zeta"], &["--set zeta", "section.key=value"]),
+    ];
+    for (name, extra, needles) in cases {
+        let (ok, err, dir) = run_text(GOOD, extra);
+        assert!(!ok, "{name}: must fail");
+        for n in *needles {
+            assert!(err.contains(n), "{name}: {err:?} lacks {n:?}");
+        }
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        assert!(!dir.path().join("out/series.csv").exists(), "{name}: nothing is run");
+    }
+    let (ok, err, _d) = run_text("[domain]\nlx = 100\n", &[]);
+    assert!(!ok && err.contains("missing field") && err.contains("ly"), "{err}");
+    let (ok, err, _d) = run_text(GOOD, &[]);
+    assert!(ok, "the good scene runs: {err}");
+}
+
+/// A run that blows up stops with an error naming the step and the cell, exits non-zero and
+/// keeps the series written so far.
+#[test]
+fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
+    let (ok, err, dir) = run_text(GOOD, &["--set", "model.zeta=1.0", "--set", "run.time=400", "--set", "run.output_every=50", "--set", "run.series_every=1"]);
+    assert!(!ok);
+    assert!(err.contains("at step") && err.contains("cell ") && err.contains("reduce [integrator] dt"), "{err}");
+    assert!(err.contains("output up to step"), "{err}");
+    let series = std::fs::read_to_string(dir.path().join("out/series.csv")).unwrap();
+    assert!(series.lines().count() > 10, "rows before the blow-up are kept");
+    assert!(series.lines().skip(1).all(|l| !l.contains("NaN") && !l.contains("inf")));
+    assert!(dir.path().join("out/frames/frame_00000000.npz").exists());
+}
