@@ -1,0 +1,1 @@
+//! Criterion benchmarks of monolayer live in `step.rs`; this library is empty.

@@ -1,0 +1,52 @@
+//! One relaxed time step (Heun, dt = 0.2, ζ = 0.005) of the shipped scenes `paper.toml`
+//! (60 cells, 100²) and `large.toml` (960 cells, 400²), with patch margins 12 and 25, on one
+//! and two threads. Throughput is in node updates: cells × patch nodes per step (each step is
+//! two sweeps, predictor and corrector), the unit of `node_substeps_per_s` in
+//! `../shared/reference/celadro-performance.csv`.
+//!
+//! Run with `cargo bench -p monolayer-benches --bench step`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use mechanics::{Tissue, Workspace};
+use monolayer_cli::scene::Scene;
+
+/// Relaxation before timing, in steps (20 TU): the initial discs have grown to confluence.
+const RELAX_STEPS: usize = 100;
+
+fn relaxed(scene: &str, margin: usize) -> (Tissue, Workspace, Scene) {
+    let path = format!("{}/../scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).unwrap();
+    let s = Scene::parse(&text, &[format!("integrator.margin={margin}")]).unwrap();
+    let mut t = s.build().unwrap();
+    let mut ws = Workspace::new(&t.cells);
+    t.params.zeta = 0.0;
+    for _ in 0..RELAX_STEPS {
+        t.step(&mut ws, &s.step_params()).unwrap();
+    }
+    t.params.zeta = 0.005;
+    (t, ws, s)
+}
+
+fn bench_step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("step");
+    g.sample_size(10);
+    for scene in ["paper.toml", "large.toml"] {
+        for margin in [12, 25] {
+            let pool2 = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+            let (mut t, mut ws, s) = pool2.install(|| relaxed(scene, margin));
+            let sp = s.step_params();
+            g.throughput(Throughput::Elements((t.cells.n_cells() * t.cells.patch_len()) as u64));
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                let id = BenchmarkId::new(format!("{}-m{margin}", scene.trim_end_matches(".toml")), format!("threads={threads}"));
+                g.bench_function(id, |b| {
+                    pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
+                });
+            }
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_step);
+criterion_main!(benches);
