@@ -6,7 +6,7 @@
 //!
 //! Run with `cargo bench -p monolayer-benches --bench step`.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
 use monolayer_cli::scene::Scene;
 
@@ -32,13 +32,24 @@ fn bench_step(c: &mut Criterion) {
     g.sample_size(10);
     for scene in ["paper.toml", "large.toml"] {
         for margin in [12, 25] {
-            let pool2 = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+            let pool2 = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap();
             let (mut t, mut ws, s) = pool2.install(|| relaxed(scene, margin));
             let sp = s.step_params();
-            g.throughput(Throughput::Elements((t.cells.n_cells() * t.cells.patch_len()) as u64));
+            g.throughput(Throughput::Elements(
+                (t.cells.n_cells() * t.cells.patch_len()) as u64,
+            ));
             for threads in [1, 2] {
-                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-                let id = BenchmarkId::new(format!("{}-m{margin}", scene.trim_end_matches(".toml")), format!("threads={threads}"));
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let id = BenchmarkId::new(
+                    format!("{}-m{margin}", scene.trim_end_matches(".toml")),
+                    format!("threads={threads}"),
+                );
                 g.bench_function(id, |b| {
                     pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
                 });
@@ -48,5 +59,9 @@ fn bench_step(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_step);
+#[allow(missing_docs)]
+mod group {
+    criterion::criterion_group!(benches, super::bench_step);
+}
+use group::benches;
 criterion_main!(benches);

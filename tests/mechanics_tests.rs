@@ -85,7 +85,10 @@ fn translated_rotated_and_mirrored_states_give_the_image_trajectory() {
             );
             for (name, (e_phi, e_c, e_v)) in [("translation", t), ("rotation", r), ("mirror", m)] {
                 eprintln!("{name} zeta={zeta} {pressure:?}: phi {e_phi:.1e} centre {e_c:.1e} velocity {e_v:.1e}");
-                assert!(e_phi < 1e-10 && e_c < 1e-10 && e_v < 1e-10, "{name}: {e_phi} {e_c} {e_v}");
+                assert!(
+                    e_phi < 1e-10 && e_c < 1e-10 && e_v < 1e-10,
+                    "{name}: {e_phi} {e_c} {e_v}"
+                );
             }
         }
     }
@@ -139,7 +142,11 @@ fn two_overlapping_cells_move_apart_with_equal_and_opposite_velocities() {
     for &zeta in &ZETAS {
         for pressure in PRESSURES {
             // Mirror-symmetric about x = 46 (a node), so the balance is exact to round-off.
-            let (mut t, mut ws) = tissue(discs(100, 12, &[[40.0, 50.0], [52.0, 50.0]], 8.0), zeta, pressure);
+            let (mut t, mut ws) = tissue(
+                discs(100, 12, &[[40.0, 50.0], [52.0, 50.0]], 8.0),
+                zeta,
+                pressure,
+            );
             t.refresh(&mut ws);
             let (v0, v1) = (ws.cell_state[0].velocity, ws.cell_state[1].velocity);
             assert!(v0[0] < 0.0 && v1[0] > 0.0, "they must repel: {v0:?} {v1:?}");
@@ -148,10 +155,15 @@ fn two_overlapping_cells_move_apart_with_equal_and_opposite_velocities() {
             advance(&mut t, &mut ws, 50, &HEUN);
             assert!(t.centre[1][0] - t.centre[0][0] > d0);
             // A generic pair, on no symmetry axis: equal and opposite to the net-force bound.
-            let (mut t2, mut ws2) = tissue(discs(100, 12, &[[40.3, 47.1], [51.2, 53.9]], 8.0), zeta, pressure);
+            let (mut t2, mut ws2) = tissue(
+                discs(100, 12, &[[40.3, 47.1], [51.2, 53.9]], 8.0),
+                zeta,
+                pressure,
+            );
             t2.refresh(&mut ws2);
             let (f0, f1) = (ws2.cell_state[0].force, ws2.cell_state[1].force);
-            let rel = (f0[0] + f1[0]).hypot(f0[1] + f1[1]) / (f0[0].hypot(f0[1]) + f1[0].hypot(f1[1]));
+            let rel =
+                (f0[0] + f1[0]).hypot(f0[1] + f1[1]) / (f0[0].hypot(f0[1]) + f1[0].hypot(f1[1]));
             eprintln!("pair zeta={zeta} {pressure:?}: |F0+F1|/(|F0|+|F1|) = {rel:.2e}");
             assert!(rel < 1e-2, "{rel}");
         }
@@ -173,7 +185,13 @@ fn net_force_vanishes_on_mirror_symmetric_clusters() {
     for &zeta in &ZETAS {
         for pressure in PRESSURES {
             // Symmetric under x -> 92 - x and y -> 92 - y.
-            let c = [[40.0, 40.0], [52.0, 40.0], [40.0, 52.0], [52.0, 52.0], [46.0, 46.0]];
+            let c = [
+                [40.0, 40.0],
+                [52.0, 40.0],
+                [40.0, 52.0],
+                [52.0, 52.0],
+                [46.0, 46.0],
+            ];
             let (mut t, mut ws) = tissue(discs(100, 12, &c, 7.0), zeta, pressure);
             t.refresh(&mut ws);
             let r = net_force_ratio(&ws);
@@ -196,11 +214,21 @@ pub const NET_FORCE_BOUND: f64 = 0.25;
 fn net_force_is_small_on_random_confluent_states() {
     use proptest::prelude::*;
     use proptest::test_runner::{Config, TestRng, TestRunner};
-    let cases = std::env::var("MONOLAYER_NET_FORCE_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(6);
-    let config = Config { cases, ..Config::default() };
+    let cases = std::env::var("MONOLAYER_NET_FORCE_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(6);
+    let config = Config {
+        cases,
+        ..Config::default()
+    };
     let rng = TestRng::deterministic_rng(config.rng_algorithm);
     let mut runner = TestRunner::new_with_rng(config, rng);
-    let strategy = (0u64..10_000, -0.01f64..0.01, prop_oneof![Just(PressureKind::Paper), Just(PressureKind::Interaction)]);
+    let strategy = (
+        0u64..10_000,
+        -0.01f64..0.01,
+        prop_oneof![Just(PressureKind::Paper), Just(PressureKind::Interaction)],
+    );
     runner
         .run(&strategy, |(seed, zeta, pressure)| {
             let (mut t, mut ws) = confluent(100, seed, 150, pressure);
@@ -217,7 +245,10 @@ fn net_force_is_small_on_random_confluent_states() {
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
     let run = |threads: usize| -> Tissue {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let (mut t, mut ws) = confluent(100, 4, 20, PressureKind::Paper);
             t.params.zeta = 0.01;

@@ -40,7 +40,8 @@ pub fn patch_error(m: usize, zeta: f64) -> (f64, f64, usize) {
             e_c = e_c.max(lat.distance(full.centre[i], sub.centre[i]));
             for x in 0..L {
                 for y in 0..L {
-                    e_phi = e_phi.max((full.cells.value_at(i, x, y) - sub.cells.value_at(i, x, y)).abs());
+                    e_phi = e_phi
+                        .max((full.cells.value_at(i, x, y) - sub.cells.value_at(i, x, y)).abs());
                 }
             }
         }
@@ -62,7 +63,10 @@ fn a_patch_crossing_the_periodic_edges_matches_the_full_domain() {
         assert!(crossings >= 2, "the cell must cross both edges");
         assert!(e_c < 2.0 * tail(m), "m = {m}: centre error {e_c}");
         assert!(e_phi < 2.0 * tail(m), "m = {m}: phi error {e_phi}");
-        assert!(e_c < prev.0 && e_phi < prev.1, "errors must fall with the margin");
+        assert!(
+            e_c < prev.0 && e_phi < prev.1,
+            "errors must fall with the margin"
+        );
         prev = (e_c, e_phi);
     }
 }

@@ -25,7 +25,10 @@ fn cells_from(values: &[f64]) -> Cells {
 fn analytic(e: &EnergyParams, cells: &Cells, i: usize, k: usize) -> f64 {
     let shape = cells.shape();
     let area: f64 = cells.cell_phi(i).iter().map(|p| p * p).sum();
-    let others: f64 = (0..cells.n_cells()).filter(|&j| j != i).map(|j| cells.cell_phi(j)[k].powi(2)).sum();
+    let others: f64 = (0..cells.n_cells())
+        .filter(|&j| j != i)
+        .map(|j| cells.cell_phi(j)[k].powi(2))
+        .sum();
     let mut out = 0.0;
     for_each_stencil(cells.cell_phi(i), shape, |kk, s| {
         if kk == k {
@@ -36,7 +39,10 @@ fn analytic(e: &EnergyParams, cells: &Cells, i: usize, k: usize) -> f64 {
 }
 
 fn check_derivative(e: EnergyParams) {
-    let mut runner = TestRunner::new(Config { cases: 24, ..Config::default() });
+    let mut runner = TestRunner::new(Config {
+        cases: 24,
+        ..Config::default()
+    });
     runner
         .run(&(random_state(), 0..3usize, 0..L * L), |(values, i, k)| {
             let mut cells = cells_from(&values);
@@ -50,7 +56,10 @@ fn check_derivative(e: EnergyParams) {
             cells.phi_mut()[idx] = values[idx] - h;
             let fm = e.free_energy(&cells);
             let fd = (fp - fm) / (2.0 * h);
-            prop_assert!((fd - a).abs() < 1e-7 * (1.0 + a.abs()), "analytic {a}, finite difference {fd}");
+            prop_assert!(
+                (fd - a).abs() < 1e-7 * (1.0 + a.abs()),
+                "analytic {a}, finite difference {fd}"
+            );
             Ok(())
         })
         .unwrap();
@@ -58,22 +67,46 @@ fn check_derivative(e: EnergyParams) {
 
 #[test]
 fn cahn_hilliard_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams { gamma: 0.7, mu: 0.0, lambda: 2.5, kappa: 0.0, radius: 3.0 });
+    check_derivative(EnergyParams {
+        gamma: 0.7,
+        mu: 0.0,
+        lambda: 2.5,
+        kappa: 0.0,
+        radius: 3.0,
+    });
 }
 
 #[test]
 fn area_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams { gamma: 0.0, mu: 3.0, lambda: 2.5, kappa: 0.0, radius: 3.0 });
+    check_derivative(EnergyParams {
+        gamma: 0.0,
+        mu: 3.0,
+        lambda: 2.5,
+        kappa: 0.0,
+        radius: 3.0,
+    });
 }
 
 #[test]
 fn repulsion_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams { gamma: 0.0, mu: 0.0, lambda: 2.5, kappa: 0.4, radius: 3.0 });
+    check_derivative(EnergyParams {
+        gamma: 0.0,
+        mu: 0.0,
+        lambda: 2.5,
+        kappa: 0.4,
+        radius: 3.0,
+    });
 }
 
 #[test]
 fn full_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams { gamma: 0.3, mu: 3.0, lambda: 1.7, kappa: 0.4, radius: 3.0 });
+    check_derivative(EnergyParams {
+        gamma: 0.3,
+        mu: 3.0,
+        lambda: 1.7,
+        kappa: 0.4,
+        radius: 3.0,
+    });
 }
 
 /// Exact (to round-off) on a disc symmetric about its storage, anywhere, including across
@@ -83,30 +116,36 @@ fn full_derivative_is_the_gradient_of_the_discrete_energy() {
 #[test]
 fn centre_of_mass_is_exact_on_a_wrapped_disc() {
     let l = 60;
-    let mut runner = TestRunner::new(Config { cases: 64, ..Config::default() });
+    let mut runner = TestRunner::new(Config {
+        cases: 64,
+        ..Config::default()
+    });
     runner
-        .run(&(node_or_half(l), prop_oneof![Just(0usize), Just(12usize)]), |(mut c, margin)| {
-            if margin > 0 {
-                c = [c[0].floor(), c[1].floor()];
-            }
-            let lattice = Lattice::new(l, l);
-            let shape = PatchShape::new(lattice, margin).unwrap();
-            let cells = init::discs(lattice, shape, &[c], 6.3, 2.5);
-            let com = ComTable::new(lattice);
-            let got = com.centre_of_mass(
-                cells.cell_phi(0),
-                cells.shape(),
-                cells.map().cell_x(cells.shape(), 0),
-                cells.map().cell_y(cells.shape(), 0),
-            );
-            for s in 0..2 {
-                // A wrapped coordinate near 0 may come back near L: compare on the circle.
-                let d = phasefield::min_image(got[s] - c[s], l as f64);
-                // Round-off of atan2 scaled by L/2π: a few ε·L.
-                prop_assert!(d.abs() < 1e-12 * l as f64, "axis {s}: {c:?} -> {got:?}");
-            }
-            Ok(())
-        })
+        .run(
+            &(node_or_half(l), prop_oneof![Just(0usize), Just(12usize)]),
+            |(mut c, margin)| {
+                if margin > 0 {
+                    c = [c[0].floor(), c[1].floor()];
+                }
+                let lattice = Lattice::new(l, l);
+                let shape = PatchShape::new(lattice, margin).unwrap();
+                let cells = init::discs(lattice, shape, &[c], 6.3, 2.5);
+                let com = ComTable::new(lattice);
+                let got = com.centre_of_mass(
+                    cells.cell_phi(0),
+                    cells.shape(),
+                    cells.map().cell_x(cells.shape(), 0),
+                    cells.map().cell_y(cells.shape(), 0),
+                );
+                for s in 0..2 {
+                    // A wrapped coordinate near 0 may come back near L: compare on the circle.
+                    let d = phasefield::min_image(got[s] - c[s], l as f64);
+                    // Round-off of atan2 scaled by L/2π: a few ε·L.
+                    prop_assert!(d.abs() < 1e-12 * l as f64, "axis {s}: {c:?} -> {got:?}");
+                }
+                Ok(())
+            },
+        )
         .unwrap();
 }
 
@@ -115,8 +154,20 @@ fn centre_of_mass_follows_a_disc_across_both_edges() {
     let l = 48;
     let lattice = Lattice::new(l, l);
     let com = ComTable::new(lattice);
-    for &c in &[[0.0, 0.0], [47.0, 1.0], [1.0, 47.0], [47.0, 47.0], [24.0, 46.0]] {
-        let cells = init::discs(lattice, PatchShape::new(lattice, 10).unwrap(), &[c], 5.0, 2.5);
+    for &c in &[
+        [0.0, 0.0],
+        [47.0, 1.0],
+        [1.0, 47.0],
+        [47.0, 47.0],
+        [24.0, 46.0],
+    ] {
+        let cells = init::discs(
+            lattice,
+            PatchShape::new(lattice, 10).unwrap(),
+            &[c],
+            5.0,
+            2.5,
+        );
         let got = com.centre_of_mass(
             cells.cell_phi(0),
             cells.shape(),
@@ -124,7 +175,10 @@ fn centre_of_mass_follows_a_disc_across_both_edges() {
             cells.map().cell_y(cells.shape(), 0),
         );
         for s in 0..2 {
-            assert!(phasefield::min_image(got[s] - c[s], l as f64).abs() < 1e-12 * l as f64, "{c:?} -> {got:?}");
+            assert!(
+                phasefield::min_image(got[s] - c[s], l as f64).abs() < 1e-12 * l as f64,
+                "{c:?} -> {got:?}"
+            );
             assert!((0.0..l as f64).contains(&got[s]));
         }
     }

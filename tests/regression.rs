@@ -4,7 +4,9 @@ use mechanics::{Observables, Workspace};
 use monolayer_cli::scene::Scene;
 
 fn paper_scene(overrides: &[&str]) -> Scene {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/paper.toml")).unwrap();
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/paper.toml"))
+            .unwrap();
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let scene = Scene::parse(&text, &o).unwrap();
     scene.validate().unwrap();
@@ -43,11 +45,22 @@ fn sixty_cells_relax_at_zero_activity() {
     let peak = series.iter().map(|(_, o)| o.v_rms).fold(0.0, f64::max);
     let (t_end, end) = *series.last().unwrap();
     assert!((t_end - 1200.0).abs() < 1e-6);
-    eprintln!("peak v_rms {peak:.3e}, final {:.3e}, areas [{:.1}, {:.1}] mean {:.2}", end.v_rms, end.area_min, end.area_max, end.area_mean);
+    eprintln!(
+        "peak v_rms {peak:.3e}, final {:.3e}, areas [{:.1}, {:.1}] mean {:.2}",
+        end.v_rms, end.area_min, end.area_max, end.area_mean
+    );
     // At least a factor 20 below the peak, and below the reference code's 1e-3 level × 2.
-    assert!(end.v_rms < peak / 20.0 && end.v_rms < 2e-3, "{} vs peak {peak}", end.v_rms);
+    assert!(
+        end.v_rms < peak / 20.0 && end.v_rms < 2e-3,
+        "{} vs peak {peak}",
+        end.v_rms
+    );
     // Decreasing from 100 TU on, sampled every 100 TU.
-    let late: Vec<f64> = series.iter().filter(|(t, _)| *t >= 99.0 && (*t as u64).is_multiple_of(100)).map(|(_, o)| o.v_rms).collect();
+    let late: Vec<f64> = series
+        .iter()
+        .filter(|(t, _)| *t >= 99.0 && (*t as u64).is_multiple_of(100))
+        .map(|(_, o)| o.v_rms)
+        .collect();
     assert!(late.windows(2).all(|w| w[1] < w[0]), "{late:?}");
     // Areas: within ±4 % of the mean (measured ±2.1 %), the mean within 1 of 167.3.
     assert!(end.area_min > 0.96 * end.area_mean && end.area_max < 1.04 * end.area_mean);
@@ -63,7 +76,11 @@ fn sixty_cells_relax_at_zero_activity() {
 fn active_statistics_agree_with_the_reference_code() {
     let scene = paper_scene(&["model.pressure=\"interaction\"", "run.seed=3"]);
     let series = run(&scene, 5);
-    let last: Vec<&Observables> = series.iter().filter(|(t, _)| *t >= 700.0 - 1e-9).map(|(_, o)| o).collect();
+    let last: Vec<&Observables> = series
+        .iter()
+        .filter(|(t, _)| *t >= 700.0 - 1e-9)
+        .map(|(_, o)| o)
+        .collect();
     let n = last.len() as f64;
     let v = last.iter().map(|o| o.v_rms).sum::<f64>() / n;
     let a = last.iter().map(|o| o.area_mean).sum::<f64>() / n;

@@ -14,7 +14,13 @@ pub const ZETAS: [f64; 4] = [-0.0018, 0.0, 0.005, 0.01];
 /// Discs of radius `r0` at `centres` on a square `l × l` lattice with margin `margin`.
 pub fn discs(l: usize, margin: usize, centres: &[[f64; 2]], r0: f64) -> Cells {
     let lattice = Lattice::new(l, l);
-    init::discs(lattice, PatchShape::new(lattice, margin).unwrap(), centres, r0, 2.5)
+    init::discs(
+        lattice,
+        PatchShape::new(lattice, margin).unwrap(),
+        centres,
+        r0,
+        2.5,
+    )
 }
 
 /// A tissue with the paper's parameters at activity `zeta`.
@@ -37,8 +43,20 @@ pub fn advance(t: &mut Tissue, ws: &mut Workspace, n: usize, sp: &StepParams) {
 pub fn confluent(l: usize, seed: u64, steps: usize, pressure: PressureKind) -> (Tissue, Workspace) {
     let lattice = Lattice::new(l, l);
     let n = (l * l) as f64 * 15.0 / 2500.0;
-    let centres = init::positions(lattice, n.round() as usize, 4.0, &init::Layout::Random { seed }).unwrap();
-    let cells = init::discs(lattice, PatchShape::new(lattice, 12).unwrap(), &centres, 4.0, 2.5);
+    let centres = init::positions(
+        lattice,
+        n.round() as usize,
+        4.0,
+        &init::Layout::Random { seed },
+    )
+    .unwrap();
+    let cells = init::discs(
+        lattice,
+        PatchShape::new(lattice, 12).unwrap(),
+        &centres,
+        4.0,
+        2.5,
+    );
     let (mut t, mut ws) = tissue(cells, 0.0, pressure);
     advance(&mut t, &mut ws, steps, &HEUN);
     (t, ws)
@@ -46,10 +64,14 @@ pub fn confluent(l: usize, seed: u64, steps: usize, pressure: PressureKind) -> (
 
 /// A lattice position: an integer node plus 0 or 1/2, anywhere on an `l × l` lattice.
 pub fn node_or_half(l: usize) -> impl Strategy<Value = [f64; 2]> {
-    (0..l, 0..l, 0..2u8, 0..2u8).prop_map(|(x, y, hx, hy)| [x as f64 + 0.5 * hx as f64, y as f64 + 0.5 * hy as f64])
+    (0..l, 0..l, 0..2u8, 0..2u8)
+        .prop_map(|(x, y, hx, hy)| [x as f64 + 0.5 * hx as f64, y as f64 + 0.5 * hy as f64])
 }
 
 /// Maximum absolute difference of two slices.
 pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }

@@ -58,8 +58,11 @@ fn real_main() -> Result<()> {
         } => {
             let text = std::fs::read_to_string(&scene)
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
-            let parsed = Scene::parse(&text, &set).with_context(|| format!("in scene {}", scene.display()))?;
-            parsed.validate().with_context(|| format!("in scene {}", scene.display()))?;
+            let parsed = Scene::parse(&text, &set)
+                .with_context(|| format!("in scene {}", scene.display()))?;
+            parsed
+                .validate()
+                .with_context(|| format!("in scene {}", scene.display()))?;
             let mut pool = rayon::ThreadPoolBuilder::new();
             if let Some(n) = threads {
                 anyhow::ensure!(n >= 1, "--threads must be at least 1");

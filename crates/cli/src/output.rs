@@ -65,7 +65,10 @@ impl SeriesWriter {
     }
 }
 
-fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(shape: &[u64], data: impl IntoIterator<Item = T>) -> Result<Vec<u8>> {
+fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
+    shape: &[u64],
+    data: impl IntoIterator<Item = T>,
+) -> Result<Vec<u8>> {
     let mut buf = Vec::new();
     {
         let mut w = npyz::WriteOptions::new()
@@ -100,17 +103,40 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
         ("step", npy(&[], [tissue.step as i64])?),
         ("time", npy(&[], [tissue.time])?),
         ("zeta", npy(&[], [tissue.params.zeta])?),
-        ("lattice", npy(&[2], [lattice.lx as i64, lattice.ly as i64])?),
-        ("centre", npy(&[n64, 2], tissue.centre.iter().flatten().copied())?),
-        ("velocity", npy(&[n64, 2], cs.iter().flat_map(|c| c.velocity))?),
+        (
+            "lattice",
+            npy(&[2], [lattice.lx as i64, lattice.ly as i64])?,
+        ),
+        (
+            "centre",
+            npy(&[n64, 2], tissue.centre.iter().flatten().copied())?,
+        ),
+        (
+            "velocity",
+            npy(&[n64, 2], cs.iter().flat_map(|c| c.velocity))?,
+        ),
         ("force", npy(&[n64, 2], cs.iter().flat_map(|c| c.force))?),
         ("area", npy(&[n64], cs.iter().map(|c| c.area))?),
-        ("shape_tensor", npy(&[n64, 2], cs.iter().flat_map(|c| c.shape))?),
+        (
+            "shape_tensor",
+            npy(&[n64, 2], cs.iter().flat_map(|c| c.shape))?,
+        ),
         (
             "origin",
-            npy(&[n64, 2], tissue.cells.map().origin.iter().flat_map(|o| [o[0] as i64, o[1] as i64]))?,
+            npy(
+                &[n64, 2],
+                tissue
+                    .cells
+                    .map()
+                    .origin
+                    .iter()
+                    .flat_map(|o| [o[0] as i64, o[1] as i64]),
+            )?,
         ),
-        ("phi", npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?),
+        (
+            "phi",
+            npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?,
+        ),
     ];
     {
         let f = File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;

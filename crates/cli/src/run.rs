@@ -26,7 +26,8 @@ pub struct RunInfo {
 /// Runs a validated scene, writing into `out`. On a step error the output written so far is
 /// kept and the error is returned.
 pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create output directory {}", out.display()))?;
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("cannot create output directory {}", out.display()))?;
     std::fs::write(out.join("scene.toml"), scene.to_toml())?;
     let mut tissue: Tissue = scene.build()?;
     let mut ws = Workspace::new(&tissue.cells);
@@ -58,7 +59,11 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
             break;
         }
         tissue.step(&mut ws, &step_params).with_context(|| {
-            format!("the run stopped; output up to step {} is kept in {}", tissue.step, out.display())
+            format!(
+                "the run stopped; output up to step {} is kept in {}",
+                tissue.step,
+                out.display()
+            )
         })?;
     }
     progress.finish();
@@ -82,8 +87,10 @@ impl Progress {
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let b = ProgressBar::new(total);
             b.set_style(
-                ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {msg}  [{elapsed_precise} < {eta_precise}]")
-                    .expect("valid template"),
+                ProgressStyle::with_template(
+                    "{bar:40} {pos}/{len} steps  {msg}  [{elapsed_precise} < {eta_precise}]",
+                )
+                .expect("valid template"),
             );
             b
         });
@@ -100,7 +107,10 @@ impl Progress {
             b.set_position(step);
             b.set_message(format!("t = {time:.1}  v_rms = {v_rms:.3e}"));
         } else if !self.quiet && (step >= self.next_line.get() || step == self.total) {
-            eprintln!("step {step}/{}  t = {time:.1}  v_rms = {v_rms:.3e}", self.total);
+            eprintln!(
+                "step {step}/{}  t = {time:.1}  v_rms = {v_rms:.3e}",
+                self.total
+            );
             self.next_line.set(step + self.total.div_ceil(10).max(1));
         }
     }

@@ -285,47 +285,113 @@ impl Scene {
         let d = &self.domain;
         for (key, v) in [("lx", d.lx), ("ly", d.ly)] {
             if v < 8 {
-                return Err(invalid("domain", key, v, "the domain is too small", "use at least 8 nodes per side (the paper uses 100)"));
+                return Err(invalid(
+                    "domain",
+                    key,
+                    v,
+                    "the domain is too small",
+                    "use at least 8 nodes per side (the paper uses 100)",
+                ));
             }
         }
         let c = &self.cells;
         if c.count == 0 {
-            return Err(invalid("cells", "count", 0, "a scene needs at least one cell", "set count to 1 or more"));
+            return Err(invalid(
+                "cells",
+                "count",
+                0,
+                "a scene needs at least one cell",
+                "set count to 1 or more",
+            ));
         }
         if !(c.radius.is_finite() && c.radius > 0.0) {
-            return Err(invalid("cells", "radius", c.radius, "the radius must be positive", "use a radius of a few nodes (paper: 8)"));
+            return Err(invalid(
+                "cells",
+                "radius",
+                c.radius,
+                "the radius must be positive",
+                "use a radius of a few nodes (paper: 8)",
+            ));
         }
         let r0 = self.init_radius();
         if !(r0.is_finite() && r0 > 0.0 && r0 <= c.radius) {
-            return Err(invalid("cells", "init_radius", r0, "the initial disc radius must be positive and at most the radius", "leave it out (default R/2) or choose a value in (0, radius]"));
+            return Err(invalid(
+                "cells",
+                "init_radius",
+                r0,
+                "the initial disc radius must be positive and at most the radius",
+                "leave it out (default R/2) or choose a value in (0, radius]",
+            ));
         }
         match (c.init, &c.positions) {
             (InitKind::Positions, None) => {
-                return Err(invalid("cells", "init", "\"positions\"", "no positions are given", "add positions = [[x, y], ...] with one pair per cell"));
+                return Err(invalid(
+                    "cells",
+                    "init",
+                    "\"positions\"",
+                    "no positions are given",
+                    "add positions = [[x, y], ...] with one pair per cell",
+                ));
             }
             (InitKind::Random | InitKind::Hexagonal, Some(_)) => {
-                return Err(invalid("cells", "positions", "[...]", "positions are only read with init = \"positions\"", "set init = \"positions\" or remove positions"));
+                return Err(invalid(
+                    "cells",
+                    "positions",
+                    "[...]",
+                    "positions are only read with init = \"positions\"",
+                    "set init = \"positions\" or remove positions",
+                ));
             }
             _ => {}
         }
         let m = &self.model;
         for (key, v) in [("gamma", m.gamma), ("mu", m.mu), ("kappa", m.kappa)] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(invalid("model", key, v, "must be zero or positive", "use the paper's value (gamma 0.01, mu 3, kappa 0.1) as a start"));
+                return Err(invalid(
+                    "model",
+                    key,
+                    v,
+                    "must be zero or positive",
+                    "use the paper's value (gamma 0.01, mu 3, kappa 0.1) as a start",
+                ));
             }
         }
         if !(m.lambda.is_finite() && m.lambda > 0.0) {
-            return Err(invalid("model", "lambda", m.lambda, "the interface width must be positive", "use a width of a few nodes (paper: 2.5)"));
+            return Err(invalid(
+                "model",
+                "lambda",
+                m.lambda,
+                "the interface width must be positive",
+                "use a width of a few nodes (paper: 2.5)",
+            ));
         }
         if !(m.xi.is_finite() && m.xi > 0.0) {
-            return Err(invalid("model", "xi", m.xi, "the friction must be positive", "use the paper's value 2"));
+            return Err(invalid(
+                "model",
+                "xi",
+                m.xi,
+                "the friction must be positive",
+                "use the paper's value 2",
+            ));
         }
         if !m.zeta.is_finite() {
-            return Err(invalid("model", "zeta", m.zeta, "the activity must be a finite number", "use a value between -0.01 and 0.01"));
+            return Err(invalid(
+                "model",
+                "zeta",
+                m.zeta,
+                "the activity must be a finite number",
+                "use a value between -0.01 and 0.01",
+            ));
         }
         let it = &self.integrator;
         if !(it.dt.is_finite() && it.dt > 0.0) {
-            return Err(invalid("integrator", "dt", it.dt, "the time step must be positive", "use the paper's 0.2"));
+            return Err(invalid(
+                "integrator",
+                "dt",
+                it.dt,
+                "the time step must be positive",
+                "use the paper's 0.2",
+            ));
         }
         let params = self.model_params(m.zeta);
         let dt_max = params.max_stable_dt();
@@ -333,41 +399,98 @@ impl Scene {
             return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {dt_max:.3} for these parameters (linear estimate 2/stiffness)"), format!("use dt ≤ {:.3}; the paper uses 0.2", dt_max)));
         }
         if it.npc > 16 {
-            return Err(invalid("integrator", "npc", it.npc, "more than 16 corrector passes buy no accuracy", "use 1 (Heun) or 0 (Euler)"));
+            return Err(invalid(
+                "integrator",
+                "npc",
+                it.npc,
+                "more than 16 corrector passes buy no accuracy",
+                "use 1 (Heun) or 0 (Euler)",
+            ));
         }
         if it.margin != 0 && (it.margin as f64) < c.radius {
-            return Err(invalid("integrator", "margin", it.margin, format!("a patch margin smaller than the cell radius {} cuts the cells", c.radius), format!("use margin ≥ radius + 2λ ≈ {}, the paper's 12, or 0 for the full domain", (c.radius + 2.0 * m.lambda).ceil())));
+            return Err(invalid(
+                "integrator",
+                "margin",
+                it.margin,
+                format!(
+                    "a patch margin smaller than the cell radius {} cuts the cells",
+                    c.radius
+                ),
+                format!(
+                    "use margin ≥ radius + 2λ ≈ {}, the paper's 12, or 0 for the full domain",
+                    (c.radius + 2.0 * m.lambda).ceil()
+                ),
+            ));
         }
         let lattice = Lattice::new(d.lx, d.ly);
         if let Err(e) = PatchShape::new(lattice, it.margin) {
-            return Err(invalid("integrator", "margin", it.margin, e.to_string(), "reduce the margin"));
+            return Err(invalid(
+                "integrator",
+                "margin",
+                it.margin,
+                e.to_string(),
+                "reduce the margin",
+            ));
         }
         let r = &self.run;
         for (key, v) in [("relax_time", r.relax_time), ("time", r.time)] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(invalid("run", key, v, "times must be zero or positive", "give the time in model units (paper: 0.2 per step)"));
+                return Err(invalid(
+                    "run",
+                    key,
+                    v,
+                    "times must be zero or positive",
+                    "give the time in model units (paper: 0.2 per step)",
+                ));
             }
         }
-        for (key, v) in [("output_every", Some(r.output_every)), ("series_every", r.series_every)] {
+        for (key, v) in [
+            ("output_every", Some(r.output_every)),
+            ("series_every", r.series_every),
+        ] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= it.dt) {
-                    return Err(invalid("run", key, v, format!("the interval must be at least one time step ({})", it.dt), "use a multiple of dt"));
+                    return Err(invalid(
+                        "run",
+                        key,
+                        v,
+                        format!("the interval must be at least one time step ({})", it.dt),
+                        "use a multiple of dt",
+                    ));
                 }
             }
         }
         let layout = self.layout();
         if let Err(e) = init::positions(lattice, c.count, r0, &layout) {
-            let key = if c.init == InitKind::Positions { "positions" } else { "count" };
-            return Err(invalid("cells", key, if key == "count" { c.count.to_string() } else { "[...]".into() }, e.to_string(), "use fewer cells, smaller init_radius or a larger [domain]"));
+            let key = if c.init == InitKind::Positions {
+                "positions"
+            } else {
+                "count"
+            };
+            return Err(invalid(
+                "cells",
+                key,
+                if key == "count" {
+                    c.count.to_string()
+                } else {
+                    "[...]".into()
+                },
+                e.to_string(),
+                "use fewer cells, smaller init_radius or a larger [domain]",
+            ));
         }
         Ok(())
     }
 
     fn layout(&self) -> init::Layout {
         match self.cells.init {
-            InitKind::Random => init::Layout::Random { seed: self.run.seed },
+            InitKind::Random => init::Layout::Random {
+                seed: self.run.seed,
+            },
             InitKind::Hexagonal => init::Layout::Hexagonal,
-            InitKind::Positions => init::Layout::Positions(self.cells.positions.clone().unwrap_or_default()),
+            InitKind::Positions => {
+                init::Layout::Positions(self.cells.positions.clone().unwrap_or_default())
+            }
         }
     }
 
@@ -380,17 +503,29 @@ impl Scene {
         let lattice = Lattice::new(self.domain.lx, self.domain.ly);
         let shape = PatchShape::new(lattice, self.integrator.margin).expect("validated");
         let r0 = self.init_radius();
-        let centres = init::positions(lattice, self.cells.count, r0, &self.layout()).expect("validated");
+        let centres =
+            init::positions(lattice, self.cells.count, r0, &self.layout()).expect("validated");
         let cells = init::discs(lattice, shape, &centres, r0, self.model.lambda);
-        let zeta = if self.schedule().relax_steps > 0 { 0.0 } else { self.model.zeta };
+        let zeta = if self.schedule().relax_steps > 0 {
+            0.0
+        } else {
+            self.model.zeta
+        };
         Ok(Tissue::new(cells, self.model_params(zeta)))
     }
 }
 
 fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
-    let bad = |why: &str| SceneError::Parse(format!("--set {o}: {why}; write --set section.key=value, e.g. --set model.zeta=0.005"));
+    let bad = |why: &str| {
+        SceneError::Parse(format!(
+            "--set {o}: {why}; write --set section.key=value, e.g. --set model.zeta=0.005"
+        ))
+    };
     let (path, value) = o.split_once('=').ok_or_else(|| bad("no '='"))?;
-    let (section, key) = path.trim().split_once('.').ok_or_else(|| bad("the key needs a section"))?;
+    let (section, key) = path
+        .trim()
+        .split_once('.')
+        .ok_or_else(|| bad("the key needs a section"))?;
     let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {}", value.trim())) {
         Ok(mut t) => t.remove("v").expect("parsed"),
         Err(_) => toml::Value::String(value.trim().to_string()),

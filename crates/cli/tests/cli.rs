@@ -9,7 +9,9 @@ fn bin() -> Command {
 }
 
 fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
 }
 
 fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
@@ -44,10 +46,15 @@ fn a_run_writes_scene_series_and_frames() {
     assert!(o.status.success(), "{}", stderr(&o));
     let series = std::fs::read_to_string(dir.path().join("series.csv")).unwrap();
     let mut lines = series.lines();
-    assert!(lines.next().unwrap().starts_with("step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max"));
+    assert!(lines
+        .next()
+        .unwrap()
+        .starts_with("step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max"));
     // 10 TU at dt = 0.2 with a row every TU: rows at t = 0, 1, ..., 10.
     assert_eq!(lines.count(), 11);
-    let frames: Vec<_> = std::fs::read_dir(dir.path().join("frames")).unwrap().collect();
+    let frames: Vec<_> = std::fs::read_dir(dir.path().join("frames"))
+        .unwrap()
+        .collect();
     assert_eq!(frames.len(), 6, "frames at t = 0, 2, ..., 10");
     // The resolved scene parses back and has every default filled in.
     let resolved = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
@@ -60,9 +67,16 @@ fn a_run_writes_scene_series_and_frames() {
 /// says so and passes only if NumPy is missing *and* we are not in CI.
 #[test]
 fn frames_load_in_numpy_without_custom_code() {
-    let have_numpy = Command::new("python3").args(["-c", "import numpy"]).status().map(|s| s.success()).unwrap_or(false);
+    let have_numpy = Command::new("python3")
+        .args(["-c", "import numpy"])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
     if !have_numpy {
-        assert!(std::env::var("CI").is_err(), "CI must install numpy (see .ci/run)");
+        assert!(
+            std::env::var("CI").is_err(),
+            "CI must install numpy (see .ci/run)"
+        );
         eprintln!("numpy not installed: skipping the NumPy check");
         return;
     }
@@ -92,8 +106,15 @@ print("ok")
 "#,
         dir.path().display()
     );
-    let py = Command::new("python3").args(["-c", &script]).output().unwrap();
-    assert!(py.status.success(), "{}", String::from_utf8_lossy(&py.stderr));
+    let py = Command::new("python3")
+        .args(["-c", &script])
+        .output()
+        .unwrap();
+    assert!(
+        py.status.success(),
+        "{}",
+        String::from_utf8_lossy(&py.stderr)
+    );
 }
 
 #[test]
@@ -139,19 +160,74 @@ output_every = 1.0
 #[test]
 fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
     let cases: &[(&str, &[&str], &[&str])] = &[
-        ("unknown key", &["--set", "model.zetta=0.01"], &["zetta", "expected one of"]),
-        ("unknown section", &["--set", "physics.zeta=0.01"], &["physics"]),
-        ("negative radius", &["--set", "cells.radius=-3"], &["[cells] radius", "must be positive"]),
-        ("margin smaller than the radius", &["--set", "integrator.margin=5"], &["[integrator] margin", "use margin"]),
-        ("patch larger than the domain", &["--set", "integrator.margin=60"], &["[integrator] margin", "at most 49"]),
-        ("more cells than fit", &["--set", "cells.count=1000"], &["[cells] count", "do not fit", "fewer cells"]),
-        ("unstable dt", &["--set", "integrator.dt=5"], &["[integrator] dt", "unstable", "use dt ≤"]),
-        ("zero dt", &["--set", "integrator.dt=0"], &["[integrator] dt", "positive"]),
-        ("negative lambda", &["--set", "model.lambda=-1"], &["[model] lambda"]),
+        (
+            "unknown key",
+            &["--set", "model.zetta=0.01"],
+            &["zetta", "expected one of"],
+        ),
+        (
+            "unknown section",
+            &["--set", "physics.zeta=0.01"],
+            &["physics"],
+        ),
+        (
+            "negative radius",
+            &["--set", "cells.radius=-3"],
+            &["[cells] radius", "must be positive"],
+        ),
+        (
+            "margin smaller than the radius",
+            &["--set", "integrator.margin=5"],
+            &["[integrator] margin", "use margin"],
+        ),
+        (
+            "patch larger than the domain",
+            &["--set", "integrator.margin=60"],
+            &["[integrator] margin", "at most 49"],
+        ),
+        (
+            "more cells than fit",
+            &["--set", "cells.count=1000"],
+            &["[cells] count", "do not fit", "fewer cells"],
+        ),
+        (
+            "unstable dt",
+            &["--set", "integrator.dt=5"],
+            &["[integrator] dt", "unstable", "use dt ≤"],
+        ),
+        (
+            "zero dt",
+            &["--set", "integrator.dt=0"],
+            &["[integrator] dt", "positive"],
+        ),
+        (
+            "negative lambda",
+            &["--set", "model.lambda=-1"],
+            &["[model] lambda"],
+        ),
         ("wrong type", &["--set", "cells.count=\"many\""], &["count"]),
-        ("positions without init", &["--set", "cells.positions=[[1.0, 2.0]]"], &["[cells] positions", "init = \"positions\""]),
-        ("positions off the domain", &["--set", "cells.init=\"positions\"", "--set", "cells.count=1", "--set", "cells.positions=[[150.0, 2.0]]"], &["[cells] positions", "outside the domain"]),
-        ("bad override", &["--set", "zeta"], &["--set zeta", "section.key=value"]),
+        (
+            "positions without init",
+            &["--set", "cells.positions=[[1.0, 2.0]]"],
+            &["[cells] positions", "init = \"positions\""],
+        ),
+        (
+            "positions off the domain",
+            &[
+                "--set",
+                "cells.init=\"positions\"",
+                "--set",
+                "cells.count=1",
+                "--set",
+                "cells.positions=[[150.0, 2.0]]",
+            ],
+            &["[cells] positions", "outside the domain"],
+        ),
+        (
+            "bad override",
+            &["--set", "zeta"],
+            &["--set zeta", "section.key=value"],
+        ),
     ];
     for (name, extra, needles) in cases {
         let (ok, err, dir) = run_text(GOOD, extra);
@@ -160,10 +236,16 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
             assert!(err.contains(n), "{name}: {err:?} lacks {n:?}");
         }
         assert!(!err.contains("panicked"), "{name}: {err}");
-        assert!(!dir.path().join("out/series.csv").exists(), "{name}: nothing is run");
+        assert!(
+            !dir.path().join("out/series.csv").exists(),
+            "{name}: nothing is run"
+        );
     }
     let (ok, err, _d) = run_text("[domain]\nlx = 100\n", &[]);
-    assert!(!ok && err.contains("missing field") && err.contains("ly"), "{err}");
+    assert!(
+        !ok && err.contains("missing field") && err.contains("ly"),
+        "{err}"
+    );
     let (ok, err, _d) = run_text(GOOD, &[]);
     assert!(ok, "the good scene runs: {err}");
 }
@@ -172,12 +254,33 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
 /// keeps the series written so far.
 #[test]
 fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
-    let (ok, err, dir) = run_text(GOOD, &["--set", "model.zeta=1.0", "--set", "run.time=400", "--set", "run.output_every=50", "--set", "run.series_every=1"]);
+    let (ok, err, dir) = run_text(
+        GOOD,
+        &[
+            "--set",
+            "model.zeta=1.0",
+            "--set",
+            "run.time=400",
+            "--set",
+            "run.output_every=50",
+            "--set",
+            "run.series_every=1",
+        ],
+    );
     assert!(!ok);
-    assert!(err.contains("at step") && err.contains("cell ") && err.contains("reduce [integrator] dt"), "{err}");
+    assert!(
+        err.contains("at step") && err.contains("cell ") && err.contains("reduce [integrator] dt"),
+        "{err}"
+    );
     assert!(err.contains("output up to step"), "{err}");
     let series = std::fs::read_to_string(dir.path().join("out/series.csv")).unwrap();
-    assert!(series.lines().count() > 10, "rows before the blow-up are kept");
-    assert!(series.lines().skip(1).all(|l| !l.contains("NaN") && !l.contains("inf")));
+    assert!(
+        series.lines().count() > 10,
+        "rows before the blow-up are kept"
+    );
+    assert!(series
+        .lines()
+        .skip(1)
+        .all(|l| !l.contains("NaN") && !l.contains("inf")));
     assert!(dir.path().join("out/frames/frame_00000000.npz").exists());
 }

@@ -42,8 +42,8 @@ mod tissue;
 pub use observables::Observables;
 pub use params::{ModelParams, PressureKind, StepParams};
 pub use tissue::{
-    evaluate, CellState, Tissue, Workspace, G_LAP, G_QXX, G_QXY, G_S1, G_S2, G_S3, G_S4, G_SA, N_GLOBAL,
-    PHI_BOUND,
+    evaluate, CellState, Tissue, Workspace, G_LAP, G_QXX, G_QXY, G_S1, G_S2, G_S3, G_S4, G_SA,
+    N_GLOBAL, PHI_BOUND,
 };
 
 /// Why a time step could not be taken.

@@ -49,7 +49,10 @@ impl ModelParams {
     pub fn stiffness(&self) -> f64 {
         let e = &self.energy;
         let a0 = e.target_area();
-        16.0 * e.gamma * e.lambda + 8.0 * e.gamma / e.lambda + 12.0 * e.mu / a0 + 4.0 * e.kappa / e.lambda
+        16.0 * e.gamma * e.lambda
+            + 8.0 * e.gamma / e.lambda
+            + 12.0 * e.mu / a0
+            + 4.0 * e.kappa / e.lambda
     }
 
     /// The largest time step the linear stability estimate allows, `2 / stiffness()`.

@@ -162,7 +162,15 @@ impl Tissue {
             cell_state,
             ..
         } = ws;
-        evaluate(&self.params, &self.cells, self.cells.phi(), k2, global, pressure, cell_state);
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            k2,
+            global,
+            pressure,
+            cell_state,
+        );
     }
 
     /// Advances the state by one time step `dt` with `npc` Heun corrector passes.
@@ -185,7 +193,15 @@ impl Tissue {
             com,
             ..
         } = ws;
-        evaluate(&self.params, &self.cells, self.cells.phi(), k1, global, pressure, cell_state);
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            k1,
+            global,
+            pressure,
+            cell_state,
+        );
         self.check(cell_state, dt)?;
         let phi = self.cells.phi_mut();
         phi_old.copy_from_slice(phi);
@@ -193,7 +209,15 @@ impl Tissue {
             .zip(phi_old.par_iter().zip(k1.par_iter()))
             .for_each(|(p, (o, r))| *p = o + dt * r);
         for _ in 0..step_params.npc {
-            evaluate(&self.params, &self.cells, self.cells.phi(), k2, global, pressure, cell_state);
+            evaluate(
+                &self.params,
+                &self.cells,
+                self.cells.phi(),
+                k2,
+                global,
+                pressure,
+                cell_state,
+            );
             let phi = self.cells.phi_mut();
             phi.par_iter_mut()
                 .zip(phi_old.par_iter())
@@ -225,7 +249,11 @@ impl Tissue {
                     step: self.step,
                     time: self.time,
                     cell_idx: i,
-                    phi: if c.phi_min < -PHI_BOUND { c.phi_min } else { c.phi_max },
+                    phi: if c.phi_min < -PHI_BOUND {
+                        c.phi_min
+                    } else {
+                        c.phi_max
+                    },
                     dt,
                 });
             }
@@ -313,24 +341,30 @@ pub fn evaluate(
                 2.0 * energy.gamma * energy.lambda,
                 4.0 * energy.mu / a0,
             );
-            pressure.par_chunks_mut(ly).enumerate().for_each(|(x, row)| {
-                for y in 0..ly {
-                    let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
-                    row[y] = c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
-                        - c_ch * (n[G_S1] - 3.0 * n[G_S2] + 2.0 * n[G_S3])
-                        + c_lap * n[G_LAP]
-                        + c_area * (n[G_S1] - n[G_SA] / a0);
-                }
-            });
+            pressure
+                .par_chunks_mut(ly)
+                .enumerate()
+                .for_each(|(x, row)| {
+                    for y in 0..ly {
+                        let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
+                        row[y] = c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
+                            - c_ch * (n[G_S1] - 3.0 * n[G_S2] + 2.0 * n[G_S3])
+                            + c_lap * n[G_LAP]
+                            + c_area * (n[G_S1] - n[G_SA] / a0);
+                    }
+                });
         }
         PressureKind::Interaction => {
             let c_rep = 2.0 * energy.kappa / energy.lambda;
-            pressure.par_chunks_mut(ly).enumerate().for_each(|(x, row)| {
-                for y in 0..ly {
-                    let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
-                    row[y] = c_rep * (n[G_S2] * n[G_S2] - n[G_S4]);
-                }
-            });
+            pressure
+                .par_chunks_mut(ly)
+                .enumerate()
+                .for_each(|(x, row)| {
+                    for y in 0..ly {
+                        let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
+                        row[y] = c_rep * (n[G_S2] * n[G_S2] - n[G_S4]);
+                    }
+                });
         }
     }
 

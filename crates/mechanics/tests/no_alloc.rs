@@ -34,16 +34,35 @@ static GLOBAL: Counting = Counting;
 /// in the [`Workspace`].
 #[test]
 fn a_warm_step_allocates_nothing() {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
     pool.install(check_steps);
 }
 
 fn check_steps() {
     let lattice = Lattice::new(100, 100);
     let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 2 }).unwrap();
-    for (margin, pressure) in [(12, PressureKind::Paper), (12, PressureKind::Interaction), (0, PressureKind::Paper)] {
-        let cells = init::discs(lattice, PatchShape::new(lattice, margin).unwrap(), &centres, 4.0, 2.5);
-        let mut t = Tissue::new(cells, ModelParams { pressure, ..ModelParams::paper(0.01) });
+    for (margin, pressure) in [
+        (12, PressureKind::Paper),
+        (12, PressureKind::Interaction),
+        (0, PressureKind::Paper),
+    ] {
+        let cells = init::discs(
+            lattice,
+            PatchShape::new(lattice, margin).unwrap(),
+            &centres,
+            4.0,
+            2.5,
+        );
+        let mut t = Tissue::new(
+            cells,
+            ModelParams {
+                pressure,
+                ..ModelParams::paper(0.01)
+            },
+        );
         let mut ws = Workspace::new(&t.cells);
         let sp = StepParams { dt: 0.2, npc: 2 };
         // Warm-up: starts rayon's pool and its thread-local state.
@@ -57,6 +76,11 @@ fn check_steps() {
         let o = t.observe(&mut ws);
         let after = ALLOCS.load(Ordering::SeqCst);
         assert!(o.v_rms.is_finite());
-        assert_eq!(after - before, 0, "margin {margin}: {} allocations in 60 steps and one observation", after - before);
+        assert_eq!(
+            after - before,
+            0,
+            "margin {margin}: {} allocations in 60 steps and one observation",
+            after - before
+        );
     }
 }

@@ -41,7 +41,13 @@ impl ComTable {
 
     /// The centre of mass of one cell's patch, given its values in storage order and the
     /// lattice coordinates of its storage columns and rows.
-    pub fn centre_of_mass(&self, phi: &[f64], shape: &PatchShape, xs: &[u32], ys: &[u32]) -> [f64; 2] {
+    pub fn centre_of_mass(
+        &self,
+        phi: &[f64],
+        shape: &PatchShape,
+        xs: &[u32],
+        ys: &[u32],
+    ) -> [f64; 2] {
         let ny = shape.ny;
         let (mut xr, mut xi, mut yr, mut yi) = (0.0, 0.0, 0.0, 0.0);
         for (a, &x) in xs.iter().enumerate() {

@@ -33,7 +33,11 @@ pub enum Layout {
 ///
 /// # Errors
 /// [`PhaseFieldError::TooManyCells`] when they would cover more than [`MAX_INITIAL_COVERAGE`].
-pub fn check_fits(lattice: Lattice, n_cells: usize, disc_radius: f64) -> Result<(), PhaseFieldError> {
+pub fn check_fits(
+    lattice: Lattice,
+    n_cells: usize,
+    disc_radius: f64,
+) -> Result<(), PhaseFieldError> {
     let covered = n_cells as f64 * std::f64::consts::PI * disc_radius * disc_radius;
     let max_cells = (MAX_INITIAL_COVERAGE * lattice.len() as f64
         / (std::f64::consts::PI * disc_radius * disc_radius))
@@ -129,10 +133,9 @@ pub fn positions(
                         break 'rows;
                     }
                     let shift = if r % 2 == 1 { 0.5 } else { 0.0 };
-                    out.push(lattice.wrap_point([
-                        (c as f64 + 0.25 + shift) * sx,
-                        (r as f64 + 0.5) * sy,
-                    ]));
+                    out.push(
+                        lattice.wrap_point([(c as f64 + 0.25 + shift) * sx, (r as f64 + 0.5) * sy]),
+                    );
                 }
             }
             Ok(out)

@@ -70,7 +70,10 @@ impl Lattice {
 
     /// Wraps a real position into `[0, lx) × [0, ly)`.
     pub fn wrap_point(&self, p: [f64; 2]) -> [f64; 2] {
-        [wrap_real(p[0], self.lx as f64), wrap_real(p[1], self.ly as f64)]
+        [
+            wrap_real(p[0], self.lx as f64),
+            wrap_real(p[1], self.ly as f64),
+        ]
     }
 }
 
