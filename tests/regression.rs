@@ -1,6 +1,6 @@
 //! Whole runs of the shipped paper scene against measured and published behaviour.
 
-use mechanics::{Observables, Workspace};
+use mechanics::{Observables, Observer, StepError, Tissue, Workspace};
 use monolayer_cli::scene::Scene;
 
 fn paper_scene(overrides: &[&str]) -> Scene {
@@ -13,23 +13,33 @@ fn paper_scene(overrides: &[&str]) -> Scene {
     scene
 }
 
+/// Collects `(time, observables)` every `every` steps.
+struct Sampler {
+    every: u64,
+    samples: Vec<(f64, Observables)>,
+}
+
+impl Observer for Sampler {
+    type Error = StepError;
+    fn wants(&self, step: u64, _total: u64) -> bool {
+        step.is_multiple_of(self.every)
+    }
+    fn observe(&mut self, t: &Tissue, _: &Workspace, o: &Observables) -> Result<(), StepError> {
+        self.samples.push((t.time, *o));
+        Ok(())
+    }
+}
+
 /// Runs `scene` (relaxation, then activity) and returns `(time, observables)` every `every` steps.
 fn run(scene: &Scene, every: u64) -> Vec<(f64, Observables)> {
     let mut t = scene.build().unwrap();
     let mut ws = Workspace::new(&t.cells);
-    let sched = scene.schedule();
-    let sp = scene.step_params();
-    let mut out = Vec::new();
-    for s in 0..=sched.relax_steps + sched.active_steps {
-        if s == sched.relax_steps {
-            t.params.zeta = scene.model.zeta;
-        }
-        if s % every == 0 {
-            out.push((t.time, t.observe(&mut ws)));
-        }
-        t.step(&mut ws, &sp).unwrap();
-    }
-    out
+    let mut sampler = Sampler {
+        every,
+        samples: Vec::new(),
+    };
+    mechanics::run(&mut t, &mut ws, &scene.protocol(), &mut sampler).unwrap();
+    sampler.samples
 }
 
 /// Sixty cells at the paper's density relax at ζ = 0 (paper pressure, seed 1).

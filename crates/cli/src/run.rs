@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mechanics::{Tissue, Workspace};
+use mechanics::{Observables, Observer, Tissue, Workspace};
 
 use crate::output::{write_frame, SeriesWriter};
 use crate::scene::Scene;
@@ -31,47 +31,70 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     std::fs::write(out.join("scene.toml"), scene.to_toml())?;
     let mut tissue: Tissue = scene.build()?;
     let mut ws = Workspace::new(&tissue.cells);
+    let protocol = scene.protocol();
     let sched = scene.schedule();
-    let step_params = scene.step_params();
-    let mut series = SeriesWriter::create(out)?;
-    let total = sched.relax_steps + sched.active_steps;
-    let progress = Progress::new(total, quiet);
+    let mut writer = Writer {
+        out,
+        series: SeriesWriter::create(out)?,
+        frame_every: sched.frame_every,
+        series_every: sched.series_every,
+        frames: 0,
+        progress: Progress::new(protocol.total_steps(), quiet),
+    };
     let start = Instant::now();
-    let mut frames = 0;
-    for s in 0..=total {
-        if s == sched.relax_steps {
-            tissue.params.zeta = scene.model.zeta;
-        }
-        let want_series = s % sched.series_every == 0 || s == total;
-        let want_frame = s % sched.frame_every == 0 || s == total;
-        if want_series || want_frame {
-            let o = tissue.observe(&mut ws);
-            if want_series {
-                series.row(&tissue, &o)?;
-            }
-            if want_frame {
-                write_frame(out, &tissue, &ws)?;
-                frames += 1;
-            }
-            progress.report(s, tissue.time, o.v_rms);
-        }
-        if s == total {
-            break;
-        }
-        tissue.step(&mut ws, &step_params).with_context(|| {
-            format!(
-                "the run stopped; output up to step {} is kept in {}",
-                tissue.step,
-                out.display()
-            )
-        })?;
-    }
-    progress.finish();
+    mechanics::run(&mut tissue, &mut ws, &protocol, &mut writer).with_context(|| {
+        format!(
+            "the run stopped; output up to step {} is kept in {}",
+            tissue.step,
+            out.display()
+        )
+    })?;
+    writer.progress.finish();
     Ok(RunInfo {
-        steps: total,
+        steps: protocol.total_steps(),
         wall_s: start.elapsed().as_secs_f64(),
-        frames,
+        frames: writer.frames,
     })
+}
+
+/// Writes series rows and frames on their schedules.
+struct Writer<'a> {
+    out: &'a Path,
+    series: SeriesWriter,
+    frame_every: u64,
+    series_every: u64,
+    frames: usize,
+    progress: Progress,
+}
+
+impl Writer<'_> {
+    fn wants_frame(&self, step: u64, total: u64) -> bool {
+        step.is_multiple_of(self.frame_every) || step == total
+    }
+    fn wants_series(&self, step: u64, total: u64) -> bool {
+        step.is_multiple_of(self.series_every) || step == total
+    }
+}
+
+impl Observer for Writer<'_> {
+    type Error = anyhow::Error;
+
+    fn wants(&self, step: u64, total: u64) -> bool {
+        self.wants_frame(step, total) || self.wants_series(step, total)
+    }
+
+    fn observe(&mut self, tissue: &Tissue, ws: &Workspace, o: &Observables) -> Result<()> {
+        let total = self.progress.total;
+        if self.wants_series(tissue.step, total) {
+            self.series.row(tissue, o)?;
+        }
+        if self.wants_frame(tissue.step, total) {
+            write_frame(self.out, tissue, ws)?;
+            self.frames += 1;
+        }
+        self.progress.report(tissue.step, tissue.time, o.v_rms);
+        Ok(())
+    }
 }
 
 /// A progress bar on a terminal, plain lines (about every 10 %) otherwise.

@@ -4,7 +4,7 @@
 //! and rejects unknown keys; [`Scene::validate`] checks every value and names the key and the
 //! fix of the first problem; [`Scene::build`] turns a valid scene into library objects.
 
-use mechanics::{ModelParams, PressureKind, StepParams, Tissue};
+use mechanics::{ModelParams, PressureKind, Protocol, StepParams, Tissue};
 use phasefield::{init, EnergyParams, Lattice, PatchShape};
 use serde::{Deserialize, Serialize};
 
@@ -274,6 +274,17 @@ impl Scene {
             active_steps: steps(self.run.time),
             frame_every: steps(self.run.output_every).max(1),
             series_every: steps(self.run.series_every.unwrap_or(self.run.output_every)).max(1),
+        }
+    }
+
+    /// The run protocol: relaxation, activity, integrator.
+    pub fn protocol(&self) -> Protocol {
+        let sched = self.schedule();
+        Protocol {
+            relax_steps: sched.relax_steps,
+            active_steps: sched.active_steps,
+            zeta: self.model.zeta,
+            step: self.step_params(),
         }
     }
 

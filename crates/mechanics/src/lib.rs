@@ -8,6 +8,7 @@
 //! - [`Tissue`]: fields, parameters and clock; [`Tissue::step`] advances by one time step.
 //! - [`Workspace`]: all scratch memory of a step, built once; the step allocates nothing.
 //! - [`Observables`]: `v_rms`, `S_rms` and the area statistics of a state.
+//! - [`run`] with a [`Protocol`] (relaxation, then activity) and an [`Observer`]: a whole run.
 //!
 //! The equations, as implemented:
 //! - stress `σ = −P𝕀 − ζQ`, with `Q(x) = Σ_i φ_i(x) S_i`;
@@ -37,10 +38,12 @@
 mod observables;
 mod params;
 pub mod scatter;
+mod simulation;
 mod tissue;
 
 pub use observables::Observables;
 pub use params::{ModelParams, PressureKind, StepParams};
+pub use simulation::{run, Observer, Protocol};
 pub use tissue::{
     evaluate, CellState, Tissue, Workspace, G_LAP, G_QXX, G_QXY, G_S1, G_S2, G_S3, G_S4, G_SA,
     N_GLOBAL, PHI_BOUND,
