@@ -284,3 +284,30 @@ fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
         .all(|l| !l.contains("NaN") && !l.contains("inf")));
     assert!(dir.path().join("out/frames/frame_00000000.npz").exists());
 }
+
+/// Every shipped scene parses and validates; `single.toml` runs whole, and its isolated cell
+/// stays at rest (velocity at round-off, see the isolated-cell test) and grows towards its
+/// equilibrium area: 195.5 after the scene's 500 TU, 195.76 at 1000 TU (measured), below
+/// πR² = 201 because the line tension γ compresses the cell against the area constraint μ.
+#[test]
+fn shipped_scenes_are_valid_and_the_single_cell_rests() {
+    for name in ["paper.toml", "single.toml", "large.toml"] {
+        let text = std::fs::read_to_string(scene_path(name)).unwrap();
+        let scene = monolayer_cli::scene::Scene::parse(&text, &[]).unwrap();
+        scene.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(&scene_path("single.toml"), dir.path(), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let series = std::fs::read_to_string(dir.path().join("series.csv")).unwrap();
+    let last: Vec<f64> = series
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let (v_rms, area) = (last[3], last[5]);
+    assert!(v_rms < 1e-14, "{v_rms}");
+    assert!((area - 195.5).abs() < 0.5, "{area}");
+}
