@@ -33,6 +33,9 @@ enum Command {
         /// No progress output.
         #[arg(long, short)]
         quiet: bool,
+        /// Replace the results of an earlier run in the output directory.
+        #[arg(long)]
+        overwrite: bool,
     },
 }
 
@@ -55,6 +58,7 @@ fn real_main() -> Result<()> {
             threads,
             set,
             quiet,
+            overwrite,
         } => {
             let text = std::fs::read_to_string(&scene)
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
@@ -63,6 +67,7 @@ fn real_main() -> Result<()> {
             parsed
                 .validate()
                 .with_context(|| format!("in scene {}", scene.display()))?;
+            run::prepare_output(&out, overwrite)?;
             let mut pool = rayon::ThreadPoolBuilder::new();
             if let Some(n) = threads {
                 anyhow::ensure!(n >= 1, "--threads must be at least 1");

@@ -23,6 +23,31 @@ pub struct RunInfo {
     pub frames: usize,
 }
 
+/// Makes sure `out` holds no earlier run: with `overwrite`, removes its `series.csv`,
+/// `scene.toml` and `frames/`; without, refuses.
+///
+/// # Errors
+/// When `out` already holds a run and `overwrite` is false, or files cannot be removed.
+pub fn prepare_output(out: &Path, overwrite: bool) -> Result<()> {
+    let series = out.join("series.csv");
+    if !series.exists() {
+        return Ok(());
+    }
+    anyhow::ensure!(
+        overwrite,
+        "{} already holds a run (series.csv); choose another --out or pass --overwrite to replace it",
+        out.display()
+    );
+    std::fs::remove_file(&series)?;
+    let _ = std::fs::remove_file(out.join("scene.toml"));
+    let frames = out.join("frames");
+    if frames.exists() {
+        std::fs::remove_dir_all(&frames)
+            .with_context(|| format!("cannot remove {}", frames.display()))?;
+    }
+    Ok(())
+}
+
 /// Runs a validated scene, writing into `out`. On a step error the output written so far is
 /// kept and the error is returned.
 pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {

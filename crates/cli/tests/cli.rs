@@ -311,3 +311,23 @@ fn shipped_scenes_are_valid_and_the_single_cell_rests() {
     assert!(v_rms < 1e-14, "{v_rms}");
     assert!((area - 195.5).abs() < 0.5, "{area}");
 }
+
+/// A second run into the same directory is refused unless `--overwrite` is given, which
+/// replaces the old frames instead of mixing them.
+#[test]
+fn an_earlier_run_is_not_overwritten_by_accident() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(&scene_path("paper.toml"), dir.path(), &SHORT);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&scene_path("paper.toml"), dir.path(), &SHORT);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--overwrite"), "{}", stderr(&o));
+    let mut args = SHORT.to_vec();
+    args.extend(["--overwrite", "--set", "run.output_every=5"]);
+    let o = run(&scene_path("paper.toml"), dir.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let n = std::fs::read_dir(dir.path().join("frames"))
+        .unwrap()
+        .count();
+    assert_eq!(n, 3, "frames at t = 0, 5, 10 only; the old ones are gone");
+}
