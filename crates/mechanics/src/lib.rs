@@ -35,12 +35,14 @@
 //! ```
 #![deny(missing_docs)]
 
+mod fields;
 mod observables;
 mod params;
 pub mod scatter;
 mod simulation;
 mod tissue;
 
+pub use fields::TissueFields;
 pub use observables::Observables;
 pub use params::{ModelParams, PressureKind, StepParams};
 pub use simulation::{run, Observer, Protocol};

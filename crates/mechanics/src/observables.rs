@@ -1,6 +1,5 @@
 //! Scalar observables of a state (MODEL.md §7) and the lattice fields they are built from.
 
-use crate::scatter::scatter;
 use crate::tissue::{Tissue, Workspace};
 
 /// Scalar summary of one state, computed on output steps only.
@@ -29,13 +28,11 @@ impl Tissue {
     /// state. Leaves the tissue velocity field `Σ φ_i v_i` in `ws.field2` (`[vx, vy]` per node).
     pub fn observe(&mut self, ws: &mut Workspace) -> Observables {
         self.refresh(ws);
+        self.scatter_velocity(ws);
         let Workspace {
             cell_state, field2, ..
         } = ws;
         let cs: &[_] = cell_state;
-        scatter::<2, _>(&self.cells, self.cells.phi(), field2, |i, _, p| {
-            [p * cs[i].velocity[0], p * cs[i].velocity[1]]
-        });
         let n_nodes = self.lattice().len() as f64;
         let v2: f64 = field2.iter().map(|v| v * v).sum::<f64>() / n_nodes;
         let n = cs.len().max(1) as f64;
