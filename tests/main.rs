@@ -1,5 +1,6 @@
 //! One integration-test binary for the whole workspace, with topical modules.
 
+mod analysis_tests;
 mod cli;
 mod mechanics_tests;
 mod patch_tests;

@@ -31,7 +31,10 @@ pub struct Correlator {
 
 impl std::fmt::Debug for Correlator {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Correlator").field("lattice", &self.lattice).field("n_frames", &self.n_frames).finish()
+        f.debug_struct("Correlator")
+            .field("lattice", &self.lattice)
+            .field("n_frames", &self.n_frames)
+            .finish()
     }
 }
 
@@ -78,9 +81,11 @@ impl Correlator {
             for (b, &v) in self.buf.iter_mut().zip(c.iter()) {
                 *b = Complex64::new(v, 0.0);
             }
-            self.fft_y.process_with_scratch(&mut self.buf, &mut self.scratch);
+            self.fft_y
+                .process_with_scratch(&mut self.buf, &mut self.scratch);
             transpose(&self.buf, &mut self.tbuf, lx, ly);
-            self.fft_x.process_with_scratch(&mut self.tbuf, &mut self.scratch);
+            self.fft_x
+                .process_with_scratch(&mut self.tbuf, &mut self.scratch);
             for (p, b) in self.power.iter_mut().zip(&self.tbuf) {
                 *p += b.norm_sqr();
             }
@@ -89,9 +94,11 @@ impl Correlator {
         for (b, &p) in self.tbuf.iter_mut().zip(&self.power) {
             *b = Complex64::new(p, 0.0);
         }
-        self.ifft_x.process_with_scratch(&mut self.tbuf, &mut self.scratch);
+        self.ifft_x
+            .process_with_scratch(&mut self.tbuf, &mut self.scratch);
         transpose(&self.tbuf, &mut self.buf, ly, lx);
-        self.ifft_y.process_with_scratch(&mut self.buf, &mut self.scratch);
+        self.ifft_y
+            .process_with_scratch(&mut self.buf, &mut self.scratch);
         let norm = 1.0 / (n as f64 * n as f64);
         for (s, b) in self.sum.iter_mut().zip(&self.buf) {
             *s += b.re * norm;
@@ -144,22 +151,32 @@ pub fn radial_average(lattice: Lattice, corr: &[f64]) -> Vec<f64> {
         }
     }
     let c0 = corr[0];
-    sum.iter().zip(&count).map(|(s, &c)| s / c as f64 / c0).collect()
+    sum.iter()
+        .zip(&count)
+        .map(|(s, &c)| s / c as f64 / c0)
+        .collect()
 }
 
 /// The position of the first local minimum of `c` (sampled at `r = 0, 1, ...`), refined by the
 /// vertex of the parabola through the three samples around it. `None` if `c` has no interior
 /// minimum.
+///
+/// Rings of lattice nodes hold few nodes at small `r`: for a strongly anisotropic field (a
+/// single plane wave, say) the ring average is noisy at the 0.05 level and can show a spurious
+/// local minimum a node or two early. Turbulent fields averaged over frames are isotropic
+/// enough for this not to matter; check `correlations.csv` when in doubt.
 pub fn first_minimum(c: &[f64]) -> Option<f64> {
-    (1..c.len().saturating_sub(1)).find(|&k| c[k] < c[k - 1] && c[k] <= c[k + 1]).map(|k| {
-        let (a, b, d) = (c[k - 1], c[k], c[k + 1]);
-        let curv = a - 2.0 * b + d;
-        if curv > 0.0 {
-            k as f64 + 0.5 * (a - d) / curv
-        } else {
-            k as f64
-        }
-    })
+    (1..c.len().saturating_sub(1))
+        .find(|&k| c[k] < c[k - 1] && c[k] <= c[k + 1])
+        .map(|k| {
+            let (a, b, d) = (c[k - 1], c[k], c[k + 1]);
+            let curv = a - 2.0 * b + d;
+            if curv > 0.0 {
+                k as f64 + 0.5 * (a - d) / curv
+            } else {
+                k as f64
+            }
+        })
 }
 
 #[cfg(test)]

@@ -33,7 +33,9 @@ pub struct CropFields<'a> {
 }
 
 /// Names of the averaged components, in storage order.
-pub const COMPONENTS: [&str; 8] = ["vx", "vy", "sigma_xx", "sigma_yy", "sigma_xy", "pressure", "qxx", "qxy"];
+pub const COMPONENTS: [&str; 8] = [
+    "vx", "vy", "sigma_xx", "sigma_yy", "sigma_xy", "pressure", "qxx", "qxy",
+];
 
 /// Running sums of cropped fields for `+½` and `−½` defects.
 #[derive(Debug, Clone)]
@@ -55,7 +57,8 @@ fn bilinear(lattice: Lattice, f: &[f64], x: f64, y: f64) -> f64 {
     let y0 = lattice.wrap_y(fy as i64);
     let (x1, y1) = ((x0 + 1) % lx, (y0 + 1) % ly);
     let g = |a: usize, b: usize| f[a * ly + b];
-    (1.0 - tx) * ((1.0 - ty) * g(x0, y0) + ty * g(x0, y1)) + tx * ((1.0 - ty) * g(x1, y0) + ty * g(x1, y1))
+    (1.0 - tx) * ((1.0 - ty) * g(x0, y0) + ty * g(x0, y1))
+        + tx * ((1.0 - ty) * g(x1, y0) + ty * g(x1, y1))
 }
 
 impl DefectAverage {
@@ -66,7 +69,13 @@ impl DefectAverage {
     pub fn new(side: usize) -> Self {
         assert!(side % 2 == 1, "the crop side must be odd");
         let n = side * side * COMPONENTS.len();
-        Self { side, plus: vec![0.0; n], minus: vec![0.0; n], n_plus: 0, n_minus: 0 }
+        Self {
+            side,
+            plus: vec![0.0; n],
+            minus: vec![0.0; n],
+            n_plus: 0,
+            n_minus: 0,
+        }
     }
 
     /// Side of the crops.
@@ -97,7 +106,11 @@ impl DefectAverage {
                     let y = d.y + s * u + c * v;
                     let at = |f: &[f64]| bilinear(lattice, f, x, y);
                     let (vx, vy) = (at(fields.vx), at(fields.vy));
-                    let (sxx, syy, sxy) = (at(fields.sigma_xx), at(fields.sigma_yy), at(fields.sigma_xy));
+                    let (sxx, syy, sxy) = (
+                        at(fields.sigma_xx),
+                        at(fields.sigma_yy),
+                        at(fields.sigma_xy),
+                    );
                     let (qxx, qxy) = (at(fields.qxx), at(fields.qxy));
                     let rot = |txx: f64, tyy: f64, txy: f64| {
                         (
@@ -134,9 +147,18 @@ impl DefectAverage {
     /// # Panics
     /// If `name` is not a component.
     pub fn average(&self, plus: bool, name: &str) -> Vec<f64> {
-        let k = COMPONENTS.iter().position(|c| *c == name).expect("a known component");
-        let (sums, n) = if plus { (&self.plus, self.n_plus) } else { (&self.minus, self.n_minus) };
+        let k = COMPONENTS
+            .iter()
+            .position(|c| *c == name)
+            .expect("a known component");
+        let (sums, n) = if plus {
+            (&self.plus, self.n_plus)
+        } else {
+            (&self.minus, self.n_minus)
+        };
         let inv = 1.0 / n as f64;
-        (0..self.side * self.side).map(|i| sums[i * COMPONENTS.len() + k] * inv).collect()
+        (0..self.side * self.side)
+            .map(|i| sums[i * COMPONENTS.len() + k] * inv)
+            .collect()
     }
 }

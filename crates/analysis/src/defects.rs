@@ -45,7 +45,11 @@ fn wrap_half_pi(d: f64) -> f64 {
 pub fn detect(lattice: Lattice, qxx: &[f64], qxy: &[f64]) -> Vec<Defect> {
     let (lx, ly) = (lattice.lx, lattice.ly);
     assert!(qxx.len() == lattice.len() && qxy.len() == lattice.len());
-    let theta: Vec<f64> = qxx.iter().zip(qxy).map(|(a, b)| 0.5 * b.atan2(*a)).collect();
+    let theta: Vec<f64> = qxx
+        .iter()
+        .zip(qxy)
+        .map(|(a, b)| 0.5 * b.atan2(*a))
+        .collect();
     let mut out = Vec::new();
     for x in 0..lx {
         let xp = (x + 1) % lx;

@@ -37,7 +37,11 @@ pub fn box_smooth_into(
     if side.is_multiple_of(2) || side > lx.min(ly) {
         return Err(AnalysisError::BadBox { side, lx, ly });
     }
-    assert!(field.len() == lattice.len() && out.len() == lattice.len() && scratch.len() == lattice.len());
+    assert!(
+        field.len() == lattice.len()
+            && out.len() == lattice.len()
+            && scratch.len() == lattice.len()
+    );
     let h = side / 2;
     // Along y, row by row (contiguous).
     for x in 0..lx {
@@ -52,7 +56,9 @@ pub fn box_smooth_into(
     // Along x.
     let norm = 1.0 / (side * side) as f64;
     for y in 0..ly {
-        let mut s: f64 = (0..side).map(|i| scratch[((i + lx - h) % lx) * ly + y]).sum();
+        let mut s: f64 = (0..side)
+            .map(|i| scratch[((i + lx - h) % lx) * ly + y])
+            .sum();
         for x in 0..lx {
             out[x * ly + y] = s * norm;
             s += scratch[((x + h + 1) % lx) * ly + y] - scratch[((x + lx - h) % lx) * ly + y];
@@ -78,7 +84,9 @@ mod tests {
     #[test]
     fn box_smoothing_equals_the_direct_sum() {
         let lattice = Lattice::new(13, 10);
-        let f: Vec<f64> = (0..130).map(|k| ((k * 7919) % 101) as f64 / 101.0 - 0.3).collect();
+        let f: Vec<f64> = (0..130)
+            .map(|k| ((k * 7919) % 101) as f64 / 101.0 - 0.3)
+            .collect();
         for side in [1, 3, 5, 9] {
             let s = box_smooth(lattice, &f, side).unwrap();
             let h = side as i64 / 2;
@@ -87,12 +95,16 @@ mod tests {
                     let mut d = 0.0;
                     for i in -h..=h {
                         for j in -h..=h {
-                            d += f[lattice.index(lattice.wrap_x(x as i64 + i), lattice.wrap_y(y as i64 + j))];
+                            d += f[lattice
+                                .index(lattice.wrap_x(x as i64 + i), lattice.wrap_y(y as i64 + j))];
                         }
                     }
                     d /= (side * side) as f64;
                     // Running sums accumulate round-off over one lattice side: ~L ε.
-                    assert!((s[lattice.index(x, y)] - d).abs() < 1e-13, "side {side} at ({x}, {y})");
+                    assert!(
+                        (s[lattice.index(x, y)] - d).abs() < 1e-13,
+                        "side {side} at ({x}, {y})"
+                    );
                 }
             }
         }

@@ -102,7 +102,10 @@ fn assign(a: &[[f64; 2]], b: &[[f64; 2]], lattice: Lattice, max: f64) -> Vec<(us
 }
 
 fn midpoint(lattice: Lattice, p: [f64; 2], q: [f64; 2]) -> [f64; 2] {
-    lattice.wrap_point([p[0] + 0.5 * lattice.delta_x(p[0], q[0]), p[1] + 0.5 * lattice.delta_y(p[1], q[1])])
+    lattice.wrap_point([
+        p[0] + 0.5 * lattice.delta_x(p[0], q[0]),
+        p[1] + 0.5 * lattice.delta_y(p[1], q[1]),
+    ])
 }
 
 fn pos(d: &Defect) -> [f64; 2] {
@@ -112,7 +115,12 @@ fn pos(d: &Defect) -> [f64; 2] {
 impl Tracker {
     /// A tracker with no history.
     pub fn new(lattice: Lattice, params: TrackParams) -> Self {
-        Self { lattice, params, prev: Vec::new(), next_id: 0 }
+        Self {
+            lattice,
+            params,
+            prev: Vec::new(),
+            next_id: 0,
+        }
     }
 
     /// Adds the defects of the next frame and links them to the previous one.
@@ -120,8 +128,12 @@ impl Tracker {
         let mut track = vec![u64::MAX; defects.len()];
         let mut prev_linked = vec![false; self.prev.len()];
         for sign in [0.5, -0.5] {
-            let old: Vec<usize> = (0..self.prev.len()).filter(|&i| self.prev[i].1.charge == sign).collect();
-            let new: Vec<usize> = (0..defects.len()).filter(|&i| defects[i].charge == sign).collect();
+            let old: Vec<usize> = (0..self.prev.len())
+                .filter(|&i| self.prev[i].1.charge == sign)
+                .collect();
+            let new: Vec<usize> = (0..defects.len())
+                .filter(|&i| defects[i].charge == sign)
+                .collect();
             let a: Vec<[f64; 2]> = old.iter().map(|&i| pos(&self.prev[i].1)).collect();
             let b: Vec<[f64; 2]> = new.iter().map(|&i| pos(&defects[i])).collect();
             for (i, j) in assign(&a, &b, self.lattice, self.params.max_link) {
@@ -132,10 +144,16 @@ impl Tracker {
         let mut out = FrameTracks::default();
         // Births and deaths of ±½ defects, paired into events.
         let born = |s: f64| -> Vec<[f64; 2]> {
-            (0..defects.len()).filter(|&i| track[i] == u64::MAX && defects[i].charge == s).map(|i| pos(&defects[i])).collect()
+            (0..defects.len())
+                .filter(|&i| track[i] == u64::MAX && defects[i].charge == s)
+                .map(|i| pos(&defects[i]))
+                .collect()
         };
         let died = |s: f64| -> Vec<[f64; 2]> {
-            (0..self.prev.len()).filter(|&i| !prev_linked[i] && self.prev[i].1.charge == s).map(|i| pos(&self.prev[i].1)).collect()
+            (0..self.prev.len())
+                .filter(|&i| !prev_linked[i] && self.prev[i].1.charge == s)
+                .map(|i| pos(&self.prev[i].1))
+                .collect()
         };
         for (kind, plus, minus) in [
             (EventKind::Creation, born(0.5), born(-0.5)),
@@ -145,7 +163,11 @@ impl Tracker {
             out.unpaired += plus.len() + minus.len() - 2 * pairs.len();
             for (i, j) in pairs {
                 let m = midpoint(self.lattice, plus[i], minus[j]);
-                out.events.push(Event { kind, x: m[0], y: m[1] });
+                out.events.push(Event {
+                    kind,
+                    x: m[0],
+                    y: m[1],
+                });
             }
         }
         for t in track.iter_mut() {
@@ -165,18 +187,39 @@ mod tests {
     use super::*;
 
     fn d(x: f64, y: f64, charge: f64) -> Defect {
-        Defect { x, y, charge, angle: 0.0 }
+        Defect {
+            x,
+            y,
+            charge,
+            angle: 0.0,
+        }
     }
 
     #[test]
     fn a_pair_is_created_moves_and_annihilates_across_the_edge() {
         let lattice = Lattice::new(50, 50);
-        let mut t = Tracker::new(lattice, TrackParams { max_link: 4.0, max_pair: 10.0 });
+        let mut t = Tracker::new(
+            lattice,
+            TrackParams {
+                max_link: 4.0,
+                max_pair: 10.0,
+            },
+        );
         let f0 = t.push(&[d(20.5, 20.5, 0.5)]);
-        assert!(f0.events.is_empty() && f0.unpaired == 1, "the first frame's defects are unpaired births");
+        assert!(
+            f0.events.is_empty() && f0.unpaired == 1,
+            "the first frame's defects are unpaired births"
+        );
         // A pair appears across the x edge, next to the old defect.
         let f1 = t.push(&[d(21.5, 20.5, 0.5), d(49.5, 3.5, 0.5), d(1.5, 3.5, -0.5)]);
-        assert_eq!(f1.events, vec![Event { kind: EventKind::Creation, x: 0.5, y: 3.5 }]);
+        assert_eq!(
+            f1.events,
+            vec![Event {
+                kind: EventKind::Creation,
+                x: 0.5,
+                y: 3.5
+            }]
+        );
         assert_eq!(f1.track[0], f0.track[0]);
         // They move apart and back, then vanish.
         let f2 = t.push(&[d(22.5, 20.5, 0.5), d(47.5, 3.5, 0.5), d(3.5, 4.5, -0.5)]);

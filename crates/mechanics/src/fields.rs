@@ -46,8 +46,20 @@ impl Tissue {
         let mut f = TissueFields {
             vx: ws.field2.iter().step_by(2).copied().collect(),
             vy: ws.field2.iter().skip(1).step_by(2).copied().collect(),
-            qxx: ws.global.iter().skip(G_QXX).step_by(N_GLOBAL).copied().collect(),
-            qxy: ws.global.iter().skip(G_QXY).step_by(N_GLOBAL).copied().collect(),
+            qxx: ws
+                .global
+                .iter()
+                .skip(G_QXX)
+                .step_by(N_GLOBAL)
+                .copied()
+                .collect(),
+            qxy: ws
+                .global
+                .iter()
+                .skip(G_QXY)
+                .step_by(N_GLOBAL)
+                .copied()
+                .collect(),
             pressure: ws.pressure.clone(),
             ..Default::default()
         };
