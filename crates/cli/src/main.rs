@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use monolayer_cli::analyze::{analyze, AnalyzeOptions};
 use monolayer_cli::{run, scene::Scene};
 
 /// Multi-phase-field simulations of cell monolayers (Mueller, Yeomans & Doostmohammadi, PRL 2019).
@@ -37,6 +38,33 @@ enum Command {
         #[arg(long)]
         overwrite: bool,
     },
+    /// Analyse a run directory: observables, correlations, defects and defect-centred
+    /// averages, written into RUN_DIR/analysis/.
+    Analyze {
+        /// A directory written by `monolayer run`.
+        run_dir: PathBuf,
+        /// First time analysed (default: the end of relaxation).
+        #[arg(long)]
+        from: Option<f64>,
+        /// Side of the smoothing box, odd (default: the odd side nearest 3R).
+        #[arg(long = "box")]
+        box_side: Option<usize>,
+        /// Side of the defect-centred crops, odd.
+        #[arg(long, default_value_t = 101)]
+        crop: usize,
+        /// Longest link of a defect between frames (default: R).
+        #[arg(long)]
+        max_link: Option<f64>,
+        /// Largest separation of a created or annihilated pair (default: 2R).
+        #[arg(long)]
+        max_pair: Option<f64>,
+        /// S_rms of a zeta = 0 run, to report S_rms relative to it.
+        #[arg(long)]
+        s_rms_baseline: Option<f64>,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -68,12 +96,7 @@ fn real_main() -> Result<()> {
                 .validate()
                 .with_context(|| format!("in scene {}", scene.display()))?;
             run::prepare_output(&out, overwrite)?;
-            let mut pool = rayon::ThreadPoolBuilder::new();
-            if let Some(n) = threads {
-                anyhow::ensure!(n >= 1, "--threads must be at least 1");
-                pool = pool.num_threads(n);
-            }
-            let pool = pool.build()?;
+            let pool = pool(threads)?;
             let info = pool.install(|| run::run(&parsed, &out, quiet))?;
             if !quiet {
                 eprintln!(
@@ -86,5 +109,42 @@ fn real_main() -> Result<()> {
             }
             Ok(())
         }
+        Command::Analyze {
+            run_dir,
+            from,
+            box_side,
+            crop,
+            max_link,
+            max_pair,
+            s_rms_baseline,
+            threads,
+        } => {
+            let opts = AnalyzeOptions {
+                from,
+                box_side,
+                crop_side: crop,
+                max_link,
+                max_pair,
+                s_rms_baseline,
+            };
+            let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
+            eprintln!(
+                "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
+                info.frames,
+                info.defects,
+                info.events,
+                run_dir.join("analysis").display()
+            );
+            Ok(())
+        }
     }
+}
+
+fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = threads {
+        anyhow::ensure!(n >= 1, "--threads must be at least 1");
+        pool = pool.num_threads(n);
+    }
+    Ok(pool.build()?)
 }

@@ -5,6 +5,7 @@
 //!
 //! | name | shape | meaning |
 //! |---|---|---|
+//! | `format` | `()` int64 | [`FRAME_FORMAT`], the version of this layout |
 //! | `step`, `time`, `zeta` | `()` | clock and activity |
 //! | `lattice` | `(2,)` int64 | `[lx, ly]` |
 //! | `centre` | `(N, 2)` | centre of mass `[x, y]` |
@@ -16,12 +17,15 @@
 //! | `phi` | `(N, nx, ny)` | `phi[i, u, v]` is `φ_i` at node `((origin_x+u) % lx, (origin_y+v) % ly)` |
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use mechanics::{Observables, Tissue, Workspace};
 use npyz::WriterBuilder;
+
+/// Version of the frame layout; `monolayer analyze` refuses frames of another version.
+pub const FRAME_FORMAT: i64 = 1;
 
 /// The header of `series.csv`.
 pub const SERIES_HEADER: &str =
@@ -100,6 +104,7 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
     }
     let n64 = n as u64;
     let arrays: Vec<(&str, Vec<u8>)> = vec![
+        ("format", npy(&[], [FRAME_FORMAT])?),
         ("step", npy(&[], [tissue.step as i64])?),
         ("time", npy(&[], [tissue.time])?),
         ("zeta", npy(&[], [tissue.params.zeta])?),
@@ -152,4 +157,49 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
     }
     std::fs::rename(&tmp, &path)?;
     Ok(path)
+}
+
+/// An array read from an `.npz` archive: its shape and its values as `f64`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Array {
+    /// The shape.
+    pub shape: Vec<u64>,
+    /// The values in C order.
+    pub data: Vec<f64>,
+}
+
+/// Reads the arrays `names` (and only those) from an `.npz` archive. Integer arrays are
+/// converted to `f64`.
+///
+/// # Errors
+/// When the file is not a readable archive or lacks one of the arrays.
+pub fn read_npz(path: &Path, names: &[&str]) -> Result<Vec<Array>> {
+    let f = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let mut zip = zip::ZipArchive::new(BufReader::new(f)).with_context(|| {
+        format!(
+            "{} is not a readable .npz archive (truncated?)",
+            path.display()
+        )
+    })?;
+    let mut out = Vec::with_capacity(names.len());
+    for name in names {
+        let mut entry = zip
+            .by_name(&format!("{name}.npy"))
+            .with_context(|| format!("{} has no array '{name}'", path.display()))?;
+        let mut bytes = Vec::with_capacity(entry.size() as usize);
+        entry.read_to_end(&mut bytes)?;
+        let npy = npyz::NpyFile::new(&bytes[..])
+            .with_context(|| format!("bad array '{name}' in {}", path.display()))?;
+        let shape = npy.shape().to_vec();
+        let data = match npy.dtype() {
+            npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Int => npy
+                .into_vec::<i64>()?
+                .into_iter()
+                .map(|v| v as f64)
+                .collect(),
+            _ => npy.into_vec::<f64>()?,
+        };
+        out.push(Array { shape, data });
+    }
+    Ok(out)
 }

@@ -331,3 +331,128 @@ fn an_earlier_run_is_not_overwritten_by_accident() {
         .count();
     assert_eq!(n, 3, "frames at t = 0, 5, 10 only; the old ones are gone");
 }
+
+fn csv_rows(path: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+/// `monolayer run` on a short active scene, then `monolayer analyze`: every file is there and
+/// the row counts agree with each other.
+#[test]
+fn analyze_after_run_writes_consistent_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--set",
+        "run.relax_time=60",
+        "--set",
+        "run.time=100",
+        "--set",
+        "run.output_every=10",
+        "--set",
+        "model.zeta=0.01",
+    ];
+    let o = run(&scene_path("paper.toml"), dir.path(), &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let a = bin().arg("analyze").arg(dir.path()).output().unwrap();
+    assert!(a.status.success(), "{}", stderr(&a));
+    let an = dir.path().join("analysis");
+    let obs = csv_rows(&an.join("observables.csv"));
+    // Frames at t = 60, 70, ..., 160: the default --from is the end of relaxation.
+    assert_eq!(obs.len(), 11);
+    let col = |name: &str| -> usize {
+        let header = std::fs::read_to_string(an.join("observables.csv")).unwrap();
+        header
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .position(|c| c == name)
+            .unwrap()
+    };
+    let sum = |name: &str| -> usize {
+        obs.iter()
+            .map(|r| r[col(name)].parse::<usize>().unwrap())
+            .sum()
+    };
+    let defects = csv_rows(&an.join("defects.csv"));
+    assert_eq!(
+        defects.len(),
+        sum("n_plus") + sum("n_minus") + sum("n_other")
+    );
+    assert!(sum("n_plus") > 0, "an active monolayer has defects");
+    for r in &obs {
+        assert_eq!(r[col("net_charge")].parse::<f64>().unwrap(), 0.0);
+    }
+    let events = csv_rows(&an.join("defect_events.csv"));
+    assert_eq!(events.len(), sum("creations") + sum("annihilations"));
+    let corr = csv_rows(&an.join("correlations.csv"));
+    assert_eq!(corr.len(), 51, "r = 0..=50 on a 100² lattice");
+    assert_eq!(corr[0], vec!["0", "1e0", "1e0", "1e0"]);
+    let lengths = csv_rows(&an.join("lengths.csv"));
+    assert_eq!(lengths.len(), 3);
+    let avg = monolayer_cli::output::read_npz(
+        &an.join("defect_averages.npz"),
+        &["n_plus", "n_minus", "plus_vx", "minus_qxx"],
+    )
+    .unwrap();
+    assert_eq!(avg[0].data[0] as usize, sum("n_plus"));
+    assert_eq!(avg[1].data[0] as usize, sum("n_minus"));
+    assert_eq!(avg[2].shape, vec![101, 101]);
+    // --from restricts the frames.
+    let a = bin()
+        .arg("analyze")
+        .arg(dir.path())
+        .args(["--from", "140"])
+        .output()
+        .unwrap();
+    assert!(a.status.success(), "{}", stderr(&a));
+    assert_eq!(csv_rows(&an.join("observables.csv")).len(), 3);
+}
+
+/// A missing, partial or foreign run directory gets a message that says what is wrong.
+#[test]
+fn analyze_explains_what_is_wrong_with_a_run_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let analyze = |p: &Path, extra: &[&str]| {
+        let o = bin().arg("analyze").arg(p).args(extra).output().unwrap();
+        (o.status.success(), stderr(&o))
+    };
+    let (ok, err) = analyze(&dir.path().join("nowhere"), &[]);
+    assert!(!ok && err.contains("no run directory"), "{err}");
+    let (ok, err) = analyze(dir.path(), &[]);
+    assert!(!ok && err.contains("scene.toml is missing"), "{err}");
+    let o = run(&scene_path("paper.toml"), &dir.path().join("run"), &SHORT);
+    assert!(o.status.success());
+    let rd = dir.path().join("run");
+    let (ok, err) = analyze(&rd, &["--from", "1000"]);
+    assert!(!ok && err.contains("no frame at or after"), "{err}");
+    let (ok, err) = analyze(&rd, &["--box", "24"]);
+    assert!(!ok && err.contains("must be odd"), "{err}");
+    // A damaged (truncated) frame.
+    let f = rd.join("frames/frame_00000050.npz");
+    let bytes = std::fs::read(&f).unwrap();
+    std::fs::write(&f, &bytes[..bytes.len() / 2]).unwrap();
+    let (ok, err) = analyze(&rd, &[]);
+    assert!(!ok && err.contains("frame_00000050.npz"), "{err}");
+    // A frame of another format: an archive without the format array.
+    std::fs::remove_file(&f).unwrap();
+    {
+        let mut zip = zip::ZipWriter::new(std::fs::File::create(&f).unwrap());
+        zip.start_file("time.npy", zip::write::SimpleFileOptions::default())
+            .unwrap();
+        std::io::Write::write_all(&mut zip, b"\x93NUMPY").unwrap();
+        zip.finish().unwrap();
+    }
+    let (ok, err) = analyze(&rd, &[]);
+    assert!(!ok && err.contains("another version"), "{err}");
+    // No frames at all.
+    std::fs::remove_dir_all(rd.join("frames")).unwrap();
+    let (ok, err) = analyze(&rd, &[]);
+    assert!(!ok && err.contains("no frames/ directory"), "{err}");
+}

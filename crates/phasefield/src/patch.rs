@@ -254,6 +254,41 @@ impl Cells {
         }
     }
 
+    /// Cells from patches in logical order (as written by [`Cells::unrolled_into`]): cell `i`'s
+    /// element `u * ny + v` is its value at node `(origins[i] + (u, v)) mod L`.
+    ///
+    /// # Panics
+    /// If `values.len() != origins.len() * shape.len()` or an origin is off the lattice.
+    pub fn from_unrolled(
+        lattice: Lattice,
+        shape: PatchShape,
+        origins: &[[usize; 2]],
+        values: &[f64],
+    ) -> Self {
+        let n_cells = origins.len();
+        assert_eq!(values.len(), n_cells * shape.len());
+        let mut map = PatchMap {
+            origin: origins.to_vec(),
+            offset: vec![[0, 0]; n_cells],
+            lat_x: vec![0; n_cells * shape.nx],
+            lat_y: vec![0; n_cells * shape.ny],
+        };
+        for (i, o) in origins.iter().enumerate() {
+            assert!(
+                o[0] < lattice.lx && o[1] < lattice.ly,
+                "origin {o:?} off the lattice"
+            );
+            map.refresh_tables(lattice, &shape, i);
+        }
+        Self {
+            lattice,
+            phi: values.to_vec(),
+            shape,
+            n_cells,
+            map,
+        }
+    }
+
     /// The patch origin that centres the patch on the node nearest to `centre`.
     fn origin_for(lattice: Lattice, shape: &PatchShape, centre: [f64; 2]) -> [usize; 2] {
         match shape.margin {

@@ -1,0 +1,402 @@
+//! `monolayer analyze RUN_DIR`: from a run directory to the paper's quantities, in
+//! `RUN_DIR/analysis/`.
+//!
+//! For every frame at or after `--from` (default: the end of relaxation) the state is rebuilt
+//! from the frame's patches and evaluated by `mechanics` (the step's own code) into lattice
+//! fields; `analysis` then smooths `v`, `ω` and `Q` with a periodic box (default the odd side
+//! nearest 3R), accumulates their correlations, finds and orients the defects of the smoothed
+//! `Q`, tracks them, and averages the raw fields around each defect in its own frame.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use analysis::correlation::{first_minimum, Correlator};
+use analysis::crop::{CropFields, DefectAverage, COMPONENTS};
+use analysis::defects::{detect, net_charge};
+use analysis::fields::{rms, s_rms, vorticity};
+use analysis::smooth::{box_smooth, paper_box_side};
+use analysis::tracking::{TrackParams, Tracker};
+use anyhow::{bail, ensure, Context, Result};
+use mechanics::{Tissue, Workspace};
+use npyz::WriterBuilder;
+use phasefield::{Cells, Lattice, PatchShape};
+
+use crate::output::{read_npz, FRAME_FORMAT};
+use crate::scene::Scene;
+
+/// Options of `monolayer analyze`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnalyzeOptions {
+    /// First time analysed (default: the scene's `relax_time`, the start of activity).
+    pub from: Option<f64>,
+    /// Side of the smoothing box (odd; default: the odd side nearest 3R).
+    pub box_side: Option<usize>,
+    /// Side of the defect-centred crops (odd).
+    pub crop_side: usize,
+    /// Longest link of a defect between frames (default R).
+    pub max_link: Option<f64>,
+    /// Largest separation of a created or annihilated pair (default 2R).
+    pub max_pair: Option<f64>,
+    /// `S_rms` of a ζ = 0 run, to report `S_rms` relative to it.
+    pub s_rms_baseline: Option<f64>,
+}
+
+impl Default for AnalyzeOptions {
+    fn default() -> Self {
+        Self {
+            from: None,
+            box_side: None,
+            crop_side: 101,
+            max_link: None,
+            max_pair: None,
+            s_rms_baseline: None,
+        }
+    }
+}
+
+/// What an analysis found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnalyzeInfo {
+    /// Frames analysed.
+    pub frames: usize,
+    /// Defects found over all frames.
+    pub defects: usize,
+    /// Creation and annihilation events.
+    pub events: usize,
+}
+
+/// The frames of a run directory, in step order, and how many partial files were skipped.
+fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
+    let dir = run_dir.join("frames");
+    let entries = std::fs::read_dir(&dir).with_context(|| {
+        format!(
+            "{} has no frames/ directory: the run wrote no frame yet",
+            run_dir.display()
+        )
+    })?;
+    let (mut frames, mut partial) = (Vec::new(), 0);
+    for e in entries {
+        let p = e?.path();
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if name.ends_with(".partial") {
+            partial += 1;
+        } else if name.starts_with("frame_") && name.ends_with(".npz") {
+            frames.push(p);
+        }
+    }
+    frames.sort();
+    ensure!(!frames.is_empty(), "{} holds no frame_*.npz", dir.display());
+    Ok((frames, partial))
+}
+
+/// Reads the run's resolved scene.
+fn read_scene(run_dir: &Path) -> Result<Scene> {
+    ensure!(
+        run_dir.is_dir(),
+        "no run directory at {}",
+        run_dir.display()
+    );
+    let path = run_dir.join("scene.toml");
+    let text = std::fs::read_to_string(&path).with_context(|| {
+        format!(
+            "{} is not a monolayer run directory: scene.toml is missing",
+            run_dir.display()
+        )
+    })?;
+    let scene = Scene::parse(&text, &[]).with_context(|| {
+        format!(
+            "{} does not parse with this version of monolayer",
+            path.display()
+        )
+    })?;
+    scene
+        .validate()
+        .with_context(|| format!("in {}", path.display()))?;
+    Ok(scene)
+}
+
+/// One frame's state, rebuilt as a tissue.
+fn load_frame(
+    path: &Path,
+    scene: &Scene,
+    shape: &PatchShape,
+    lattice: Lattice,
+) -> Result<(Tissue, Vec<[f64; 2]>, u64)> {
+    let a = read_npz(
+        path,
+        &[
+            "format",
+            "step",
+            "time",
+            "zeta",
+            "lattice",
+            "origin",
+            "phi",
+            "shape_tensor",
+        ],
+    )
+    .with_context(|| {
+        format!(
+            "frame {} was written by another version or is damaged",
+            path.display()
+        )
+    })?;
+    let (step, time, zeta) = (a[1].data[0] as u64, a[2].data[0], a[3].data[0]);
+    ensure!(
+        a[4].data == [lattice.lx as f64, lattice.ly as f64],
+        "frame {} is on a {:?} lattice but scene.toml says {}×{}",
+        path.display(),
+        a[4].data,
+        lattice.lx,
+        lattice.ly
+    );
+    let n = scene.cells.count;
+    let want = vec![n as u64, shape.nx as u64, shape.ny as u64];
+    ensure!(
+        a[6].shape == want,
+        "frame {}: phi has shape {:?}, the scene implies {:?}",
+        path.display(),
+        a[6].shape,
+        want
+    );
+    let origins: Vec<[usize; 2]> = a[5]
+        .data
+        .chunks_exact(2)
+        .map(|o| [o[0] as usize, o[1] as usize])
+        .collect();
+    let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &a[6].data);
+    let shapes: Vec<[f64; 2]> = a[7].data.chunks_exact(2).map(|s| [s[0], s[1]]).collect();
+    let tissue = Tissue {
+        centre: vec![[0.0; 2]; n],
+        cells,
+        params: scene.model_params(zeta),
+        time,
+        step,
+    };
+    Ok((tissue, shapes, step))
+}
+
+/// The time of a frame, after checking that this version can read it.
+fn frame_time(path: &Path) -> Result<f64> {
+    let a = read_npz(path, &["format", "time"]).with_context(|| {
+        format!(
+            "frame {} was written by another version or is damaged",
+            path.display()
+        )
+    })?;
+    let format = a[0].data[0] as i64;
+    ensure!(
+        format == FRAME_FORMAT,
+        "frame {} has format {format}, this version reads format {FRAME_FORMAT}",
+        path.display()
+    );
+    Ok(a[1].data[0])
+}
+
+fn csv(path: &Path) -> Result<BufWriter<File>> {
+    Ok(BufWriter::new(File::create(path).with_context(|| {
+        format!("cannot create {}", path.display())
+    })?))
+}
+
+/// Runs the analysis of `run_dir` into `run_dir/analysis/`.
+///
+/// # Errors
+/// On a missing, partial or foreign run directory, with what is wrong.
+pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
+    let scene = read_scene(run_dir)?;
+    let lattice = Lattice::new(scene.domain.lx, scene.domain.ly);
+    let shape = PatchShape::new(lattice, scene.integrator.margin)?;
+    let (frames, partial) = list_frames(run_dir)?;
+    if partial > 0 {
+        eprintln!("note: skipping {partial} partially written frame(s)");
+    }
+    let from = opts.from.unwrap_or(scene.run.relax_time);
+    let radius = scene.cells.radius;
+    let box_side = opts
+        .box_side
+        .unwrap_or_else(|| paper_box_side(radius).min(lattice.lx.min(lattice.ly) | 1));
+    box_smooth(lattice, &vec![0.0; lattice.len()], box_side).map_err(anyhow::Error::from)?;
+    ensure!(
+        opts.crop_side % 2 == 1,
+        "--crop must be odd (the defect sits on the centre node), e.g. 101"
+    );
+    let params = TrackParams {
+        max_link: opts.max_link.unwrap_or(radius),
+        max_pair: opts.max_pair.unwrap_or(2.0 * radius),
+    };
+
+    let selected: Vec<PathBuf> = frames
+        .into_iter()
+        .map(|p| frame_time(&p).map(|t| (p, t)))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .filter(|(_, t)| *t >= from - 1e-9)
+        .map(|(p, _)| p)
+        .collect();
+    if selected.is_empty() {
+        bail!("no frame at or after t = {from}; use --from with an earlier time");
+    }
+
+    let out = run_dir.join("analysis");
+    std::fs::create_dir_all(&out)?;
+    let mut obs = csv(&out.join("observables.csv"))?;
+    writeln!(
+        obs,
+        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate"
+    )?;
+    let mut defects_csv = csv(&out.join("defects.csv"))?;
+    writeln!(defects_csv, "# axes: x is the first lattice index, y the second, right-handed; angle in radians counterclockwise from +x (+1/2: direction of div Q; -1/2: one arm, modulo 2pi/3)")?;
+    writeln!(defects_csv, "frame,time,x,y,charge,angle,track")?;
+    let mut events_csv = csv(&out.join("defect_events.csv"))?;
+    writeln!(events_csv, "frame,time,kind,x,y")?;
+
+    let mut ws: Option<Workspace> = None;
+    let mut corr = [
+        Correlator::new(lattice),
+        Correlator::new(lattice),
+        Correlator::new(lattice),
+    ];
+    let mut tracker = Tracker::new(lattice, params);
+    let mut avg = DefectAverage::new(opts.crop_side);
+    let mut info = AnalyzeInfo {
+        frames: 0,
+        defects: 0,
+        events: 0,
+    };
+    let mut prev_time: Option<f64> = None;
+    let area = lattice.len() as f64;
+    for path in &selected {
+        let (mut tissue, shapes, step) = load_frame(path, &scene, &shape, lattice)?;
+        let ws = ws.get_or_insert_with(|| Workspace::new(&tissue.cells));
+        let f = tissue.fields(ws);
+        let smooth = |v: &[f64]| box_smooth(lattice, v, box_side).expect("checked above");
+        let (svx, svy) = (smooth(&f.vx), smooth(&f.vy));
+        let w = vorticity(lattice, &svx, &svy);
+        let (sqxx, sqxy) = (smooth(&f.qxx), smooth(&f.qxy));
+        corr[0].add(&[&svx, &svy]);
+        corr[1].add(&[&w]);
+        corr[2].add(&[&sqxx, &sqxy]);
+        let found = detect(lattice, &sqxx, &sqxy);
+        let tracks = tracker.push(&found);
+        let time = tissue.time;
+        for (d, t) in found.iter().zip(&tracks.track) {
+            writeln!(
+                defects_csv,
+                "{step},{time:.6},{},{},{},{},{t}",
+                d.x, d.y, d.charge, d.angle
+            )?;
+        }
+        let (mut creations, mut annihilations) = (0, 0);
+        for e in &tracks.events {
+            match e.kind {
+                analysis::tracking::EventKind::Creation => creations += 1,
+                analysis::tracking::EventKind::Annihilation => annihilations += 1,
+            }
+            writeln!(
+                events_csv,
+                "{step},{time:.6},{},{},{}",
+                e.kind.name(),
+                e.x,
+                e.y
+            )?;
+        }
+        avg.add(
+            lattice,
+            &CropFields {
+                vx: &f.vx,
+                vy: &f.vy,
+                sigma_xx: &f.sigma_xx,
+                sigma_yy: &f.sigma_yy,
+                sigma_xy: &f.sigma_xy,
+                pressure: &f.pressure,
+                qxx: &f.qxx,
+                qxy: &f.qxy,
+            },
+            &found,
+        );
+        let n_plus = found.iter().filter(|d| d.charge == 0.5).count();
+        let n_minus = found.iter().filter(|d| d.charge == -0.5).count();
+        let s = s_rms(&shapes);
+        let rate = match prev_time {
+            Some(p) if time > p => creations as f64 / ((time - p) * area),
+            _ => f64::NAN,
+        };
+        writeln!(
+            obs,
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e}",
+            rms(&[&f.vx, &f.vy]),
+            s,
+            opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
+            found.len() - n_plus - n_minus,
+            net_charge(&found),
+            found.len() as f64 / area,
+            tracks.unpaired,
+            rate
+        )?;
+        prev_time = Some(time);
+        info.frames += 1;
+        info.defects += found.len();
+        info.events += tracks.events.len();
+    }
+    obs.flush()?;
+    defects_csv.flush()?;
+    events_csv.flush()?;
+
+    let radial: Vec<Vec<f64>> = corr.iter().map(|c| c.radial()).collect();
+    let mut c = csv(&out.join("correlations.csv"))?;
+    writeln!(c, "r,c_velocity,c_vorticity,c_q")?;
+    for r in 0..radial[0].len() {
+        writeln!(
+            c,
+            "{r},{:e},{:e},{:e}",
+            radial[0][r], radial[1][r], radial[2][r]
+        )?;
+    }
+    c.flush()?;
+    let mut l = csv(&out.join("lengths.csv"))?;
+    writeln!(l, "field,length")?;
+    for (name, r) in ["velocity", "vorticity", "q"].iter().zip(&radial) {
+        writeln!(l, "{name},{}", first_minimum(r).unwrap_or(f64::NAN))?;
+    }
+    l.flush()?;
+    write_averages(&out.join("defect_averages.npz"), &avg)?;
+    Ok(info)
+}
+
+fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {
+    let side = avg.side() as u64;
+    let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut zip = zip::ZipWriter::new(BufWriter::new(f));
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let mut put = |name: &str, shape: &[u64], data: &[f64]| -> Result<()> {
+        let mut buf = Vec::new();
+        {
+            let mut w = npyz::WriteOptions::new()
+                .default_dtype()
+                .shape(shape)
+                .writer(&mut buf)
+                .begin_nd()?;
+            w.extend(data.iter().copied())?;
+            w.finish()?;
+        }
+        zip.start_file(format!("{name}.npy"), opts)?;
+        zip.write_all(&buf)?;
+        Ok(())
+    };
+    put("n_plus", &[], &[avg.n_plus as f64])?;
+    put("n_minus", &[], &[avg.n_minus as f64])?;
+    for (plus, prefix) in [(true, "plus"), (false, "minus")] {
+        for name in COMPONENTS {
+            put(
+                &format!("{prefix}_{name}"),
+                &[side, side],
+                &avg.average(plus, name),
+            )?;
+        }
+    }
+    zip.finish()?.flush()?;
+    Ok(())
+}
