@@ -8,6 +8,7 @@
 //! number of defects.
 
 use phasefield::Lattice;
+use rayon::prelude::*;
 
 use crate::defects::Defect;
 
@@ -98,45 +99,48 @@ impl DefectAverage {
                 continue;
             };
             let (s, c) = d.angle.sin_cos();
-            for iu in 0..side {
-                let u = iu as f64 - h;
-                for iv in 0..side {
-                    let v = iv as f64 - h;
-                    let x = d.x + c * u - s * v;
-                    let y = d.y + s * u + c * v;
-                    let at = |f: &[f64]| bilinear(lattice, f, x, y);
-                    let (vx, vy) = (at(fields.vx), at(fields.vy));
-                    let (sxx, syy, sxy) = (
-                        at(fields.sigma_xx),
-                        at(fields.sigma_yy),
-                        at(fields.sigma_xy),
-                    );
-                    let (qxx, qxy) = (at(fields.qxx), at(fields.qxy));
-                    let rot = |txx: f64, tyy: f64, txy: f64| {
-                        (
-                            c * c * txx + 2.0 * c * s * txy + s * s * tyy,
-                            s * s * txx - 2.0 * c * s * txy + c * c * tyy,
-                            -c * s * txx + (c * c - s * s) * txy + c * s * tyy,
-                        )
-                    };
-                    let (rsxx, rsyy, rsxy) = rot(sxx, syy, sxy);
-                    let (rqxx, _, rqxy) = rot(qxx, -qxx, qxy);
-                    let vals = [
-                        c * vx + s * vy,
-                        -s * vx + c * vy,
-                        rsxx,
-                        rsyy,
-                        rsxy,
-                        at(fields.pressure),
-                        rqxx,
-                        rqxy,
-                    ];
-                    let base = (iu * side + iv) * COMPONENTS.len();
-                    for (k, val) in vals.iter().enumerate() {
-                        sums[base + k] += val;
+            // Rows of the crop are disjoint slices of the sums: parallel and deterministic.
+            sums.par_chunks_mut(side * COMPONENTS.len())
+                .enumerate()
+                .for_each(|(iu, row)| {
+                    let u = iu as f64 - h;
+                    for iv in 0..side {
+                        let v = iv as f64 - h;
+                        let x = d.x + c * u - s * v;
+                        let y = d.y + s * u + c * v;
+                        let at = |f: &[f64]| bilinear(lattice, f, x, y);
+                        let (vx, vy) = (at(fields.vx), at(fields.vy));
+                        let (sxx, syy, sxy) = (
+                            at(fields.sigma_xx),
+                            at(fields.sigma_yy),
+                            at(fields.sigma_xy),
+                        );
+                        let (qxx, qxy) = (at(fields.qxx), at(fields.qxy));
+                        let rot = |txx: f64, tyy: f64, txy: f64| {
+                            (
+                                c * c * txx + 2.0 * c * s * txy + s * s * tyy,
+                                s * s * txx - 2.0 * c * s * txy + c * c * tyy,
+                                -c * s * txx + (c * c - s * s) * txy + c * s * tyy,
+                            )
+                        };
+                        let (rsxx, rsyy, rsxy) = rot(sxx, syy, sxy);
+                        let (rqxx, _, rqxy) = rot(qxx, -qxx, qxy);
+                        let vals = [
+                            c * vx + s * vy,
+                            -s * vx + c * vy,
+                            rsxx,
+                            rsyy,
+                            rsxy,
+                            at(fields.pressure),
+                            rqxx,
+                            rqxy,
+                        ];
+                        let base = iv * COMPONENTS.len();
+                        for (k, val) in vals.iter().enumerate() {
+                            row[base + k] += val;
+                        }
                     }
-                }
-            }
+                });
         }
     }
 
