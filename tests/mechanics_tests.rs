@@ -261,3 +261,32 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_eq!(a.centre, b.centre);
     assert_eq!(max_diff(a.cells.phi(), b.cells.phi()), 0.0);
 }
+
+/// The lattice fields are the step's own sums: `Σ_x Q = Σ_i S_i Σ_x φ_i`,
+/// `Σ_x v = Σ_i v_i Σ_x φ_i`, and the stress is `−P𝕀 − ζQ`, to round-off.
+#[test]
+fn lattice_fields_are_consistent_with_the_cells() {
+    for pressure in PRESSURES {
+        let (mut t, mut ws) = confluent(100, 5, 100, pressure);
+        t.params.zeta = 0.007;
+        let f = t.fields(&mut ws);
+        let (mut qx, mut qy, mut vx, mut vy) = (0.0, 0.0, 0.0, 0.0);
+        for i in 0..t.cells.n_cells() {
+            let mass: f64 = t.cells.cell_phi(i).iter().sum();
+            let c = ws.cell_state[i];
+            qx += c.shape[0] * mass;
+            qy += c.shape[1] * mass;
+            vx += c.velocity[0] * mass;
+            vy += c.velocity[1] * mass;
+        }
+        let sum = |v: &[f64]| v.iter().sum::<f64>();
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-10 * (a.abs() + b.abs() + 1e-300);
+        assert!(close(sum(&f.qxx), qx) && close(sum(&f.qxy), qy));
+        assert!(close(sum(&f.vx), vx) && close(sum(&f.vy), vy));
+        for k in (0..f.pressure.len()).step_by(97) {
+            assert_eq!(f.sigma_xx[k], -f.pressure[k] - 0.007 * f.qxx[k]);
+            assert_eq!(f.sigma_yy[k], -f.pressure[k] + 0.007 * f.qxx[k]);
+            assert_eq!(f.sigma_xy[k], -0.007 * f.qxy[k]);
+        }
+    }
+}
