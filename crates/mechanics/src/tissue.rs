@@ -9,7 +9,7 @@
 //!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
-use phasefield::{for_each_stencil, Cells, ComTable, Lattice};
+use phasefield::{for_each_stencil, for_each_stencil_at, Cells, ComTable, Lattice};
 use rayon::prelude::*;
 
 use crate::params::{ModelParams, PressureKind, StepParams};
@@ -371,7 +371,6 @@ pub fn evaluate(
     // 4. Forces, velocities and the right-hand side.
     let pr: &[f64] = pressure;
     let map = cells.map();
-    let ny = shape.ny;
     let xi = params.xi;
     // The paper's P contains cell i's own double-well term −(8γ/λ) φ_i(1−φ_i)(1−2φ_i). Its
     // contribution to F_i is the integral of a gradient, zero in the continuum, but its central
@@ -389,10 +388,10 @@ pub fn evaluate(
         .for_each(|(i, ((out, cell), st))| {
             let xs = map.cell_x(shape, i);
             let ys = map.cell_y(shape, i);
-            let node = |k: usize| (xs[k / ny] as usize) * ly + ys[k % ny] as usize;
+            let node = |a: usize, b: usize| (xs[a] as usize) * ly + ys[b] as usize;
             let (mut fx, mut fy) = (0.0, 0.0);
-            for_each_stencil(cell, shape, |k, s| {
-                let n = node(k);
+            for_each_stencil_at(cell, shape, |_, a, b, s| {
+                let n = node(a, b);
                 let p = pr[n] + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
                 let (qxx, qxy) = (g[n * N_GLOBAL + G_QXX], g[n * N_GLOBAL + G_QXY]);
                 let (dx, dy) = (s.dx(), s.dy());
@@ -403,8 +402,8 @@ pub fn evaluate(
             st.force = [fx, fy];
             st.velocity = [vx, vy];
             let area = st.area;
-            for_each_stencil(cell, shape, |k, s| {
-                let n = node(k);
+            for_each_stencil_at(cell, shape, |k, a, b, s| {
+                let n = node(a, b);
                 let others = g[n * N_GLOBAL + G_S2] - s.c * s.c;
                 let dfdphi = energy.ch(s.c, s.laplacian())
                     + energy.area(s.c, area)

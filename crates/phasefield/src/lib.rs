@@ -43,7 +43,7 @@ mod patch;
 pub use com::ComTable;
 pub use energy::EnergyParams;
 pub use lattice::{min_image, wrap_real, Lattice};
-pub use patch::{for_each_stencil, Cells, PatchMap, PatchShape, Stencil};
+pub use patch::{for_each_stencil, for_each_stencil_at, Cells, PatchMap, PatchShape, Stencil};
 
 /// Errors from building lattices, patches and initial states.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

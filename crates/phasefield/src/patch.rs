@@ -122,6 +122,21 @@ impl Stencil {
 /// If `phi.len() != shape.len()`.
 #[inline(always)]
 pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShape, mut f: F) {
+    for_each_stencil_at(phi, shape, |k, _, _, s| f(k, s));
+}
+
+/// Calls `f(k, a, b, stencil)` for every node `k = a * ny + b` (storage column `a`, row `b`)
+/// of one patch, with periodic wrap inside the patch; rows are visited in order, so that a
+/// kernel can look up per-column data once per column.
+///
+/// # Panics
+/// If `phi.len() != shape.len()`.
+#[inline(always)]
+pub fn for_each_stencil_at<F: FnMut(usize, usize, usize, Stencil)>(
+    phi: &[f64],
+    shape: &PatchShape,
+    mut f: F,
+) {
     let ny = shape.ny;
     assert_eq!(phi.len(), shape.len());
     for a in 0..shape.nx {
@@ -132,6 +147,8 @@ pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShap
         if ny == 1 {
             f(
                 k0,
+                a,
+                0,
                 Stencil {
                     c: row[0],
                     xm: row_m[0],
@@ -144,6 +161,8 @@ pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShap
         }
         f(
             k0,
+            a,
+            0,
             Stencil {
                 c: row[0],
                 xm: row_m[0],
@@ -155,6 +174,8 @@ pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShap
         for b in 1..ny - 1 {
             f(
                 k0 + b,
+                a,
+                b,
                 Stencil {
                     c: row[b],
                     xm: row_m[b],
@@ -166,6 +187,8 @@ pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShap
         }
         f(
             k0 + ny - 1,
+            a,
+            ny - 1,
             Stencil {
                 c: row[ny - 1],
                 xm: row_m[ny - 1],
