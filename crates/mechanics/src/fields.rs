@@ -3,7 +3,7 @@
 //! `P` and the stress `σ = −P𝕀 − ζQ`.
 
 use crate::scatter::scatter;
-use crate::tissue::{Tissue, Workspace, G_QXX, G_QXY, N_GLOBAL};
+use crate::tissue::{Tissue, Workspace, G_QXX, G_QXY, N_GATHER, N_GLOBAL};
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -60,7 +60,7 @@ impl Tissue {
                 .step_by(N_GLOBAL)
                 .copied()
                 .collect(),
-            pressure: ws.pressure.clone(),
+            pressure: ws.pressure.iter().step_by(N_GATHER).copied().collect(),
             ..Default::default()
         };
         f.sigma_xx = (0..n).map(|k| -f.pressure[k] - zeta * f.qxx[k]).collect();

@@ -37,6 +37,11 @@ pub const G_QXY: usize = 6;
 /// term `Σ_x ∇²φ_i ∂φ_i` vanishes exactly, so that an isolated cell feels no force.
 pub const G_LAP: usize = 7;
 
+/// Components per node of the gather buffer `Workspace::pressure`: `[P, s2, Q_xx, Q_xy]`,
+/// the lattice values the force pass reads, packed so that a patch row touches half the
+/// cache lines of the full global record.
+pub const N_GATHER: usize = 4;
+
 /// Per-cell quantities derived from the fields by one evaluation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct CellState {
@@ -77,7 +82,7 @@ pub struct Workspace {
     k2: Vec<f64>,
     /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices).
     pub global: Vec<f64>,
-    /// Pressure on the lattice.
+    /// `[P, s2, Q_xx, Q_xy]` per lattice node (see [`N_GATHER`]).
     pub pressure: Vec<f64>,
     /// Per-cell derived quantities of the last evaluation.
     pub cell_state: Vec<CellState>,
@@ -96,7 +101,7 @@ impl Workspace {
             k1: vec![0.0; n],
             k2: vec![0.0; n],
             global: vec![0.0; lattice.len() * N_GLOBAL],
-            pressure: vec![0.0; lattice.len()],
+            pressure: vec![0.0; lattice.len() * N_GATHER],
             cell_state: vec![CellState::default(); cells.n_cells()],
             field2: vec![0.0; lattice.len() * 2],
             com: ComTable::new(lattice),
@@ -329,44 +334,35 @@ pub fn evaluate(
         });
     }
 
-    // 3. Pressure.
+    // 3. Pressure, packed with the other values the force pass gathers.
     let ly = lattice.ly;
     let g: &[f64] = global;
-    match params.pressure {
-        PressureKind::Paper => {
-            let a0 = energy.target_area();
-            let (c_rep, c_ch, c_lap, c_area) = (
-                2.0 * energy.kappa / energy.lambda,
-                8.0 * energy.gamma / energy.lambda,
-                2.0 * energy.gamma * energy.lambda,
-                4.0 * energy.mu / a0,
-            );
-            pressure
-                .par_chunks_mut(ly)
-                .enumerate()
-                .for_each(|(x, row)| {
-                    for y in 0..ly {
-                        let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
-                        row[y] = c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
+    let a0 = energy.target_area();
+    let (c_rep, c_ch, c_lap, c_area) = (
+        2.0 * energy.kappa / energy.lambda,
+        8.0 * energy.gamma / energy.lambda,
+        2.0 * energy.gamma * energy.lambda,
+        4.0 * energy.mu / a0,
+    );
+    let kind = params.pressure;
+    pressure
+        .par_chunks_mut(ly * N_GATHER)
+        .enumerate()
+        .for_each(|(x, row)| {
+            for (y, out) in row.chunks_exact_mut(N_GATHER).enumerate() {
+                let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
+                let p = match kind {
+                    PressureKind::Paper => {
+                        c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
                             - c_ch * (n[G_S1] - 3.0 * n[G_S2] + 2.0 * n[G_S3])
                             + c_lap * n[G_LAP]
-                            + c_area * (n[G_S1] - n[G_SA] / a0);
+                            + c_area * (n[G_S1] - n[G_SA] / a0)
                     }
-                });
-        }
-        PressureKind::Interaction => {
-            let c_rep = 2.0 * energy.kappa / energy.lambda;
-            pressure
-                .par_chunks_mut(ly)
-                .enumerate()
-                .for_each(|(x, row)| {
-                    for y in 0..ly {
-                        let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
-                        row[y] = c_rep * (n[G_S2] * n[G_S2] - n[G_S4]);
-                    }
-                });
-        }
-    }
+                    PressureKind::Interaction => c_rep * (n[G_S2] * n[G_S2] - n[G_S4]),
+                };
+                out.copy_from_slice(&[p, n[G_S2], n[G_QXX], n[G_QXY]]);
+            }
+        });
 
     // 4. Forces, velocities and the right-hand side.
     let pr: &[f64] = pressure;
@@ -391,9 +387,9 @@ pub fn evaluate(
             let node = |a: usize, b: usize| (xs[a] as usize) * ly + ys[b] as usize;
             let (mut fx, mut fy) = (0.0, 0.0);
             for_each_stencil_at(cell, shape, |_, a, b, s| {
-                let n = node(a, b);
-                let p = pr[n] + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
-                let (qxx, qxy) = (g[n * N_GLOBAL + G_QXX], g[n * N_GLOBAL + G_QXY]);
+                let n = &pr[node(a, b) * N_GATHER..][..N_GATHER];
+                let p = n[0] + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
+                let (qxx, qxy) = (n[2], n[3]);
                 let (dx, dy) = (s.dx(), s.dy());
                 fx += p * dx + zeta * (qxx * dx + qxy * dy);
                 fy += p * dy + zeta * (qxy * dx - qxx * dy);
@@ -403,8 +399,7 @@ pub fn evaluate(
             st.velocity = [vx, vy];
             let area = st.area;
             for_each_stencil_at(cell, shape, |k, a, b, s| {
-                let n = node(a, b);
-                let others = g[n * N_GLOBAL + G_S2] - s.c * s.c;
+                let others = pr[node(a, b) * N_GATHER + 1] - s.c * s.c;
                 let dfdphi = energy.ch(s.c, s.laplacian())
                     + energy.area(s.c, area)
                     + energy.rep(s.c, others);
