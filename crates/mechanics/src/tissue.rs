@@ -368,6 +368,7 @@ pub fn evaluate(
     let pr: &[f64] = pressure;
     let map = cells.map();
     let xi = params.xi;
+    let coef = energy.coefficients();
     // The paper's P contains cell i's own double-well term −(8γ/λ) φ_i(1−φ_i)(1−2φ_i). Its
     // contribution to F_i is the integral of a gradient, zero in the continuum, but its central
     // difference sum is not zero on the lattice and would propel isolated cells (|v| ~ 5e-4).
@@ -397,12 +398,11 @@ pub fn evaluate(
             let (vx, vy) = (fx / xi, fy / xi);
             st.force = [fx, fy];
             st.velocity = [vx, vy];
-            let area = st.area;
+            let area_factor = coef.area_factor(st.area);
             for_each_stencil_at(cell, shape, |k, a, b, s| {
                 let others = pr[node(a, b) * N_GATHER + 1] - s.c * s.c;
-                let dfdphi = energy.ch(s.c, s.laplacian())
-                    + energy.area(s.c, area)
-                    + energy.rep(s.c, others);
+                let dfdphi =
+                    coef.ch(s.c, s.laplacian()) + area_factor * s.c + coef.rep(s.c, others);
                 out[k] = -(vx * s.dx() + vy * s.dy()) - dfdphi;
             });
         });

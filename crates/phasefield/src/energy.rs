@@ -52,23 +52,32 @@ impl EnergyParams {
     }
 
     /// `δF_CH/δφ_i = (8γ/λ) φ(1−φ)(1−2φ) − 2γλ ∇²φ`, given `φ` and its five-point Laplacian.
-    #[inline(always)]
     pub fn ch(&self, phi: f64, laplacian: f64) -> f64 {
-        8.0 * self.gamma / self.lambda * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
-            - 2.0 * self.gamma * self.lambda * laplacian
+        self.coefficients().ch(phi, laplacian)
     }
 
     /// `δF_area/δφ_i = −(4μ/(πR²)) φ (1 − A_i/(πR²))`, given `φ` and the cell's area `A_i`.
-    #[inline(always)]
     pub fn area(&self, phi: f64, area: f64) -> f64 {
-        let a0 = self.target_area();
-        -4.0 * self.mu / a0 * phi * (1.0 - area / a0)
+        let c = self.coefficients();
+        c.area_factor(area) * phi
     }
 
     /// `δF_rep/δφ_i = (2κ/λ) φ Σ_{k≠i} φ_k²`, given `φ` and `Σ_{k≠i} φ_k²` at the node.
-    #[inline(always)]
     pub fn rep(&self, phi: f64, others_sq: f64) -> f64 {
-        2.0 * self.kappa / self.lambda * phi * others_sq
+        self.coefficients().rep(phi, others_sq)
+    }
+
+    /// The constant factors of the three derivatives, computed once so that a kernel does no
+    /// division per node.
+    pub fn coefficients(&self) -> EnergyCoefficients {
+        let a0 = self.target_area();
+        EnergyCoefficients {
+            double_well: 8.0 * self.gamma / self.lambda,
+            gradient: 2.0 * self.gamma * self.lambda,
+            area: 4.0 * self.mu / a0,
+            inv_target_area: 1.0 / a0,
+            repulsion: 2.0 * self.kappa / self.lambda,
+        }
     }
 
     /// The discrete free energy of a state (see the module docs). Allocates two lattice-sized
@@ -102,5 +111,41 @@ impl EnergyParams {
         // Σ_{i<k} φ_i² φ_k² = ((Σ φ²)² − Σ φ⁴) / 2
         let rep: f64 = s2.iter().zip(&s4).map(|(a, b)| a * a - b).sum();
         total + self.kappa / self.lambda * 0.5 * rep
+    }
+}
+
+/// The constant factors of the free-energy derivatives ([`EnergyParams::coefficients`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyCoefficients {
+    /// `8γ/λ`.
+    pub double_well: f64,
+    /// `2γλ`.
+    pub gradient: f64,
+    /// `4μ/(πR²)`.
+    pub area: f64,
+    /// `1/(πR²)`.
+    pub inv_target_area: f64,
+    /// `2κ/λ`.
+    pub repulsion: f64,
+}
+
+impl EnergyCoefficients {
+    /// `δF_CH/δφ_i` (see [`EnergyParams::ch`]).
+    #[inline(always)]
+    pub fn ch(&self, phi: f64, laplacian: f64) -> f64 {
+        self.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi) - self.gradient * laplacian
+    }
+
+    /// The factor `−(4μ/(πR²))(1 − A_i/(πR²))` of cell i, so that
+    /// `δF_area/δφ_i = area_factor(A_i) · φ`; constant over a cell's patch.
+    #[inline(always)]
+    pub fn area_factor(&self, area: f64) -> f64 {
+        -self.area * (1.0 - area * self.inv_target_area)
+    }
+
+    /// `δF_rep/δφ_i` (see [`EnergyParams::rep`]).
+    #[inline(always)]
+    pub fn rep(&self, phi: f64, others_sq: f64) -> f64 {
+        self.repulsion * phi * others_sq
     }
 }

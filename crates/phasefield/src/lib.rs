@@ -41,7 +41,7 @@ mod lattice;
 mod patch;
 
 pub use com::ComTable;
-pub use energy::EnergyParams;
+pub use energy::{EnergyCoefficients, EnergyParams};
 pub use lattice::{min_image, wrap_real, Lattice};
 pub use patch::{for_each_stencil, for_each_stencil_at, Cells, PatchMap, PatchShape, Stencil};
 
