@@ -3,7 +3,7 @@
 //! `P` and the stress `σ = −P𝕀 − ζQ`.
 
 use crate::scatter::scatter;
-use crate::tissue::{Tissue, Workspace, G_QXX, G_QXY, N_GATHER, N_GLOBAL};
+use crate::tissue::{pressure, Tissue, Workspace, G_QXX, G_QXY, N_GLOBAL};
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -43,6 +43,7 @@ impl Tissue {
         self.scatter_velocity(ws);
         let n = self.lattice().len();
         let zeta = self.params.zeta;
+        let rep = self.params.energy.coefficients().repulsion;
         let mut f = TissueFields {
             vx: ws.field2.iter().step_by(2).copied().collect(),
             vy: ws.field2.iter().skip(1).step_by(2).copied().collect(),
@@ -60,7 +61,11 @@ impl Tissue {
                 .step_by(N_GLOBAL)
                 .copied()
                 .collect(),
-            pressure: ws.pressure.iter().step_by(N_GATHER).copied().collect(),
+            pressure: ws
+                .global
+                .chunks_exact(N_GLOBAL)
+                .map(|n| pressure(self.params.pressure, rep, n))
+                .collect(),
             ..Default::default()
         };
         f.sigma_xx = (0..n).map(|k| -f.pressure[k] - zeta * f.qxx[k]).collect();

@@ -47,8 +47,8 @@ pub use observables::Observables;
 pub use params::{ModelParams, PressureKind, StepParams};
 pub use simulation::{run, Observer, Protocol};
 pub use tissue::{
-    evaluate, CellState, Tissue, Workspace, G_LAP, G_QXX, G_QXY, G_S1, G_S2, G_S3, G_S4, G_SA,
-    N_GLOBAL, PHI_BOUND,
+    evaluate, pressure, CellState, Tissue, Workspace, G_QXX, G_QXY, G_S1, G_S2, G_U, N_GLOBAL,
+    PHI_BOUND,
 };
 
 /// Why a time step could not be taken.

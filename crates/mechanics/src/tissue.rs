@@ -1,11 +1,10 @@
 //! The state of a monolayer ([`Tissue`]), its scratch memory ([`Workspace`]) and the time step.
 //!
-//! One evaluation of the right-hand side `R(φ)` (MODEL.md §3–4) runs four passes:
+//! One evaluation of the right-hand side `R(φ)` (MODEL.md §3–4) runs three passes:
 //! 1. per cell, in parallel: area `A_i = Σ φ_i²` and deformation tensor `S_i`;
-//! 2. scatter onto the lattice, stripe-parallel in cell order:
-//!    `s1, s2, s3, s4, sA, Q_xx, Q_xy, Σ∇²φ_i`;
-//! 3. per lattice row, in parallel: the pressure `P`;
-//! 4. per cell, in parallel: the force `F_i = Σ_x [(P − P_i^self) ∇φ_i + ζ Q·∇φ_i]` (see
+//! 2. scatter onto the lattice, stripe-parallel in cell order: `s1, s2`, the part `U` of the
+//!    pressure that is a sum of single-cell terms, `Q_xx, Q_xy` (see [`pressure`]);
+//! 3. per cell, in parallel: the force `F_i = Σ_x [(P − P_i^self) ∇φ_i + ζ Q·∇φ_i]` (see
 //!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
@@ -17,30 +16,34 @@ use crate::scatter::scatter;
 use crate::StepError;
 
 /// Components of the global (lattice-wide) sums, per node.
-pub const N_GLOBAL: usize = 8;
+pub const N_GLOBAL: usize = 5;
 /// Index of `s1 = Σ φ_i` in a global node record.
 pub const G_S1: usize = 0;
 /// Index of `s2 = Σ φ_i²`.
 pub const G_S2: usize = 1;
-/// Index of `s3 = Σ φ_i³`.
-pub const G_S3: usize = 2;
-/// Index of `s4 = Σ φ_i⁴`.
-pub const G_S4: usize = 3;
-/// Index of `sA = Σ φ_i A_i`.
-pub const G_SA: usize = 4;
+/// Index of `U`, the part of the pressure that is linear in the cells' contributions:
+/// `P = (2κ/λ) s1 s2 + U` (paper) or `P = (2κ/λ) s2² + U` (interaction); see [`pressure`].
+pub const G_U: usize = 2;
 /// Index of `Q_xx = Σ φ_i S_i,xx`.
-pub const G_QXX: usize = 5;
+pub const G_QXX: usize = 3;
 /// Index of `Q_xy = Σ φ_i S_i,xy`.
-pub const G_QXY: usize = 6;
-/// Index of `Σ ∇²φ_i`, each Laplacian taken on the cell's own periodic patch. It equals the
-/// lattice Laplacian `∇² s1` in full-domain storage; on patches it is the form whose self
-/// term `Σ_x ∇²φ_i ∂φ_i` vanishes exactly, so that an isolated cell feels no force.
-pub const G_LAP: usize = 7;
+pub const G_QXY: usize = 4;
 
-/// Components per node of the gather buffer `Workspace::pressure`: `[P, s2, Q_xx, Q_xy]`,
-/// the lattice values the force pass reads, packed so that a patch row touches half the
-/// cache lines of the full global record.
-pub const N_GATHER: usize = 4;
+/// The pressure at a node from its global record (MODEL.md §3).
+///
+/// Paper: `P = (2κ/λ)(s1 s2 − s3) − (8γ/λ)(s1 − 3 s2 + 2 s3) + 2γλ Σ_i ∇²φ_i
+/// + (4μ/πR²)(s1 − sA/πR²)`, of which every term but `(2κ/λ) s1 s2` is a sum over cells of a
+/// function of `φ_i` alone; the scatter adds those into `U`. The Laplacians are taken on each
+/// cell's periodic patch: on the full domain this is `∇² s1`, and on patches it is the form
+/// whose self term `Σ_x ∇²φ_i ∂φ_i` vanishes exactly, so that an isolated cell feels no force.
+/// Interaction: `P = (2κ/λ)(s2² − s4)`, with `U = −(2κ/λ) s4`.
+#[inline(always)]
+pub fn pressure(kind: PressureKind, repulsion: f64, record: &[f64]) -> f64 {
+    match kind {
+        PressureKind::Paper => repulsion * record[G_S1] * record[G_S2] + record[G_U],
+        PressureKind::Interaction => repulsion * record[G_S2] * record[G_S2] + record[G_U],
+    }
+}
 
 /// Per-cell quantities derived from the fields by one evaluation.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -82,8 +85,6 @@ pub struct Workspace {
     k2: Vec<f64>,
     /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices).
     pub global: Vec<f64>,
-    /// `[P, s2, Q_xx, Q_xy]` per lattice node (see [`N_GATHER`]).
-    pub pressure: Vec<f64>,
     /// Per-cell derived quantities of the last evaluation.
     pub cell_state: Vec<CellState>,
     /// A two-component lattice buffer for derived fields (e.g. the tissue velocity).
@@ -101,7 +102,6 @@ impl Workspace {
             k1: vec![0.0; n],
             k2: vec![0.0; n],
             global: vec![0.0; lattice.len() * N_GLOBAL],
-            pressure: vec![0.0; lattice.len() * N_GATHER],
             cell_state: vec![CellState::default(); cells.n_cells()],
             field2: vec![0.0; lattice.len() * 2],
             com: ComTable::new(lattice),
@@ -163,7 +163,6 @@ impl Tissue {
         let Workspace {
             k2,
             global,
-            pressure,
             cell_state,
             ..
         } = ws;
@@ -173,7 +172,6 @@ impl Tissue {
             self.cells.phi(),
             k2,
             global,
-            pressure,
             cell_state,
         );
     }
@@ -193,7 +191,6 @@ impl Tissue {
             k1,
             k2,
             global,
-            pressure,
             cell_state,
             com,
             ..
@@ -204,7 +201,6 @@ impl Tissue {
             self.cells.phi(),
             k1,
             global,
-            pressure,
             cell_state,
         );
         self.check(cell_state, dt)?;
@@ -220,7 +216,6 @@ impl Tissue {
                 self.cells.phi(),
                 k2,
                 global,
-                pressure,
                 cell_state,
             );
             let phi = self.cells.phi_mut();
@@ -282,7 +277,6 @@ pub fn evaluate(
     phi: &[f64],
     rhs: &mut [f64],
     global: &mut [f64],
-    pressure: &mut [f64],
     cell_state: &mut [CellState],
 ) {
     let shape = cells.shape();
@@ -315,60 +309,31 @@ pub fn evaluate(
         });
 
     // 2. Global sums.
+    let coef = energy.coefficients();
+    let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
         let lap: &[f64] = rhs;
         scatter::<N_GLOBAL, _>(cells, phi, global, |i, k, p| {
             let c = &cs[i];
             let p2 = p * p;
-            [
-                p,
-                p2,
-                p2 * p,
-                p2 * p2,
-                p * c.area,
-                p * c.shape[0],
-                p * c.shape[1],
-                lap[i * plen + k],
-            ]
+            let u = match kind {
+                PressureKind::Paper => {
+                    -coef.repulsion * p2 * p - coef.double_well * p * (1.0 - p) * (1.0 - 2.0 * p)
+                        + coef.gradient * lap[i * plen + k]
+                        - coef.area_factor(c.area) * p
+                }
+                PressureKind::Interaction => -coef.repulsion * p2 * p2,
+            };
+            [p, p2, u, p * c.shape[0], p * c.shape[1]]
         });
     }
 
-    // 3. Pressure, packed with the other values the force pass gathers.
+    // 3. Forces, velocities and the right-hand side.
     let ly = lattice.ly;
     let g: &[f64] = global;
-    let a0 = energy.target_area();
-    let (c_rep, c_ch, c_lap, c_area) = (
-        2.0 * energy.kappa / energy.lambda,
-        8.0 * energy.gamma / energy.lambda,
-        2.0 * energy.gamma * energy.lambda,
-        4.0 * energy.mu / a0,
-    );
-    let kind = params.pressure;
-    pressure
-        .par_chunks_mut(ly * N_GATHER)
-        .enumerate()
-        .for_each(|(x, row)| {
-            for (y, out) in row.chunks_exact_mut(N_GATHER).enumerate() {
-                let n = &g[(x * ly + y) * N_GLOBAL..][..N_GLOBAL];
-                let p = match kind {
-                    PressureKind::Paper => {
-                        c_rep * (n[G_S1] * n[G_S2] - n[G_S3])
-                            - c_ch * (n[G_S1] - 3.0 * n[G_S2] + 2.0 * n[G_S3])
-                            + c_lap * n[G_LAP]
-                            + c_area * (n[G_S1] - n[G_SA] / a0)
-                    }
-                    PressureKind::Interaction => c_rep * (n[G_S2] * n[G_S2] - n[G_S4]),
-                };
-                out.copy_from_slice(&[p, n[G_S2], n[G_QXX], n[G_QXY]]);
-            }
-        });
-
-    // 4. Forces, velocities and the right-hand side.
-    let pr: &[f64] = pressure;
     let map = cells.map();
     let xi = params.xi;
-    let coef = energy.coefficients();
     // The paper's P contains cell i's own double-well term −(8γ/λ) φ_i(1−φ_i)(1−2φ_i). Its
     // contribution to F_i is the integral of a gradient, zero in the continuum, but its central
     // difference sum is not zero on the lattice and would propel isolated cells (|v| ~ 5e-4).
@@ -388,9 +353,10 @@ pub fn evaluate(
             let node = |a: usize, b: usize| (xs[a] as usize) * ly + ys[b] as usize;
             let (mut fx, mut fy) = (0.0, 0.0);
             for_each_stencil_at(cell, shape, |_, a, b, s| {
-                let n = &pr[node(a, b) * N_GATHER..][..N_GATHER];
-                let p = n[0] + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
-                let (qxx, qxy) = (n[2], n[3]);
+                let n = &g[node(a, b) * N_GLOBAL..][..N_GLOBAL];
+                let p = pressure(kind, coef.repulsion, n)
+                    + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
+                let (qxx, qxy) = (n[G_QXX], n[G_QXY]);
                 let (dx, dy) = (s.dx(), s.dy());
                 fx += p * dx + zeta * (qxx * dx + qxy * dy);
                 fy += p * dy + zeta * (qxy * dx - qxx * dy);
@@ -400,7 +366,7 @@ pub fn evaluate(
             st.velocity = [vx, vy];
             let area_factor = coef.area_factor(st.area);
             for_each_stencil_at(cell, shape, |k, a, b, s| {
-                let others = pr[node(a, b) * N_GATHER + 1] - s.c * s.c;
+                let others = g[node(a, b) * N_GLOBAL + G_S2] - s.c * s.c;
                 let dfdphi =
                     coef.ch(s.c, s.laplacian()) + area_factor * s.c + coef.rep(s.c, others);
                 out[k] = -(vx * s.dx() + vy * s.dy()) - dfdphi;
