@@ -312,6 +312,28 @@ impl Cells {
         }
     }
 
+    /// The same fields stored with another patch shape (e.g. the full domain, or another
+    /// margin), each new patch centred on `centres[i]`; values outside the old patch are zero,
+    /// values outside the new one are dropped. Allocates; meant for set-up and studies.
+    ///
+    /// # Panics
+    /// If `centres.len() != n_cells()` or `shape` was built for another lattice.
+    pub fn resampled(&self, shape: PatchShape, centres: &[[f64; 2]]) -> Self {
+        assert_eq!(centres.len(), self.n_cells);
+        let mut out = Self::zeros(self.lattice, shape, centres);
+        let (nx, ny) = (out.shape.nx, out.shape.ny);
+        for i in 0..self.n_cells {
+            for a in 0..nx {
+                let x = out.map.lat_x[i * nx + a] as usize;
+                for b in 0..ny {
+                    let y = out.map.lat_y[i * ny + b] as usize;
+                    out.phi[i * nx * ny + a * ny + b] = self.value_at(i, x, y);
+                }
+            }
+        }
+        out
+    }
+
     /// The patch origin that centres the patch on the node nearest to `centre`.
     fn origin_for(lattice: Lattice, shape: &PatchShape, centre: [f64; 2]) -> [usize; 2] {
         match shape.margin {

@@ -1,0 +1,130 @@
+//! The largest stable time step as a function of γ, κ, λ and ζ, for forward Euler and Heun
+//! (issue 4), one parameter at a time around the paper's values.
+//!
+//! `cargo bench -p monolayer-benches --bench stability` writes `docs/stability.csv` and prints
+//! a markdown table.
+//!
+//! Protocol. 60 cells in 100² (seed 1), relaxed 50 TU at ζ = 0 with dt 0.2 and margin 16. From
+//! that state a run of 200 TU at the parameters under test is *stable* when no step reports a
+//! [`mechanics::StepError`] (a non-finite value, or φ outside [−2, 3]). The largest stable dt
+//! is found by bisection between 0.05 and 8 to 3 %. The linear estimate `2 / stiffness` that the
+//! scene validator enforces is printed beside it.
+
+use std::fmt::Write as _;
+
+use mechanics::{ModelParams, StepParams, Tissue, Workspace};
+use phasefield::{init, Cells, Lattice, PatchShape};
+
+const T_RUN: f64 = 200.0;
+
+fn stable(start: &Cells, params: ModelParams, dt: f64, npc: usize) -> bool {
+    let mut t = Tissue::new(start.clone(), params);
+    let mut ws = Workspace::new(&t.cells);
+    let sp = StepParams { dt, npc };
+    let steps = (T_RUN / dt).ceil() as usize;
+    (0..steps).all(|_| t.step(&mut ws, &sp).is_ok())
+}
+
+fn largest_stable_dt(start: &Cells, params: ModelParams, npc: usize) -> f64 {
+    let (mut lo, mut hi) = (0.05, 8.0);
+    if stable(start, params, hi, npc) {
+        return hi;
+    }
+    while hi / lo > 1.03 {
+        let mid = (lo * hi).sqrt();
+        if stable(start, params, mid, npc) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+fn main() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    pool.install(study);
+}
+
+fn study() {
+    let lattice = Lattice::new(100, 100);
+    let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 1 }).unwrap();
+    let cells = init::discs(
+        lattice,
+        PatchShape::new(lattice, 16).unwrap(),
+        &centres,
+        4.0,
+        2.5,
+    );
+    let mut relax = Tissue::new(cells, ModelParams::paper(0.0));
+    let mut ws = Workspace::new(&relax.cells);
+    for _ in 0..250 {
+        relax
+            .step(&mut ws, &StepParams { dt: 0.2, npc: 1 })
+            .unwrap();
+    }
+    let start = relax.cells;
+
+    let mut cases: Vec<(String, ModelParams)> = Vec::new();
+    let base = ModelParams::paper(0.005);
+    for g in [0.005, 0.01, 0.02, 0.04, 0.08] {
+        let mut p = base;
+        p.energy.gamma = g;
+        cases.push((format!("gamma = {g}"), p));
+    }
+    for k in [0.05, 0.2, 0.4, 0.8] {
+        let mut p = base;
+        p.energy.kappa = k;
+        cases.push((format!("kappa = {k}"), p));
+    }
+    for l in [1.5, 2.0, 3.0, 4.0] {
+        let mut p = base;
+        p.energy.lambda = l;
+        cases.push((format!("lambda = {l}"), p));
+    }
+    for z in [-0.01, 0.0, 0.01, 0.02, 0.04] {
+        let mut p = base;
+        p.zeta = z;
+        cases.push((format!("zeta = {z}"), p));
+    }
+    let mut csv =
+        String::from("case,gamma,kappa,lambda,zeta,dt_max_euler,dt_max_heun,dt_linear_estimate\n");
+    let mut table = String::from("| parameters (others as the paper, ζ = 0.005) | largest stable dt, Euler | Heun | linear estimate 2/stiffness |\n|---|---|---|---|\n");
+    writeln!(
+        table,
+        "| paper (γ 0.01, κ 0.1, λ 2.5, ζ 0.005) | see rows | | {:.2} |",
+        base.max_stable_dt()
+    )
+    .unwrap();
+    for (name, p) in &cases {
+        let e = largest_stable_dt(&start, *p, 0);
+        let h = largest_stable_dt(&start, *p, 1);
+        eprintln!(
+            "{name}: Euler {e:.2}, Heun {h:.2}, estimate {:.2}",
+            p.max_stable_dt()
+        );
+        writeln!(
+            csv,
+            "{name},{},{},{},{},{e:.3},{h:.3},{:.3}",
+            p.energy.gamma,
+            p.energy.kappa,
+            p.energy.lambda,
+            p.zeta,
+            p.max_stable_dt()
+        )
+        .unwrap();
+        writeln!(
+            table,
+            "| {name} | {e:.2} | {h:.2} | {:.2} |",
+            p.max_stable_dt()
+        )
+        .unwrap();
+    }
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs");
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(format!("{dir}/stability.csv"), csv).unwrap();
+    println!("{table}");
+}

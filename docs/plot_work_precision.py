@@ -1,0 +1,41 @@
+"""Draws docs/work_precision.png from docs/work_precision.csv (written by
+`cargo bench -p monolayer-benches --bench work_precision`). Needs matplotlib."""
+import csv
+import os
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+here = os.path.dirname(os.path.abspath(__file__))
+rows = list(csv.DictReader(open(os.path.join(here, "work_precision.csv"))))
+
+fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+groups = {}
+for r in rows:
+    if r["config"].startswith("margin") and r["dt"] == "0.05":
+        key = "patch margin (Heun, dt 0.05)"
+    elif r["config"].startswith("full"):
+        key = {"0": "full domain, Euler", "1": "full domain, Heun", "2": "full domain, Heun npc 2"}[r["npc"]]
+    else:
+        key = "margin " + r["margin"] + (", Euler" if r["npc"] == "0" else ", Heun")
+    groups.setdefault(key, []).append(r)
+for ax, col, label in ((axes[0], "centre_error", "largest centre-of-mass error (nodes)"),
+                       (axes[1], "phi_error", "largest |Δφ|")):
+    for key, rs in groups.items():
+        rs = sorted(rs, key=lambda r: float(r["wall_s"]))
+        xs = [float(r["wall_s"]) for r in rs]
+        ys = [max(float(r[col]), 1e-16) for r in rs]
+        ax.loglog(xs, ys, "o-", label=key)
+        for r, x, y in zip(rs, xs, ys):
+            tag = "m" + r["margin"] if key.startswith("patch") else "dt " + r["dt"]
+            ax.annotate(tag, (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    ax.set_xlabel("wall time for 20 TU, 60 cells, 2 threads (s)")
+    ax.set_ylabel(label)
+    ax.grid(True, which="both", alpha=0.3)
+axes[0].legend(fontsize=8)
+fig.suptitle("Work against precision; reference: full domain, Heun, dt 0.01, f64")
+fig.tight_layout()
+fig.savefig(os.path.join(here, "work_precision.png"), dpi=110)
+print("wrote", os.path.join(here, "work_precision.png"))
