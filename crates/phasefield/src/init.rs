@@ -92,6 +92,19 @@ pub fn positions(
             let mut rng = ChaCha8Rng::seed_from_u64(*seed);
             let mut out: Vec<[f64; 2]> = Vec::with_capacity(n_cells);
             let min_dist = 2.0 * disc_radius;
+            // Accepted centres binned in a grid of bins at least min_dist wide: a candidate
+            // is checked against the 3 × 3 bins around it only, so placement is O(N).
+            let (bx, by) = (
+                ((lattice.lx as f64 / min_dist).floor() as usize).max(1),
+                ((lattice.ly as f64 / min_dist).floor() as usize).max(1),
+            );
+            let mut bins: Vec<Vec<usize>> = vec![Vec::new(); bx * by];
+            let bin_of = |p: [f64; 2]| -> (usize, usize) {
+                (
+                    ((p[0] / lattice.lx as f64 * bx as f64) as usize).min(bx - 1),
+                    ((p[1] / lattice.ly as f64 * by as f64) as usize).min(by - 1),
+                )
+            };
             let max_tries = 10_000 * (n_cells + 1);
             let mut tries = 0;
             while out.len() < n_cells {
@@ -107,7 +120,22 @@ pub fn positions(
                     rng.random_range(0.0..lattice.lx as f64),
                     rng.random_range(0.0..lattice.ly as f64),
                 ];
-                if out.iter().all(|q| lattice.distance(*q, p) >= min_dist) {
+                let (ix, iy) = bin_of(p);
+                let mut free = true;
+                'near: for dx in [bx - 1, 0, 1] {
+                    for dy in [by - 1, 0, 1] {
+                        let b = ((ix + dx) % bx) * by + (iy + dy) % by;
+                        if bins[b]
+                            .iter()
+                            .any(|&q| lattice.distance(out[q], p) < min_dist)
+                        {
+                            free = false;
+                            break 'near;
+                        }
+                    }
+                }
+                if free {
+                    bins[ix * by + iy].push(out.len());
                     out.push(p);
                 }
             }
