@@ -59,9 +59,66 @@ fn bench_step(c: &mut Criterion) {
     g.finish();
 }
 
+/// Cost per cell from 60 to 9600 cells at the paper's density (margin 12, 2 threads),
+/// with the cells sorted along a Morton curve (as `monolayer run` keeps them) and in their
+/// random initial order. Throughput is in cells.
+fn bench_scaling(c: &mut Criterion) {
+    let mut g = c.benchmark_group("scaling");
+    g.sample_size(10);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    for (n, l) in [
+        (60usize, 100usize),
+        (240, 200),
+        (960, 400),
+        (3840, 800),
+        (9600, 1265),
+    ] {
+        let text = std::fs::read_to_string(format!(
+            "{}/../scenes/large.toml",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap();
+        let s = Scene::parse(
+            &text,
+            &[
+                format!("cells.count={n}"),
+                format!("domain.lx={l}"),
+                format!("domain.ly={l}"),
+                "integrator.margin=12".into(),
+                "integrator.dt=0.2".into(),
+            ],
+        )
+        .unwrap();
+        let (mut t, mut ws) = pool.install(|| {
+            let mut t = s.build().unwrap();
+            let mut ws = Workspace::new(&t.cells);
+            t.params.zeta = 0.0;
+            for _ in 0..RELAX_STEPS {
+                t.step(&mut ws, &s.step_params()).unwrap();
+            }
+            t.params.zeta = 0.005;
+            (t, ws)
+        });
+        let sp = s.step_params();
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_function(BenchmarkId::new("unsorted", n), |b| {
+            pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()))
+        });
+        let mut scratch = Vec::new();
+        t.sort_cells(&mut scratch);
+        g.bench_function(BenchmarkId::new("sorted", n), |b| {
+            pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()))
+        });
+    }
+    g.finish();
+}
+
 #[allow(missing_docs)]
 mod group {
-    criterion::criterion_group!(benches, super::bench_step);
+    criterion::criterion_group!(benches, super::bench_step, super::bench_scaling);
 }
 use group::benches;
 criterion_main!(benches);

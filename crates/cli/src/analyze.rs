@@ -169,6 +169,7 @@ fn load_frame(
     let shapes: Vec<[f64; 2]> = a[7].data.chunks_exact(2).map(|s| [s[0], s[1]]).collect();
     let tissue = Tissue {
         centre: vec![[0.0; 2]; n],
+        cell_id: (0..n).collect(),
         cells,
         params: scene.model_params(zeta),
         time,

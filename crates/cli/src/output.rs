@@ -98,9 +98,14 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
     let (nx, ny) = (shape.nx, shape.ny);
     let cs = &ws.cell_state;
     let lattice = tissue.lattice();
+    // Cells are written in identity order, whatever their storage order.
+    let slots = tissue.slots();
+    let cs: Vec<_> = slots.iter().map(|&s| cs[s]).collect();
+    let centre: Vec<[f64; 2]> = slots.iter().map(|&s| tissue.centre[s]).collect();
+    let origin = &tissue.cells.map().origin;
     let mut phi = vec![0.0; n * nx * ny];
-    for (i, chunk) in phi.chunks_exact_mut(nx * ny).enumerate() {
-        tissue.cells.unrolled_into(i, chunk);
+    for (chunk, &slot) in phi.chunks_exact_mut(nx * ny).zip(&slots) {
+        tissue.cells.unrolled_into(slot, chunk);
     }
     let n64 = n as u64;
     let arrays: Vec<(&str, Vec<u8>)> = vec![
@@ -112,10 +117,7 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
             "lattice",
             npy(&[2], [lattice.lx as i64, lattice.ly as i64])?,
         ),
-        (
-            "centre",
-            npy(&[n64, 2], tissue.centre.iter().flatten().copied())?,
-        ),
+        ("centre", npy(&[n64, 2], centre.iter().flatten().copied())?),
         (
             "velocity",
             npy(&[n64, 2], cs.iter().flat_map(|c| c.velocity))?,
@@ -130,12 +132,9 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
             "origin",
             npy(
                 &[n64, 2],
-                tissue
-                    .cells
-                    .map()
-                    .origin
+                slots
                     .iter()
-                    .flat_map(|o| [o[0] as i64, o[1] as i64]),
+                    .flat_map(|&s| [origin[s][0] as i64, origin[s][1] as i64]),
             )?,
         ),
         (

@@ -207,6 +207,9 @@ pub struct Scene {
     pub run: Run,
 }
 
+/// Steps between re-sortings of the cells in memory (see `mechanics::Tissue::sort_cells`).
+pub const SORT_EVERY: u64 = 250;
+
 /// The number of steps for a duration, and the steps between outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Schedule {
@@ -292,6 +295,7 @@ impl Scene {
             active_steps: sched.active_steps,
             zeta: self.model.zeta,
             step: self.step_params(),
+            sort_every: Some(SORT_EVERY),
         }
     }
 

@@ -48,7 +48,7 @@ pub use params::{ModelParams, PressureKind, StepParams};
 pub use simulation::{run, Observer, Protocol};
 pub use tissue::{
     evaluate, pressure, CellState, Tissue, Workspace, G_QXX, G_QXY, G_S1, G_S2, G_U, N_GLOBAL,
-    PHI_BOUND,
+    PHI_BOUND, SORT_BLOCK,
 };
 
 /// Why a time step could not be taken.

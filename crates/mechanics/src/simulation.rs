@@ -17,6 +17,10 @@ pub struct Protocol {
     pub zeta: f64,
     /// The integrator.
     pub step: StepParams,
+    /// Steps between re-sortings of the cells along a space-filling curve
+    /// ([`Tissue::sort_cells`]); `None` never sorts. Cells move a fraction of a node per TU,
+    /// so every few hundred steps is plenty.
+    pub sort_every: Option<u64>,
 }
 
 impl Protocol {
@@ -70,6 +74,7 @@ pub fn run<O: Observer>(
     observer: &mut O,
 ) -> Result<(), O::Error> {
     let total = protocol.total_steps();
+    let mut scratch = Vec::new();
     tissue.params.zeta = if protocol.relax_steps > 0 {
         0.0
     } else {
@@ -85,6 +90,9 @@ pub fn run<O: Observer>(
         }
         if s == total {
             break;
+        }
+        if protocol.sort_every.is_some_and(|k| s % k == 0) {
+            tissue.sort_cells(&mut scratch);
         }
         tissue.step(ws, &protocol.step)?;
     }

@@ -312,6 +312,41 @@ impl Cells {
         }
     }
 
+    /// Reorders the cells: slot `j` receives the cell that was in slot `order[j]`. Field values
+    /// move through `scratch` (resized to the field length once, then reused), so that a
+    /// caller can reorder repeatedly without allocating the large buffer again.
+    ///
+    /// # Panics
+    /// If `order` is not a permutation of `0..n_cells()`.
+    pub fn permute(&mut self, order: &[usize], scratch: &mut Vec<f64>) {
+        let n = self.n_cells;
+        assert_eq!(order.len(), n);
+        let mut seen = vec![false; n];
+        for &o in order {
+            assert!(o < n && !seen[o], "order must be a permutation");
+            seen[o] = true;
+        }
+        let plen = self.shape.len();
+        scratch.resize(self.phi.len(), 0.0);
+        for (j, &o) in order.iter().enumerate() {
+            scratch[j * plen..(j + 1) * plen].copy_from_slice(&self.phi[o * plen..(o + 1) * plen]);
+        }
+        std::mem::swap(&mut self.phi, scratch);
+        let (nx, ny) = (self.shape.nx, self.shape.ny);
+        let m = &self.map;
+        let mut map = PatchMap {
+            origin: order.iter().map(|&o| m.origin[o]).collect(),
+            offset: order.iter().map(|&o| m.offset[o]).collect(),
+            lat_x: Vec::with_capacity(m.lat_x.len()),
+            lat_y: Vec::with_capacity(m.lat_y.len()),
+        };
+        for &o in order {
+            map.lat_x.extend_from_slice(&m.lat_x[o * nx..(o + 1) * nx]);
+            map.lat_y.extend_from_slice(&m.lat_y[o * ny..(o + 1) * ny]);
+        }
+        self.map = map;
+    }
+
     /// The same fields stored with another patch shape (e.g. the full domain, or another
     /// margin), each new patch centred on `centres[i]`; values outside the old patch are zero,
     /// values outside the new one are dropped. Allocates; meant for set-up and studies.
