@@ -325,3 +325,62 @@ fn sorting_the_cells_changes_storage_not_physics() {
         }
     }
 }
+
+/// Inside the documented stable region (|ζ| ≤ 0.02, γ ≤ 0.04, κ ≤ 0.4, λ in [1.5, 4], and dt at
+/// most the scene validator's limit 2/stiffness, which `docs/stability.csv` measures to be
+/// 1.1–1.7× below the real limit there), no step of a random confluent state fails or goes
+/// non-finite over 40 TU.
+#[test]
+fn no_step_fails_inside_the_stable_region() {
+    use mechanics::{ModelParams, StepParams};
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, TestRng, TestRunner};
+    let config = Config {
+        cases: 8,
+        ..Config::default()
+    };
+    let rng = TestRng::deterministic_rng(config.rng_algorithm);
+    let mut runner = TestRunner::new_with_rng(config, rng);
+    let strategy = (
+        0.005f64..0.04,
+        0.05f64..0.4,
+        1.5f64..4.0,
+        -0.02f64..0.02,
+        0.1f64..1.0,
+        0u64..1000,
+        0usize..2,
+    );
+    runner
+        .run(
+            &strategy,
+            |(gamma, kappa, lambda, zeta, dt_frac, seed, npc)| {
+                let (t0, _) = confluent(64, seed, 100, PressureKind::Paper);
+                let mut p = ModelParams::paper(zeta);
+                p.energy.gamma = gamma;
+                p.energy.kappa = kappa;
+                p.energy.lambda = lambda;
+                let dt = dt_frac * p.max_stable_dt();
+                let mut t = Tissue::new(t0.cells.clone(), p);
+                let mut ws = Workspace::new(&t.cells);
+                let sp = StepParams { dt, npc };
+                for _ in 0..(40.0 / dt).ceil() as usize {
+                    prop_assert!(
+                        t.step(&mut ws, &sp).is_ok(),
+                        "γ {} κ {} λ {} ζ {} dt {} npc {}",
+                        gamma,
+                        kappa,
+                        lambda,
+                        zeta,
+                        dt,
+                        npc
+                    );
+                }
+                let o = t.observe(&mut ws);
+                prop_assert!(o.v_rms.is_finite() && o.phi_min > -PHI && o.phi_max < 1.0 + PHI);
+                Ok(())
+            },
+        )
+        .unwrap();
+}
+
+const PHI: f64 = mechanics::PHI_BOUND;
