@@ -19,10 +19,9 @@ use analysis::smooth::{box_smooth, paper_box_side};
 use analysis::tracking::{TrackParams, Tracker};
 use anyhow::{bail, ensure, Context, Result};
 use mechanics::{Tissue, Workspace};
-use npyz::WriterBuilder;
 use phasefield::{Cells, Lattice, PatchShape};
 
-use crate::output::{read_npz, FRAME_FORMAT};
+use crate::output::{npy, read_npz, write_npz, FRAME_FORMAT};
 use crate::scene::Scene;
 
 /// Options of `monolayer analyze`.
@@ -368,36 +367,17 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
 
 fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {
     let side = avg.side() as u64;
-    let f = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
-    let mut zip = zip::ZipWriter::new(BufWriter::new(f));
-    let opts = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
-    let mut put = |name: &str, shape: &[u64], data: &[f64]| -> Result<()> {
-        let mut buf = Vec::new();
-        {
-            let mut w = npyz::WriteOptions::new()
-                .default_dtype()
-                .shape(shape)
-                .writer(&mut buf)
-                .begin_nd()?;
-            w.extend(data.iter().copied())?;
-            w.finish()?;
-        }
-        zip.start_file(format!("{name}.npy"), opts)?;
-        zip.write_all(&buf)?;
-        Ok(())
-    };
-    put("n_plus", &[], &[avg.n_plus as f64])?;
-    put("n_minus", &[], &[avg.n_minus as f64])?;
+    let mut arrays = vec![
+        ("n_plus".to_string(), npy(&[], [avg.n_plus as f64])?),
+        ("n_minus".to_string(), npy(&[], [avg.n_minus as f64])?),
+    ];
     for (plus, prefix) in [(true, "plus"), (false, "minus")] {
         for name in COMPONENTS {
-            put(
-                &format!("{prefix}_{name}"),
-                &[side, side],
-                &avg.average(plus, name),
-            )?;
+            arrays.push((
+                format!("{prefix}_{name}"),
+                npy(&[side, side], avg.average(plus, name))?,
+            ));
         }
     }
-    zip.finish()?.flush()?;
-    Ok(())
+    write_npz(path, arrays)
 }

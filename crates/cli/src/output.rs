@@ -69,7 +69,8 @@ impl SeriesWriter {
     }
 }
 
-fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
+/// One `.npy` array in memory.
+pub(crate) fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
     shape: &[u64],
     data: impl IntoIterator<Item = T>,
 ) -> Result<Vec<u8>> {
@@ -92,7 +93,6 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames)?;
     let path = frames.join(format!("frame_{:08}.npz", tissue.step));
-    let tmp = path.with_extension("npz.partial");
     let n = tissue.cells.n_cells();
     let shape = tissue.cells.shape();
     let (nx, ny) = (shape.nx, shape.ny);
@@ -142,6 +142,14 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
             npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?,
         ),
     ];
+    write_npz(&path, arrays)?;
+    Ok(path)
+}
+
+/// Writes named `.npy` arrays (from [`npy`]) as a deflated `.npz` archive, through a
+/// temporary name so that a reader never sees a half-written file.
+pub(crate) fn write_npz<S: AsRef<str>>(path: &Path, arrays: Vec<(S, Vec<u8>)>) -> Result<()> {
+    let tmp = path.with_extension("npz.partial");
     {
         let f = File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
         let mut zip = zip::ZipWriter::new(BufWriter::new(f));
@@ -149,13 +157,13 @@ pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBu
             .compression_method(zip::CompressionMethod::Deflated)
             .compression_level(Some(1));
         for (name, bytes) in arrays {
-            zip.start_file(format!("{name}.npy"), opts)?;
+            zip.start_file(format!("{}.npy", name.as_ref()), opts)?;
             zip.write_all(&bytes)?;
         }
         zip.finish()?.flush()?;
     }
-    std::fs::rename(&tmp, &path)?;
-    Ok(path)
+    std::fs::rename(&tmp, path)?;
+    Ok(())
 }
 
 /// An array read from an `.npz` archive: its shape and its values as `f64`.
