@@ -1,1 +1,51 @@
-//! Criterion benchmarks of monolayer live in `step.rs`; this library is empty.
+//! Shared set-up of the criterion benchmarks and studies in this package (`step.rs`,
+//! `analysis.rs`, `work_precision.rs`, `stability.rs`).
+
+use mechanics::{ModelParams, StepParams, Tissue, Workspace};
+use monolayer_cli::scene::Scene;
+use phasefield::{init, Lattice, PatchShape};
+
+/// A shipped scene (`scenes/NAME`) with `--set`-style overrides, built and relaxed for
+/// `relax_steps` steps at ζ = 0 with its own integrator, then set to activity `zeta`.
+///
+/// # Panics
+/// If the scene does not parse, validate or run.
+pub fn relaxed_scene(
+    name: &str,
+    overrides: &[String],
+    relax_steps: usize,
+    zeta: f64,
+) -> (Tissue, Workspace, Scene) {
+    let path = format!("{}/../scenes/{name}", env!("CARGO_MANIFEST_DIR"));
+    let s = Scene::parse(&std::fs::read_to_string(path).unwrap(), overrides).unwrap();
+    let mut t = s.build().unwrap();
+    let mut ws = Workspace::new(&t.cells);
+    t.params.zeta = 0.0;
+    for _ in 0..relax_steps {
+        t.step(&mut ws, &s.step_params()).unwrap();
+    }
+    t.params.zeta = zeta;
+    (t, ws, s)
+}
+
+/// The studies' starting state: 60 cells in 100² (paper parameters, seed 1) relaxed for
+/// 50 TU at ζ = 0 with dt 0.2 and the given patch margin.
+pub fn relaxed_paper_state(margin: usize) -> Tissue {
+    let lattice = Lattice::new(100, 100);
+    let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 1 }).unwrap();
+    let cells = init::discs(
+        lattice,
+        PatchShape::new(lattice, margin).unwrap(),
+        &centres,
+        4.0,
+        2.5,
+    );
+    let mut relax = Tissue::new(cells, ModelParams::paper(0.0));
+    let mut ws = Workspace::new(&relax.cells);
+    for _ in 0..250 {
+        relax
+            .step(&mut ws, &StepParams { dt: 0.2, npc: 1 })
+            .unwrap();
+    }
+    relax
+}

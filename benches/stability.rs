@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 use mechanics::{ModelParams, StepParams, Tissue, Workspace};
-use phasefield::{init, Cells, Lattice, PatchShape};
+use phasefield::Cells;
 
 const T_RUN: f64 = 200.0;
 
@@ -50,22 +50,7 @@ fn main() {
 }
 
 fn study() {
-    let lattice = Lattice::new(100, 100);
-    let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 1 }).unwrap();
-    let cells = init::discs(
-        lattice,
-        PatchShape::new(lattice, 16).unwrap(),
-        &centres,
-        4.0,
-        2.5,
-    );
-    let mut relax = Tissue::new(cells, ModelParams::paper(0.0));
-    let mut ws = Workspace::new(&relax.cells);
-    for _ in 0..250 {
-        relax
-            .step(&mut ws, &StepParams { dt: 0.2, npc: 1 })
-            .unwrap();
-    }
+    let relax = monolayer_benches::relaxed_paper_state(16);
     let start = relax.cells;
 
     let mut cases: Vec<(String, ModelParams)> = Vec::new();

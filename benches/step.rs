@@ -8,23 +8,19 @@
 
 use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
+use monolayer_benches::relaxed_scene;
 use monolayer_cli::scene::Scene;
 
 /// Relaxation before timing, in steps (20 TU): the initial discs have grown to confluence.
 const RELAX_STEPS: usize = 100;
 
 fn relaxed(scene: &str, margin: usize) -> (Tissue, Workspace, Scene) {
-    let path = format!("{}/../scenes/{scene}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(path).unwrap();
-    let s = Scene::parse(&text, &[format!("integrator.margin={margin}")]).unwrap();
-    let mut t = s.build().unwrap();
-    let mut ws = Workspace::new(&t.cells);
-    t.params.zeta = 0.0;
-    for _ in 0..RELAX_STEPS {
-        t.step(&mut ws, &s.step_params()).unwrap();
-    }
-    t.params.zeta = 0.005;
-    (t, ws, s)
+    relaxed_scene(
+        scene,
+        &[format!("integrator.margin={margin}")],
+        RELAX_STEPS,
+        0.005,
+    )
 }
 
 fn bench_step(c: &mut Criterion) {
@@ -76,32 +72,15 @@ fn bench_scaling(c: &mut Criterion) {
         (3840, 800),
         (9600, 1265),
     ] {
-        let text = std::fs::read_to_string(format!(
-            "{}/../scenes/large.toml",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .unwrap();
-        let s = Scene::parse(
-            &text,
-            &[
-                format!("cells.count={n}"),
-                format!("domain.lx={l}"),
-                format!("domain.ly={l}"),
-                "integrator.margin=12".into(),
-                "integrator.dt=0.2".into(),
-            ],
-        )
-        .unwrap();
-        let (mut t, mut ws) = pool.install(|| {
-            let mut t = s.build().unwrap();
-            let mut ws = Workspace::new(&t.cells);
-            t.params.zeta = 0.0;
-            for _ in 0..RELAX_STEPS {
-                t.step(&mut ws, &s.step_params()).unwrap();
-            }
-            t.params.zeta = 0.005;
-            (t, ws)
-        });
+        let overrides = [
+            format!("cells.count={n}"),
+            format!("domain.lx={l}"),
+            format!("domain.ly={l}"),
+            "integrator.margin=12".into(),
+            "integrator.dt=0.2".into(),
+        ];
+        let (mut t, mut ws, s) =
+            pool.install(|| relaxed_scene("large.toml", &overrides, RELAX_STEPS, 0.005));
         let sp = s.step_params();
         g.throughput(Throughput::Elements(n as u64));
         g.bench_function(BenchmarkId::new("unsorted", n), |b| {

@@ -16,9 +16,8 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use mechanics::{ModelParams, StepParams, Tissue, Workspace};
-use phasefield::{init, Cells, Lattice, PatchShape};
+use phasefield::{Cells, PatchShape};
 
-const L: usize = 100;
 const T_ACTIVE: f64 = 20.0;
 const ZETA: f64 = 0.005;
 
@@ -82,22 +81,7 @@ fn main() {
 }
 
 fn study() {
-    let lattice = Lattice::new(L, L);
-    let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 1 }).unwrap();
-    let cells = init::discs(
-        lattice,
-        PatchShape::new(lattice, 25).unwrap(),
-        &centres,
-        4.0,
-        2.5,
-    );
-    let mut relax = Tissue::new(cells, ModelParams::paper(0.0));
-    let mut ws = Workspace::new(&relax.cells);
-    for _ in 0..250 {
-        relax
-            .step(&mut ws, &StepParams { dt: 0.2, npc: 1 })
-            .unwrap();
-    }
+    let relax = monolayer_benches::relaxed_paper_state(25);
     let start = relax.cells.clone();
     let centres = relax.centre.clone();
 
