@@ -331,7 +331,7 @@ pub fn evaluate(
     let zeta = params.zeta;
 
     // 1. Per cell: area, deformation tensor, range.
-    // The Laplacians go into `rhs` as scratch; pass 4 overwrites them.
+    // The Laplacians go into `rhs` as scratch; pass 3 overwrites them.
     cell_state
         .par_iter_mut()
         .zip(phi.par_chunks(plen).zip(rhs.par_chunks_mut(plen)))
@@ -381,11 +381,12 @@ pub fn evaluate(
     let xi = params.xi;
     // The paper's P contains cell i's own double-well term −(8γ/λ) φ_i(1−φ_i)(1−2φ_i). Its
     // contribution to F_i is the integral of a gradient, zero in the continuum, but its central
-    // difference sum is not zero on the lattice and would propel isolated cells (|v| ~ 5e-4).
-    // It is removed here; the other self terms (∇²φ_i ∇φ_i and φ_i ∇φ_i) already sum to zero
-    // exactly on a periodic patch.
+    // difference sum is not zero on the lattice and would propel isolated cells (|v| ~ 2e-7
+    // off the lattice's symmetry points). It is removed here; the other self terms
+    // (∇²φ_i ∇φ_i with the patch Laplacian, and φ_i ∇φ_i) already sum to zero exactly on a
+    // periodic patch.
     let c_self = match params.pressure {
-        PressureKind::Paper => 8.0 * energy.gamma / energy.lambda,
+        PressureKind::Paper => coef.double_well,
         PressureKind::Interaction => 0.0,
     };
     rhs.par_chunks_mut(plen)
