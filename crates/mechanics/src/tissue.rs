@@ -215,6 +215,7 @@ impl Tissue {
             &self.params,
             &self.cells,
             self.cells.phi(),
+            true,
             k2,
             global,
             cell_state,
@@ -231,6 +232,7 @@ impl Tissue {
     /// [`StepError::Unstable`] if a field has left `[−PHI_BOUND, 1 + PHI_BOUND]`.
     pub fn step(&mut self, ws: &mut Workspace, step_params: &StepParams) -> Result<(), StepError> {
         let dt = step_params.dt;
+        let shapes = self.params.zeta != 0.0;
         let Workspace {
             phi_old,
             k1,
@@ -244,6 +246,7 @@ impl Tissue {
             &self.params,
             &self.cells,
             self.cells.phi(),
+            shapes,
             k1,
             global,
             cell_state,
@@ -259,6 +262,7 @@ impl Tissue {
                 &self.params,
                 &self.cells,
                 self.cells.phi(),
+                shapes,
                 k2,
                 global,
                 cell_state,
@@ -314,12 +318,45 @@ impl Tissue {
 /// to a blow-up.
 pub const PHI_BOUND: f64 = 2.0;
 
+/// Pass 1 for one cell: area, range, patch Laplacians into `lap` and, with `SHAPE`, the
+/// deformation tensor.
+#[inline(always)]
+fn cell_sums<const SHAPE: bool>(
+    cell: &[f64],
+    shape: &phasefield::PatchShape,
+    lap: &mut [f64],
+    st: &mut CellState,
+) {
+    let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for_each_stencil(cell, shape, |k, s| {
+        lap[k] = s.laplacian();
+        area += s.c * s.c;
+        if SHAPE {
+            let (dx, dy) = (s.dx(), s.dy());
+            sxx += 0.5 * (dy * dy - dx * dx);
+            sxy -= dx * dy;
+        }
+        lo = lo.min(s.c);
+        hi = hi.max(s.c);
+    });
+    st.area = area;
+    st.shape = [sxx, sxy];
+    st.phi_min = lo;
+    st.phi_max = hi;
+}
+
 /// One evaluation of the right-hand side `R(φ)` into `rhs`, with every intermediate quantity
 /// (global sums, pressure, per-cell state) left in the buffers for inspection.
+///
+/// With `shapes` false the deformation tensors are not computed (left zero), and so neither is
+/// `Q`: the step passes `shapes = (ζ ≠ 0)`, since only the active force needs them, which saves
+/// 9 % of a passive step (960 cells, 1 thread: 16.2 → 14.7 ms). Observations always compute them.
 pub fn evaluate(
     params: &ModelParams,
     cells: &Cells,
     phi: &[f64],
+    shapes: bool,
     rhs: &mut [f64],
     global: &mut [f64],
     cell_state: &mut [CellState],
@@ -336,21 +373,11 @@ pub fn evaluate(
         .par_iter_mut()
         .zip(phi.par_chunks(plen).zip(rhs.par_chunks_mut(plen)))
         .for_each(|(st, (cell, lap))| {
-            let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
-            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-            for_each_stencil(cell, shape, |k, s| {
-                lap[k] = s.laplacian();
-                let (dx, dy) = (s.dx(), s.dy());
-                area += s.c * s.c;
-                sxx += 0.5 * (dy * dy - dx * dx);
-                sxy -= dx * dy;
-                lo = lo.min(s.c);
-                hi = hi.max(s.c);
-            });
-            st.area = area;
-            st.shape = [sxx, sxy];
-            st.phi_min = lo;
-            st.phi_max = hi;
+            if shapes {
+                cell_sums::<true>(cell, shape, lap, st);
+            } else {
+                cell_sums::<false>(cell, shape, lap, st);
+            }
         });
 
     // 2. Global sums.
