@@ -75,6 +75,8 @@ fn sixty_cells_relax_at_zero_activity() {
     // Areas: within ±4 % of the mean (measured ±2.1 %), the mean within 1 of 167.3.
     assert!(end.area_min > 0.96 * end.area_mean && end.area_max < 1.04 * end.area_mean);
     assert!((end.area_mean - 167.3).abs() < 1.0, "{}", end.area_mean);
+    // Passive steps skip the deformation tensors; observations must still report them.
+    assert!(end.s_rms > 0.1, "{}", end.s_rms);
 }
 
 /// The reference's protocol (`../shared/reference/README.md`, "Agreement"): interaction
