@@ -6,13 +6,14 @@
 //! Run with `cargo bench -p monolayer-benches --bench analysis`.
 
 use analysis::correlation::Correlator;
-use analysis::crop::{CropFields, DefectAverage};
+use analysis::crop::DefectAverage;
 use analysis::defects::detect;
 use analysis::fields::vorticity;
 use analysis::smooth::box_smooth;
 use analysis::tracking::{TrackParams, Tracker};
 use criterion::{criterion_main, Criterion};
 use mechanics::{TissueFields, Workspace};
+use monolayer_cli::analyze::crop_fields;
 use monolayer_cli::scene::Scene;
 use phasefield::Lattice;
 
@@ -43,16 +44,7 @@ fn analyse(
     corr[2].add(&[&sqxx, &sqxy]);
     let found = detect(lattice, &sqxx, &sqxy);
     tracker.push(&found);
-    let cf = CropFields {
-        vx: &f.vx,
-        vy: &f.vy,
-        sigma_xx: &f.sigma_xx,
-        sigma_yy: &f.sigma_yy,
-        sigma_xy: &f.sigma_xy,
-        pressure: &f.pressure,
-        qxx: &f.qxx,
-        qxy: &f.qxy,
-    };
+    let cf = crop_fields(f);
     avg.add(lattice, &cf, &found);
     found.len()
 }

@@ -131,12 +131,7 @@ fn centre_of_mass_is_exact_on_a_wrapped_disc() {
                 let shape = PatchShape::new(lattice, margin).unwrap();
                 let cells = init::discs(lattice, shape, &[c], 6.3, 2.5);
                 let com = ComTable::new(lattice);
-                let got = com.centre_of_mass(
-                    cells.cell_phi(0),
-                    cells.shape(),
-                    cells.map().cell_x(cells.shape(), 0),
-                    cells.map().cell_y(cells.shape(), 0),
-                );
+                let got = com.cell_centre(&cells, 0);
                 for s in 0..2 {
                     // A wrapped coordinate near 0 may come back near L: compare on the circle.
                     let d = phasefield::min_image(got[s] - c[s], l as f64);
@@ -168,12 +163,7 @@ fn centre_of_mass_follows_a_disc_across_both_edges() {
             5.0,
             2.5,
         );
-        let got = com.centre_of_mass(
-            cells.cell_phi(0),
-            cells.shape(),
-            cells.map().cell_x(cells.shape(), 0),
-            cells.map().cell_y(cells.shape(), 0),
-        );
+        let got = com.cell_centre(&cells, 0);
         for s in 0..2 {
             assert!(
                 phasefield::min_image(got[s] - c[s], l as f64).abs() < 1e-12 * l as f64,

@@ -18,7 +18,7 @@ use analysis::fields::{rms, s_rms, vorticity};
 use analysis::smooth::{box_smooth, paper_box_side};
 use analysis::tracking::{TrackParams, Tracker};
 use anyhow::{bail, ensure, Context, Result};
-use mechanics::{Tissue, Workspace};
+use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
 use crate::output::{npy, read_npz, write_npz, FRAME_FORMAT};
@@ -63,6 +63,20 @@ pub struct AnalyzeInfo {
     pub defects: usize,
     /// Creation and annihilation events.
     pub events: usize,
+}
+
+/// The fields of a state that the defect-centred averages crop.
+pub fn crop_fields(f: &TissueFields) -> CropFields<'_> {
+    CropFields {
+        vx: &f.vx,
+        vy: &f.vy,
+        sigma_xx: &f.sigma_xx,
+        sigma_yy: &f.sigma_yy,
+        sigma_xy: &f.sigma_xy,
+        pressure: &f.pressure,
+        qxx: &f.qxx,
+        qxy: &f.qxy,
+    }
 }
 
 /// The frames of a run directory, in step order, and how many partial files were skipped.
@@ -302,20 +316,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
                 e.y
             )?;
         }
-        avg.add(
-            lattice,
-            &CropFields {
-                vx: &f.vx,
-                vy: &f.vy,
-                sigma_xx: &f.sigma_xx,
-                sigma_yy: &f.sigma_yy,
-                sigma_xy: &f.sigma_xy,
-                pressure: &f.pressure,
-                qxx: &f.qxx,
-                qxy: &f.qxy,
-            },
-            &found,
-        );
+        avg.add(lattice, &crop_fields(&f), &found);
         let n_plus = found.iter().filter(|d| d.charge == 0.5).count();
         let n_minus = found.iter().filter(|d| d.charge == -0.5).count();
         let s = s_rms(&shapes);

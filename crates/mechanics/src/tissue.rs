@@ -177,15 +177,10 @@ impl Tissue {
     /// Recomputes every centre of mass from the current patch values.
     fn compute_centres(&mut self, com: &ComTable) {
         let cells = &self.cells;
-        let shape = cells.shape();
-        self.centre.par_iter_mut().enumerate().for_each(|(i, c)| {
-            *c = com.centre_of_mass(
-                cells.cell_phi(i),
-                shape,
-                cells.map().cell_x(shape, i),
-                cells.map().cell_y(shape, i),
-            );
-        });
+        self.centre
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, c)| *c = com.cell_centre(cells, i));
     }
 
     /// Recomputes the centres and moves each patch onto its cell's centre.

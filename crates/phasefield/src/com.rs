@@ -39,6 +39,17 @@ impl ComTable {
         }
     }
 
+    /// The centre of mass of cell `cell_idx` of `cells`.
+    pub fn cell_centre(&self, cells: &crate::Cells, cell_idx: usize) -> [f64; 2] {
+        let shape = cells.shape();
+        self.centre_of_mass(
+            cells.cell_phi(cell_idx),
+            shape,
+            cells.map().cell_x(shape, cell_idx),
+            cells.map().cell_y(shape, cell_idx),
+        )
+    }
+
     /// The centre of mass of one cell's patch, given its values in storage order and the
     /// lattice coordinates of its storage columns and rows.
     pub fn centre_of_mass(

@@ -22,12 +22,7 @@
 //! let shape = PatchShape::new(lattice, 12).unwrap();
 //! let cells = init::discs(lattice, shape, &[[63.5, 10.0]], 6.0, 2.5);
 //! let com = ComTable::new(lattice);
-//! let c = com.centre_of_mass(
-//!     cells.cell_phi(0),
-//!     cells.shape(),
-//!     cells.map().cell_x(cells.shape(), 0),
-//!     cells.map().cell_y(cells.shape(), 0),
-//! );
+//! let c = com.cell_centre(&cells, 0);
 //! assert!((c[1] - 10.0).abs() < 1e-9);
 //! let f = EnergyParams::paper().free_energy(&cells);
 //! assert!(f.is_finite());
