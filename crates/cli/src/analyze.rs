@@ -21,7 +21,7 @@ use anyhow::{bail, ensure, Context, Result};
 use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
-use crate::output::{npy, read_npz, write_npz, FRAME_FORMAT};
+use crate::output::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
 use crate::scene::Scene;
 
 /// Options of `monolayer analyze`.
@@ -136,10 +136,10 @@ fn load_frame(
     shape: &PatchShape,
     lattice: Lattice,
 ) -> Result<(Tissue, Vec<[f64; 2]>, u64)> {
-    let a = read_npz(
+    // The format was checked when the frame was selected (`frame_time`).
+    let arrays = read_npz(
         path,
         &[
-            "format",
             "step",
             "time",
             "zeta",
@@ -155,31 +155,38 @@ fn load_frame(
             path.display()
         )
     })?;
-    let (step, time, zeta) = (a[1].data[0] as u64, a[2].data[0], a[3].data[0]);
+    let [step, time, zeta, lat, origin, phi, shape_tensor]: [Array; 7] = arrays
+        .try_into()
+        .expect("read_npz returns one array per name");
+    let (step, time, zeta) = (step.data[0] as u64, time.data[0], zeta.data[0]);
     ensure!(
-        a[4].data == [lattice.lx as f64, lattice.ly as f64],
+        lat.data == [lattice.lx as f64, lattice.ly as f64],
         "frame {} is on a {:?} lattice but scene.toml says {}×{}",
         path.display(),
-        a[4].data,
+        lat.data,
         lattice.lx,
         lattice.ly
     );
     let n = scene.cells.count;
     let want = vec![n as u64, shape.nx as u64, shape.ny as u64];
     ensure!(
-        a[6].shape == want,
+        phi.shape == want,
         "frame {}: phi has shape {:?}, the scene implies {:?}",
         path.display(),
-        a[6].shape,
+        phi.shape,
         want
     );
-    let origins: Vec<[usize; 2]> = a[5]
+    let origins: Vec<[usize; 2]> = origin
         .data
         .chunks_exact(2)
         .map(|o| [o[0] as usize, o[1] as usize])
         .collect();
-    let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &a[6].data);
-    let shapes: Vec<[f64; 2]> = a[7].data.chunks_exact(2).map(|s| [s[0], s[1]]).collect();
+    let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &phi.data);
+    let shapes: Vec<[f64; 2]> = shape_tensor
+        .data
+        .chunks_exact(2)
+        .map(|s| [s[0], s[1]])
+        .collect();
     let tissue = Tissue {
         centre: vec![[0.0; 2]; n],
         cell_id: (0..n).collect(),
