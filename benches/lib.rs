@@ -3,22 +3,23 @@
 
 use mechanics::{ModelParams, StepParams, Tissue, Workspace};
 use monolayer_cli::scene::Scene;
-use phasefield::{init, Lattice, PatchShape};
+use phasefield::{init, Lattice, PatchShape, Real};
 
 /// A shipped scene (`scenes/NAME`) with `--set`-style overrides, built and relaxed for
-/// `relax_steps` steps at ζ = 0 with its own integrator, then set to activity `zeta`.
+/// `relax_steps` steps at ζ = 0 with its own integrator, then set to activity `zeta`, with
+/// the fields stored in precision `T`.
 ///
 /// # Panics
 /// If the scene does not parse, validate or run.
-pub fn relaxed_scene(
+pub fn relaxed_scene<T: Real>(
     name: &str,
     overrides: &[String],
     relax_steps: usize,
     zeta: f64,
-) -> (Tissue, Workspace, Scene) {
+) -> (Tissue<T>, Workspace<T>, Scene) {
     let path = format!("{}/../scenes/{name}", env!("CARGO_MANIFEST_DIR"));
     let s = Scene::parse(&std::fs::read_to_string(path).unwrap(), overrides).unwrap();
-    let mut t = s.build().unwrap();
+    let mut t = s.build_in::<T>().unwrap();
     let mut ws = Workspace::new(&t.cells);
     t.params.zeta = 0.0;
     for _ in 0..relax_steps {

@@ -1,6 +1,6 @@
 //! One relaxed time step (Heun, dt = 0.2, ζ = 0.005) of the shipped scenes `paper.toml`
 //! (60 cells, 100²) and `large.toml` (960 cells, 400²), with patch margins 12 and 25, on one
-//! and two threads. Throughput is in node updates: cells × patch nodes per step (each step is
+//! and two threads, with the fields stored in `f64` and (960 cells, margin 12) in `f32`. Throughput is in node updates: cells × patch nodes per step (each step is
 //! two sweeps, predictor and corrector), the unit of `node_substeps_per_s` in
 //! `../shared/reference/celadro-performance.csv`.
 //!
@@ -8,13 +8,14 @@
 
 use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
+use phasefield::Real;
 use monolayer_benches::relaxed_scene;
 use monolayer_cli::scene::Scene;
 
 /// Relaxation before timing, in steps (20 TU): the initial discs have grown to confluence.
 const RELAX_STEPS: usize = 100;
 
-fn relaxed(scene: &str, margin: usize) -> (Tissue, Workspace, Scene) {
+fn relaxed<T: Real>(scene: &str, margin: usize) -> (Tissue<T>, Workspace<T>, Scene) {
     relaxed_scene(
         scene,
         &[format!("integrator.margin={margin}")],
@@ -32,7 +33,7 @@ fn bench_step(c: &mut Criterion) {
                 .num_threads(2)
                 .build()
                 .unwrap();
-            let (mut t, mut ws, s) = pool2.install(|| relaxed(scene, margin));
+            let (mut t, mut ws, s) = pool2.install(|| relaxed::<f64>(scene, margin));
             let sp = s.step_params();
             g.throughput(Throughput::Elements(
                 (t.cells.n_cells() * t.cells.patch_len()) as u64,
@@ -52,12 +53,32 @@ fn bench_step(c: &mut Criterion) {
             }
         }
     }
+    // Single-precision storage of the large scene.
+    let pool2 = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let (mut t, mut ws, s) = pool2.install(|| relaxed::<f32>("large.toml", 12));
+    let sp = s.step_params();
+    g.throughput(Throughput::Elements(
+        (t.cells.n_cells() * t.cells.patch_len()) as u64,
+    ));
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let id = BenchmarkId::new("large-m12-f32", format!("threads={threads}"));
+        g.bench_function(id, |b| {
+            pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
+        });
+    }
     g.finish();
 }
 
 /// Cost per cell from 60 to 9600 cells at the paper's density (margin 12, 2 threads),
 /// with the cells sorted along a Morton curve (as `monolayer run` keeps them) and in their
-/// random initial order. Throughput is in cells.
+/// random initial order, and sorted with the fields stored in `f32`. Throughput is in cells.
 fn bench_scaling(c: &mut Criterion) {
     let mut g = c.benchmark_group("scaling");
     g.sample_size(10);
@@ -80,7 +101,7 @@ fn bench_scaling(c: &mut Criterion) {
             "integrator.dt=0.2".into(),
         ];
         let (mut t, mut ws, s) =
-            pool.install(|| relaxed_scene("large.toml", &overrides, RELAX_STEPS, 0.005));
+            pool.install(|| relaxed_scene::<f64>("large.toml", &overrides, RELAX_STEPS, 0.005));
         let sp = s.step_params();
         g.throughput(Throughput::Elements(n as u64));
         g.bench_function(BenchmarkId::new("unsorted", n), |b| {
@@ -89,6 +110,12 @@ fn bench_scaling(c: &mut Criterion) {
         let mut scratch = Vec::new();
         t.sort_cells(&mut scratch);
         g.bench_function(BenchmarkId::new("sorted", n), |b| {
+            pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()))
+        });
+        let (mut t, mut ws, _) =
+            pool.install(|| relaxed_scene::<f32>("large.toml", &overrides, RELAX_STEPS, 0.005));
+        t.sort_cells(&mut Vec::new());
+        g.bench_function(BenchmarkId::new("sorted-f32", n), |b| {
             pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()))
         });
     }

@@ -2,6 +2,7 @@
 
 use mechanics::{Observables, Observer, StepError, Tissue, Workspace};
 use monolayer_cli::scene::Scene;
+use phasefield::Real;
 
 fn paper_scene(overrides: &[&str]) -> Scene {
     let text =
@@ -24,7 +25,12 @@ impl Observer for Sampler {
     fn wants(&self, step: u64, _total: u64) -> bool {
         step.is_multiple_of(self.every)
     }
-    fn observe(&mut self, t: &Tissue, _: &Workspace, o: &Observables) -> Result<(), StepError> {
+    fn observe<T: Real>(
+        &mut self,
+        t: &Tissue<T>,
+        _: &Workspace<T>,
+        o: &Observables,
+    ) -> Result<(), StepError> {
         self.samples.push((t.time, *o));
         Ok(())
     }

@@ -23,6 +23,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use mechanics::{Observables, Tissue, Workspace};
 use npyz::WriterBuilder;
+use phasefield::Real;
 
 /// Version of the frame layout; `monolayer analyze` refuses frames of another version.
 pub const FRAME_FORMAT: i64 = 1;
@@ -48,7 +49,7 @@ impl SeriesWriter {
     }
 
     /// Appends one row.
-    pub fn row(&mut self, tissue: &Tissue, o: &Observables) -> Result<()> {
+    pub fn row<T: Real>(&mut self, tissue: &Tissue<T>, o: &Observables) -> Result<()> {
         writeln!(
             self.out,
             "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}",
@@ -89,7 +90,11 @@ pub(crate) fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
 
 /// Writes one frame (see the module docs); `ws` must hold the derived quantities of the
 /// current state (call [`Tissue::observe`] or [`Tissue::refresh`] first).
-pub fn write_frame(dir: &Path, tissue: &Tissue, ws: &Workspace) -> Result<PathBuf> {
+pub fn write_frame<T: Real>(
+    dir: &Path,
+    tissue: &Tissue<T>,
+    ws: &Workspace<T>,
+) -> Result<PathBuf> {
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames)?;
     let path = frames.join(format!("frame_{:08}.npz", tissue.step));

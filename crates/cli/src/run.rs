@@ -8,9 +8,10 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mechanics::{Observables, Observer, Tissue, Workspace};
+use phasefield::Real;
 
 use crate::output::{write_frame, SeriesWriter};
-use crate::scene::Scene;
+use crate::scene::{Precision, Scene};
 
 /// What a finished run reports.
 #[derive(Debug, Clone, Copy)]
@@ -54,7 +55,14 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
     std::fs::write(out.join("scene.toml"), scene.to_toml())?;
-    let mut tissue: Tissue = scene.build()?;
+    match scene.integrator.precision {
+        Precision::F64 => run_in::<f64>(scene, out, quiet),
+        Precision::F32 => run_in::<f32>(scene, out, quiet),
+    }
+}
+
+fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
+    let mut tissue: Tissue<T> = scene.build_in()?;
     let mut ws = Workspace::new(&tissue.cells);
     let protocol = scene.protocol();
     let sched = scene.schedule();
@@ -108,7 +116,12 @@ impl Observer for Writer<'_> {
         self.wants_frame(step, total) || self.wants_series(step, total)
     }
 
-    fn observe(&mut self, tissue: &Tissue, ws: &Workspace, o: &Observables) -> Result<()> {
+    fn observe<T: Real>(
+        &mut self,
+        tissue: &Tissue<T>,
+        ws: &Workspace<T>,
+        o: &Observables,
+    ) -> Result<()> {
         let total = self.progress.total;
         if self.wants_series(tissue.step, total) {
             self.series.row(tissue, o)?;

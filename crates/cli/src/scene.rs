@@ -5,7 +5,7 @@
 //! fix of the first problem; [`Scene::build`] turns a valid scene into library objects.
 
 use mechanics::{ModelParams, PressureKind, Protocol, StepParams, Tissue};
-use phasefield::{init, EnergyParams, Lattice, PatchShape};
+use phasefield::{init, EnergyParams, Lattice, PatchShape, Real};
 use serde::{Deserialize, Serialize};
 
 /// A problem with a scene, naming the key and the fix.
@@ -147,6 +147,21 @@ pub struct Integrator {
     /// Patch margin m (patch side 2m+1; default 16, the paper's 12); 0 stores every cell on
     /// the full domain.
     pub margin: usize,
+    /// Storage precision of the fields, `"f64"` (default) or `"f32"`. Arithmetic is always
+    /// `f64`; `"f32"` rounds each stored value, which halves the memory the step moves. Its
+    /// error is in the work–precision study (`docs/performance.md`).
+    pub precision: Precision,
+}
+
+/// Storage precision of the phase fields (`[integrator] precision`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// Double precision (the reference).
+    #[default]
+    F64,
+    /// Single-precision storage, double-precision arithmetic.
+    F32,
 }
 
 impl Default for Integrator {
@@ -155,6 +170,7 @@ impl Default for Integrator {
             dt: 0.5,
             npc: 1,
             margin: 16,
+            precision: Precision::F64,
         }
     }
 }
@@ -516,11 +532,21 @@ impl Scene {
         }
     }
 
-    /// Builds the initial tissue (at ζ = 0 when there is a relaxation phase).
+    /// Builds the initial tissue (at ζ = 0 when there is a relaxation phase), stored in
+    /// `f64` whatever the scene's precision (see [`Scene::build_in`]).
     ///
     /// # Errors
     /// As [`Scene::validate`].
     pub fn build(&self) -> Result<Tissue, SceneError> {
+        self.build_in::<f64>()
+    }
+
+    /// Builds the initial tissue with its fields stored in precision `T`. The initial discs
+    /// are computed in `f64` and rounded once.
+    ///
+    /// # Errors
+    /// As [`Scene::validate`].
+    pub fn build_in<T: Real>(&self) -> Result<Tissue<T>, SceneError> {
         self.validate()?;
         let lattice = Lattice::new(self.domain.lx, self.domain.ly);
         let shape = PatchShape::new(lattice, self.integrator.margin).expect("validated");
@@ -533,7 +559,10 @@ impl Scene {
         } else {
             self.model.zeta
         };
-        Ok(Tissue::new(cells, self.model_params(zeta)))
+        Ok(Tissue::new(
+            cells.to_precision::<T>(),
+            self.model_params(zeta),
+        ))
     }
 }
 

@@ -2,6 +2,8 @@
 //! the tissue velocity `v = Σ_i φ_i v_i`, the nematic field `Q = Σ_i φ_i S_i`, the pressure
 //! `P` and the stress `σ = −P𝕀 − ζQ`.
 
+use phasefield::Real;
+
 use crate::scatter::scatter;
 use crate::tissue::{pressure, Tissue, Workspace, G_QXX, G_QXY, N_GLOBAL};
 
@@ -26,19 +28,19 @@ pub struct TissueFields {
     pub sigma_xy: Vec<f64>,
 }
 
-impl Tissue {
+impl<T: Real> Tissue<T> {
     /// Scatters the tissue velocity `Σ_i φ_i v_i` into `ws.field2` (`[vx, vy]` per node), from
     /// the velocities of the last evaluation.
-    pub(crate) fn scatter_velocity(&self, ws: &mut Workspace) {
+    pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
         let cs = &ws.cell_state;
-        scatter::<2, _>(&self.cells, self.cells.phi(), &mut ws.field2, |i, _, p| {
+        scatter::<2, T, _>(&self.cells, self.cells.phi(), &mut ws.field2, |i, _, p| {
             [p * cs[i].velocity[0], p * cs[i].velocity[1]]
         });
     }
 
     /// Evaluates the state and returns its lattice fields. Allocates the result; meant for
     /// output steps, not for the time step.
-    pub fn fields(&mut self, ws: &mut Workspace) -> TissueFields {
+    pub fn fields(&mut self, ws: &mut Workspace<T>) -> TissueFields {
         self.refresh(ws);
         self.scatter_velocity(ws);
         let n = self.lattice().len();

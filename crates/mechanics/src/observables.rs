@@ -1,5 +1,7 @@
 //! Scalar observables of a state (MODEL.md §7) and the lattice fields they are built from.
 
+use phasefield::Real;
+
 use crate::tissue::{Tissue, Workspace};
 
 /// Scalar summary of one state, computed on output steps only.
@@ -23,10 +25,10 @@ pub struct Observables {
     pub phi_max: f64,
 }
 
-impl Tissue {
+impl<T: Real> Tissue<T> {
     /// Refreshes the derived quantities into `ws` and computes the observables of the current
     /// state. Leaves the tissue velocity field `Σ φ_i v_i` in `ws.field2` (`[vx, vy]` per node).
-    pub fn observe(&mut self, ws: &mut Workspace) -> Observables {
+    pub fn observe(&mut self, ws: &mut Workspace<T>) -> Observables {
         self.refresh(ws);
         self.scatter_velocity(ws);
         let Workspace {

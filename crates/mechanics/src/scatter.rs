@@ -5,19 +5,23 @@
 //! columns that fall inside it. Every lattice node therefore receives its contributions in cell
 //! order, whatever the number of threads: results are bit-for-bit reproducible.
 
-use phasefield::{Cells, Lattice};
+use phasefield::{Cells, Lattice, Real};
 use rayon::prelude::*;
 
 /// Lattice x-rows per scatter stripe (fixed, so that the result never depends on threads).
 pub const STRIPE_ROWS: usize = 8;
 
-/// Adds `value(cell_idx, k, φ)` (K components) of every patch node `k` of every cell to the
+/// Adds `value(cell_idx, k, φ)` (K components, with `φ` widened to `f64`) of every patch node `k` of every cell to the
 /// lattice field `out`, laid out as `out[node * K + component]`. `out` is zeroed first.
 ///
 /// # Panics
 /// If `out.len() != lattice.len() * K`.
-pub fn scatter<const K: usize, F>(cells: &Cells, phi: &[f64], out: &mut [f64], value: F)
-where
+pub fn scatter<const K: usize, T: Real, F>(
+    cells: &Cells<T>,
+    phi: &[T],
+    out: &mut [f64],
+    value: F,
+) where
     F: Fn(usize, usize, f64) -> [f64; K] + Sync,
 {
     let lattice: Lattice = cells.lattice();
@@ -49,7 +53,7 @@ where
                     let base = (x - x0) * ly;
                     for b in 0..ny {
                         let k = a * ny + b;
-                        let v = value(i, k, cell[k]);
+                        let v = value(i, k, cell[k].to_f64());
                         let node = &mut chunk[(base + ys[b] as usize) * K..][..K];
                         for c in 0..K {
                             node[c] += v[c];

@@ -1,6 +1,8 @@
 //! The driver of a whole run: relaxation at ζ = 0, then activity, with an observer called on
 //! the steps it asks for (after Oceananigans' `Simulation` and ripgrep's `Sink`).
 
+use phasefield::Real;
+
 use crate::observables::Observables;
 use crate::params::StepParams;
 use crate::tissue::{Tissue, Workspace};
@@ -42,10 +44,10 @@ pub trait Observer {
     ///
     /// # Errors
     /// Whatever stops the run (e.g. a failed write).
-    fn observe(
+    fn observe<T: Real>(
         &mut self,
-        tissue: &Tissue,
-        ws: &Workspace,
+        tissue: &Tissue<T>,
+        ws: &Workspace<T>,
         obs: &Observables,
     ) -> Result<(), Self::Error>;
 }
@@ -56,7 +58,12 @@ impl Observer for () {
     fn wants(&self, _: u64, _: u64) -> bool {
         false
     }
-    fn observe(&mut self, _: &Tissue, _: &Workspace, _: &Observables) -> Result<(), StepError> {
+    fn observe<T: Real>(
+        &mut self,
+        _: &Tissue<T>,
+        _: &Workspace<T>,
+        _: &Observables,
+    ) -> Result<(), StepError> {
         Ok(())
     }
 }
@@ -67,9 +74,9 @@ impl Observer for () {
 ///
 /// # Errors
 /// The first step error or observer error; the tissue is left at the last good state.
-pub fn run<O: Observer>(
-    tissue: &mut Tissue,
-    ws: &mut Workspace,
+pub fn run<T: Real, O: Observer>(
+    tissue: &mut Tissue<T>,
+    ws: &mut Workspace<T>,
     protocol: &Protocol,
     observer: &mut O,
 ) -> Result<(), O::Error> {

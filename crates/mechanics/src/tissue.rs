@@ -8,7 +8,7 @@
 //!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
-use phasefield::{for_each_stencil, for_each_stencil_at, Cells, ComTable, Lattice};
+use phasefield::{for_each_stencil, for_each_stencil_at, Cells, ComTable, Lattice, Real};
 use rayon::prelude::*;
 
 use crate::params::{ModelParams, PressureKind, StepParams};
@@ -67,10 +67,13 @@ pub struct CellState {
 }
 
 /// A monolayer: the fields of all cells, the parameters and the clock.
+///
+/// The fields are stored in precision `T` (`f64`, the default, or `f32`; see
+/// [`phasefield::Real`]); all arithmetic is done in `f64`.
 #[derive(Debug, Clone)]
-pub struct Tissue {
+pub struct Tissue<T: Real = f64> {
     /// The phase fields.
-    pub cells: Cells,
+    pub cells: Cells<T>,
     /// The model parameters (ζ may be changed between steps, e.g. after relaxation).
     pub params: ModelParams,
     /// Model time.
@@ -86,10 +89,10 @@ pub struct Tissue {
 
 /// Scratch memory for [`Tissue::step`]: built once, reused, never serialised.
 #[derive(Debug, Clone)]
-pub struct Workspace {
-    phi_old: Vec<f64>,
-    k1: Vec<f64>,
-    k2: Vec<f64>,
+pub struct Workspace<T: Real = f64> {
+    phi_old: Vec<T>,
+    k1: Vec<T>,
+    k2: Vec<T>,
     /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices).
     pub global: Vec<f64>,
     /// Per-cell derived quantities of the last evaluation.
@@ -99,15 +102,15 @@ pub struct Workspace {
     com: ComTable,
 }
 
-impl Workspace {
+impl<T: Real> Workspace<T> {
     /// Scratch memory for a tissue of this size.
-    pub fn new(cells: &Cells) -> Self {
+    pub fn new(cells: &Cells<T>) -> Self {
         let n = cells.n_cells() * cells.patch_len();
         let lattice = cells.lattice();
         Self {
-            phi_old: vec![0.0; n],
-            k1: vec![0.0; n],
-            k2: vec![0.0; n],
+            phi_old: vec![T::default(); n],
+            k1: vec![T::default(); n],
+            k2: vec![T::default(); n],
             global: vec![0.0; lattice.len() * N_GLOBAL],
             cell_state: vec![CellState::default(); cells.n_cells()],
             field2: vec![0.0; lattice.len() * 2],
@@ -116,9 +119,9 @@ impl Workspace {
     }
 }
 
-impl Tissue {
+impl<T: Real> Tissue<T> {
     /// A tissue from initial fields; centres of mass are computed and patches centred on them.
-    pub fn new(cells: Cells, params: ModelParams) -> Self {
+    pub fn new(cells: Cells<T>, params: ModelParams) -> Self {
         let mut t = Self {
             centre: vec![[0.0; 2]; cells.n_cells()],
             cell_id: (0..cells.n_cells()).collect(),
@@ -142,7 +145,7 @@ impl Tissue {
     /// other on the lattice and the lattice-wide fields they touch stay in cache. The physics
     /// does not change; sums over cells run in another order, which changes results at the
     /// level of round-off. `scratch` carries the field values (see [`Cells::permute`]).
-    pub fn sort_cells(&mut self, scratch: &mut Vec<f64>) {
+    pub fn sort_cells(&mut self, scratch: &mut Vec<T>) {
         let key = |c: [f64; 2]| -> u64 {
             let (x, y) = ((c[0] / SORT_BLOCK) as u64, (c[1] / SORT_BLOCK) as u64);
             let spread = |mut v: u64| {
@@ -198,7 +201,7 @@ impl Tissue {
     /// After a step, [`Tissue::centre`] holds the centres that placed the patches; when a patch
     /// has just moved, the row or column that wrapped around carries far-edge values (MODEL.md
     /// §5), so the centre of the stored values can differ from it by the neglected tail.
-    pub fn refresh(&mut self, ws: &mut Workspace) {
+    pub fn refresh(&mut self, ws: &mut Workspace<T>) {
         self.compute_centres(&ws.com);
         let Workspace {
             k2,
@@ -225,7 +228,11 @@ impl Tissue {
     /// # Errors
     /// [`StepError::NonFinite`] if a cell's area or force is not finite, and
     /// [`StepError::Unstable`] if a field has left `[−PHI_BOUND, 1 + PHI_BOUND]`.
-    pub fn step(&mut self, ws: &mut Workspace, step_params: &StepParams) -> Result<(), StepError> {
+    pub fn step(
+        &mut self,
+        ws: &mut Workspace<T>,
+        step_params: &StepParams,
+    ) -> Result<(), StepError> {
         let dt = step_params.dt;
         let shapes = self.params.zeta != 0.0;
         let Workspace {
@@ -251,7 +258,7 @@ impl Tissue {
         phi_old.copy_from_slice(phi);
         phi.par_iter_mut()
             .zip(phi_old.par_iter().zip(k1.par_iter()))
-            .for_each(|(p, (o, r))| *p = o + dt * r);
+            .for_each(|(p, (o, r))| *p = T::from_f64(o.to_f64() + dt * r.to_f64()));
         for _ in 0..step_params.npc {
             evaluate(
                 &self.params,
@@ -266,7 +273,9 @@ impl Tissue {
             phi.par_iter_mut()
                 .zip(phi_old.par_iter())
                 .zip(k1.par_iter().zip(k2.par_iter()))
-                .for_each(|((p, o), (r1, r2))| *p = o + 0.5 * dt * (r1 + r2));
+                .for_each(|((p, o), (r1, r2))| {
+                    *p = T::from_f64(o.to_f64() + 0.5 * dt * (r1.to_f64() + r2.to_f64()))
+                });
         }
         self.step += 1;
         self.time += dt;
@@ -316,16 +325,16 @@ pub const PHI_BOUND: f64 = 2.0;
 /// Pass 1 for one cell: area, range, patch Laplacians into `lap` and, with `SHAPE`, the
 /// deformation tensor.
 #[inline(always)]
-fn cell_sums<const SHAPE: bool>(
-    cell: &[f64],
+fn cell_sums<T: Real, const SHAPE: bool>(
+    cell: &[T],
     shape: &phasefield::PatchShape,
-    lap: &mut [f64],
+    lap: &mut [T],
     st: &mut CellState,
 ) {
     let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for_each_stencil(cell, shape, |k, s| {
-        lap[k] = s.laplacian();
+        lap[k] = T::from_f64(s.laplacian());
         area += s.c * s.c;
         if SHAPE {
             let (dx, dy) = (s.dx(), s.dy());
@@ -347,12 +356,12 @@ fn cell_sums<const SHAPE: bool>(
 /// With `shapes` false the deformation tensors are not computed (left zero), and so neither is
 /// `Q`: the step passes `shapes = (ζ ≠ 0)`, since only the active force needs them, which saves
 /// 9 % of a passive step (960 cells, 1 thread: 16.2 → 14.7 ms). Observations always compute them.
-pub fn evaluate(
+pub fn evaluate<T: Real>(
     params: &ModelParams,
-    cells: &Cells,
-    phi: &[f64],
+    cells: &Cells<T>,
+    phi: &[T],
     shapes: bool,
-    rhs: &mut [f64],
+    rhs: &mut [T],
     global: &mut [f64],
     cell_state: &mut [CellState],
 ) {
@@ -369,9 +378,9 @@ pub fn evaluate(
         .zip(phi.par_chunks(plen).zip(rhs.par_chunks_mut(plen)))
         .for_each(|(st, (cell, lap))| {
             if shapes {
-                cell_sums::<true>(cell, shape, lap, st);
+                cell_sums::<T, true>(cell, shape, lap, st);
             } else {
-                cell_sums::<false>(cell, shape, lap, st);
+                cell_sums::<T, false>(cell, shape, lap, st);
             }
         });
 
@@ -380,14 +389,14 @@ pub fn evaluate(
     let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
-        let lap: &[f64] = rhs;
-        scatter::<N_GLOBAL, _>(cells, phi, global, |i, k, p| {
+        let lap: &[T] = rhs;
+        scatter::<N_GLOBAL, T, _>(cells, phi, global, |i, k, p| {
             let c = &cs[i];
             let p2 = p * p;
             let u = match kind {
                 PressureKind::Paper => {
                     -coef.repulsion * p2 * p - coef.double_well * p * (1.0 - p) * (1.0 - 2.0 * p)
-                        + coef.gradient * lap[i * plen + k]
+                        + coef.gradient * lap[i * plen + k].to_f64()
                         - coef.area_factor(c.area) * p
                 }
                 PressureKind::Interaction => -coef.repulsion * p2 * p2,
@@ -437,7 +446,7 @@ pub fn evaluate(
                 let others = g[node(a, b) * N_GLOBAL + G_S2] - s.c * s.c;
                 let dfdphi =
                     coef.ch(s.c, s.laplacian()) + area_factor * s.c + coef.rep(s.c, others);
-                out[k] = -(vx * s.dx() + vy * s.dy()) - dfdphi;
+                out[k] = T::from_f64(-(vx * s.dx() + vy * s.dy()) - dfdphi);
             });
         });
 }

@@ -40,7 +40,7 @@ impl ComTable {
     }
 
     /// The centre of mass of cell `cell_idx` of `cells`.
-    pub fn cell_centre(&self, cells: &crate::Cells, cell_idx: usize) -> [f64; 2] {
+    pub fn cell_centre<T: crate::Real>(&self, cells: &crate::Cells<T>, cell_idx: usize) -> [f64; 2] {
         let shape = cells.shape();
         self.centre_of_mass(
             cells.cell_phi(cell_idx),
@@ -52,9 +52,9 @@ impl ComTable {
 
     /// The centre of mass of one cell's patch, given its values in storage order and the
     /// lattice coordinates of its storage columns and rows.
-    pub fn centre_of_mass(
+    pub fn centre_of_mass<T: crate::Real>(
         &self,
-        phi: &[f64],
+        phi: &[T],
         shape: &PatchShape,
         xs: &[u32],
         ys: &[u32],
@@ -65,7 +65,7 @@ impl ComTable {
             let row = &phi[a * ny..(a + 1) * ny];
             let mut col = 0.0;
             for (b, &y) in ys.iter().enumerate() {
-                let p = row[b];
+                let p = row[b].to_f64();
                 col += p;
                 yr += p * self.cos_y[y as usize];
                 yi += p * self.sin_y[y as usize];

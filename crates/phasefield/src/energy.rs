@@ -82,7 +82,7 @@ impl EnergyParams {
 
     /// The discrete free energy of a state (see the module docs). Allocates two lattice-sized
     /// fields; meant for tests and diagnostics, not for the time step.
-    pub fn free_energy(&self, cells: &Cells) -> f64 {
+    pub fn free_energy<T: crate::Real>(&self, cells: &Cells<T>) -> f64 {
         let lattice: Lattice = cells.lattice();
         let mut s2 = vec![0.0; lattice.len()];
         let mut s4 = vec![0.0; lattice.len()];

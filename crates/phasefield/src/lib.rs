@@ -8,7 +8,7 @@
 //! - [`Lattice`]: the periodic `lx × ly` lattice; node `(x, y)` has index `x * ly + y`.
 //! - [`PatchShape`] and [`Cells`]: every cell's field `φ_i` on a periodic patch of side
 //!   `2m + 1` that follows its centre of mass (or on the whole lattice, the full-domain
-//!   reference), all cells in one contiguous buffer.
+//!   reference), all cells in one contiguous buffer, stored as `f64` or `f32` ([`Real`]).
 //! - [`EnergyParams`]: the free energy and its three functional derivatives.
 //! - [`ComTable`]: centre of mass by Fourier phase.
 //! - [`init`]: random, hexagonal or given initial positions, and tanh discs.
@@ -34,11 +34,13 @@ mod energy;
 pub mod init;
 mod lattice;
 mod patch;
+mod real;
 
 pub use com::ComTable;
 pub use energy::{EnergyCoefficients, EnergyParams};
 pub use lattice::{min_image, wrap_real, Lattice};
 pub use patch::{for_each_stencil, for_each_stencil_at, Cells, PatchMap, PatchShape, Stencil};
+pub use real::Real;
 
 /// Errors from building lattices, patches and initial states.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -14,6 +14,7 @@
 //! All cells' values are one contiguous `Vec<f64>` with stride `patch_len`; within a patch the
 //! storage index is `a * ny + b` (x slow, y contiguous, as on the [`Lattice`]).
 
+use crate::real::Real;
 use crate::lattice::Lattice;
 use crate::PhaseFieldError;
 
@@ -121,7 +122,11 @@ impl Stencil {
 /// # Panics
 /// If `phi.len() != shape.len()`.
 #[inline(always)]
-pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShape, mut f: F) {
+pub fn for_each_stencil<T: Real, F: FnMut(usize, Stencil)>(
+    phi: &[T],
+    shape: &PatchShape,
+    mut f: F,
+) {
     for_each_stencil_at(phi, shape, |k, _, _, s| f(k, s));
 }
 
@@ -132,8 +137,8 @@ pub fn for_each_stencil<F: FnMut(usize, Stencil)>(phi: &[f64], shape: &PatchShap
 /// # Panics
 /// If `phi.len() != shape.len()`.
 #[inline(always)]
-pub fn for_each_stencil_at<F: FnMut(usize, usize, usize, Stencil)>(
-    phi: &[f64],
+pub fn for_each_stencil_at<T: Real, F: FnMut(usize, usize, usize, Stencil)>(
+    phi: &[T],
     shape: &PatchShape,
     mut f: F,
 ) {
@@ -150,11 +155,11 @@ pub fn for_each_stencil_at<F: FnMut(usize, usize, usize, Stencil)>(
                 a,
                 0,
                 Stencil {
-                    c: row[0],
-                    xm: row_m[0],
-                    xp: row_p[0],
-                    ym: row[0],
-                    yp: row[0],
+                    c: row[0].to_f64(),
+                    xm: row_m[0].to_f64(),
+                    xp: row_p[0].to_f64(),
+                    ym: row[0].to_f64(),
+                    yp: row[0].to_f64(),
                 },
             );
             continue;
@@ -164,11 +169,11 @@ pub fn for_each_stencil_at<F: FnMut(usize, usize, usize, Stencil)>(
             a,
             0,
             Stencil {
-                c: row[0],
-                xm: row_m[0],
-                xp: row_p[0],
-                ym: row[ny - 1],
-                yp: row[1],
+                c: row[0].to_f64(),
+                xm: row_m[0].to_f64(),
+                xp: row_p[0].to_f64(),
+                ym: row[ny - 1].to_f64(),
+                yp: row[1].to_f64(),
             },
         );
         for b in 1..ny - 1 {
@@ -177,11 +182,11 @@ pub fn for_each_stencil_at<F: FnMut(usize, usize, usize, Stencil)>(
                 a,
                 b,
                 Stencil {
-                    c: row[b],
-                    xm: row_m[b],
-                    xp: row_p[b],
-                    ym: row[b - 1],
-                    yp: row[b + 1],
+                    c: row[b].to_f64(),
+                    xm: row_m[b].to_f64(),
+                    xp: row_p[b].to_f64(),
+                    ym: row[b - 1].to_f64(),
+                    yp: row[b + 1].to_f64(),
                 },
             );
         }
@@ -190,11 +195,11 @@ pub fn for_each_stencil_at<F: FnMut(usize, usize, usize, Stencil)>(
             a,
             ny - 1,
             Stencil {
-                c: row[ny - 1],
-                xm: row_m[ny - 1],
-                xp: row_p[ny - 1],
-                ym: row[ny - 2],
-                yp: row[0],
+                c: row[ny - 1].to_f64(),
+                xm: row_m[ny - 1].to_f64(),
+                xp: row_p[ny - 1].to_f64(),
+                ym: row[ny - 2].to_f64(),
+                yp: row[0].to_f64(),
             },
         );
     }
@@ -243,20 +248,27 @@ impl PatchMap {
 
 /// The phase fields of all cells, in structure-of-arrays layout.
 #[derive(Debug, Clone)]
-pub struct Cells {
+pub struct Cells<T: Real = f64> {
     lattice: Lattice,
     shape: PatchShape,
     n_cells: usize,
-    phi: Vec<f64>,
+    phi: Vec<T>,
     map: PatchMap,
 }
 
-impl Cells {
+impl Cells<f64> {
     /// `n_cells` cells with all-zero fields, each patch centred on `centres[i]`.
     ///
     /// # Panics
     /// If `centres.len() != n_cells`.
     pub fn zeros(lattice: Lattice, shape: PatchShape, centres: &[[f64; 2]]) -> Self {
+        Self::blank(lattice, shape, centres)
+    }
+}
+
+impl<T: Real> Cells<T> {
+    /// All-zero fields in this precision, each patch centred on `centres[i]`.
+    fn blank(lattice: Lattice, shape: PatchShape, centres: &[[f64; 2]]) -> Self {
         let n_cells = centres.len();
         let mut map = PatchMap {
             origin: vec![[0, 0]; n_cells],
@@ -270,7 +282,7 @@ impl Cells {
         }
         Self {
             lattice,
-            phi: vec![0.0; n_cells * shape.len()],
+            phi: vec![T::default(); n_cells * shape.len()],
             shape,
             n_cells,
             map,
@@ -305,7 +317,7 @@ impl Cells {
         }
         Self {
             lattice,
-            phi: values.to_vec(),
+            phi: values.iter().map(|&v| T::from_f64(v)).collect(),
             shape,
             n_cells,
             map,
@@ -318,7 +330,7 @@ impl Cells {
     ///
     /// # Panics
     /// If `order` is not a permutation of `0..n_cells()`.
-    pub fn permute(&mut self, order: &[usize], scratch: &mut Vec<f64>) {
+    pub fn permute(&mut self, order: &[usize], scratch: &mut Vec<T>) {
         let n = self.n_cells;
         assert_eq!(order.len(), n);
         let mut seen = vec![false; n];
@@ -327,7 +339,7 @@ impl Cells {
             seen[o] = true;
         }
         let plen = self.shape.len();
-        scratch.resize(self.phi.len(), 0.0);
+        scratch.resize(self.phi.len(), T::default());
         for (j, &o) in order.iter().enumerate() {
             scratch[j * plen..(j + 1) * plen].copy_from_slice(&self.phi[o * plen..(o + 1) * plen]);
         }
@@ -355,14 +367,14 @@ impl Cells {
     /// If `centres.len() != n_cells()` or `shape` was built for another lattice.
     pub fn resampled(&self, shape: PatchShape, centres: &[[f64; 2]]) -> Self {
         assert_eq!(centres.len(), self.n_cells);
-        let mut out = Self::zeros(self.lattice, shape, centres);
+        let mut out = Self::blank(self.lattice, shape, centres);
         let (nx, ny) = (out.shape.nx, out.shape.ny);
         for i in 0..self.n_cells {
             for a in 0..nx {
                 let x = out.map.lat_x[i * nx + a] as usize;
                 for b in 0..ny {
                     let y = out.map.lat_y[i * ny + b] as usize;
-                    out.phi[i * nx * ny + a * ny + b] = self.value_at(i, x, y);
+                    out.phi[i * nx * ny + a * ny + b] = T::from_f64(self.value_at(i, x, y));
                 }
             }
         }
@@ -424,15 +436,15 @@ impl Cells {
         self.shape.len()
     }
     /// All cells' values, cell after cell.
-    pub fn phi(&self) -> &[f64] {
+    pub fn phi(&self) -> &[T] {
         &self.phi
     }
     /// All cells' values, mutably.
-    pub fn phi_mut(&mut self) -> &mut [f64] {
+    pub fn phi_mut(&mut self) -> &mut [T] {
         &mut self.phi
     }
     /// One cell's patch values in storage order.
-    pub fn cell_phi(&self, cell_idx: usize) -> &[f64] {
+    pub fn cell_phi(&self, cell_idx: usize) -> &[T] {
         let n = self.shape.len();
         &self.phi[cell_idx * n..(cell_idx + 1) * n]
     }
@@ -442,7 +454,7 @@ impl Cells {
     }
     /// The values (mutable) and the patch map (shared) at once, for kernels that write
     /// fields while reading positions.
-    pub fn split_mut(&mut self) -> (&mut [f64], &PatchMap, &PatchShape) {
+    pub fn split_mut(&mut self) -> (&mut [T], &PatchMap, &PatchShape) {
         (&mut self.phi, &self.map, &self.shape)
     }
 
@@ -458,7 +470,7 @@ impl Cells {
         let [fx, fy] = self.map.offset[cell_idx];
         let a = (u + fx) % nx;
         let b = (v + fy) % ny;
-        self.cell_phi(cell_idx)[a * ny + b]
+        self.cell_phi(cell_idx)[a * ny + b].to_f64()
     }
 
     /// The patch of cell `cell_idx` unrolled into logical order: element `u * ny + v` is the
@@ -475,7 +487,7 @@ impl Cells {
             let a = (u + fx) % nx;
             for v in 0..ny {
                 let b = (v + fy) % ny;
-                out[u * ny + v] = phi[a * ny + b];
+                out[u * ny + v] = phi[a * ny + b].to_f64();
             }
         }
     }
@@ -488,8 +500,21 @@ impl Cells {
         let phi = self.cell_phi(cell_idx);
         for (a, &x) in lx.iter().enumerate() {
             for (b, &y) in ly.iter().enumerate() {
-                out[self.lattice.index(x as usize, y as usize)] += phi[a * ny + b];
+                out[self.lattice.index(x as usize, y as usize)] += phi[a * ny + b].to_f64();
             }
+        }
+    }
+}
+
+impl<T: Real> Cells<T> {
+    /// The same cells with their fields stored in precision `U` (each value rounded once).
+    pub fn to_precision<U: Real>(&self) -> Cells<U> {
+        Cells {
+            lattice: self.lattice,
+            shape: self.shape.clone(),
+            n_cells: self.n_cells,
+            phi: self.phi.iter().map(|v| U::from_f64(v.to_f64())).collect(),
+            map: self.map.clone(),
         }
     }
 }
