@@ -8,9 +8,9 @@
 
 use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
-use phasefield::Real;
 use monolayer_benches::relaxed_scene;
 use monolayer_cli::scene::Scene;
+use phasefield::Real;
 
 /// Relaxation before timing, in steps (20 TU): the initial discs have grown to confluence.
 const RELAX_STEPS: usize = 100;

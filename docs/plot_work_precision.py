@@ -14,7 +14,9 @@ rows = list(csv.DictReader(open(os.path.join(here, "work_precision.csv"))))
 fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
 groups = {}
 for r in rows:
-    if r["config"].startswith("margin") and r["dt"] == "0.05":
+    if r.get("precision") == "f32":
+        key = ("full domain" if r["margin"] == "0" else "margin " + r["margin"]) + ", Heun, f32"
+    elif r["config"].startswith("margin") and r["dt"] == "0.05":
         key = "patch margin (Heun, dt 0.05)"
     elif r["config"].startswith("full"):
         key = {"0": "full domain, Euler", "1": "full domain, Heun", "2": "full domain, Heun npc 2"}[r["npc"]]
@@ -27,14 +29,14 @@ for ax, col, label in ((axes[0], "centre_error", "largest centre-of-mass error (
         rs = sorted(rs, key=lambda r: float(r["wall_s"]))
         xs = [float(r["wall_s"]) for r in rs]
         ys = [max(float(r[col]), 1e-16) for r in rs]
-        ax.loglog(xs, ys, "o-", label=key)
+        ax.loglog(xs, ys, "s--" if key.endswith("f32") else "o-", label=key)
         for r, x, y in zip(rs, xs, ys):
             tag = "m" + r["margin"] if key.startswith("patch") else "dt " + r["dt"]
             ax.annotate(tag, (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
     ax.set_xlabel("wall time for 20 TU, 60 cells, 2 threads (s)")
     ax.set_ylabel(label)
     ax.grid(True, which="both", alpha=0.3)
-axes[0].legend(fontsize=8)
+axes[0].legend(fontsize=7, ncol=2)
 fig.suptitle("Work against precision; reference: full domain, Heun, dt 0.01, f64")
 fig.tight_layout()
 fig.savefig(os.path.join(here, "work_precision.png"), dpi=110)

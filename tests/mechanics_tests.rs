@@ -260,6 +260,60 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_eq!(a.cells.phi(), b.cells.phi(), "bit-for-bit identical fields");
     assert_eq!(a.centre, b.centre);
     assert_eq!(max_diff(a.cells.phi(), b.cells.phi()), 0.0);
+    // And with single-precision storage.
+    let run32 = |threads: usize| -> Tissue<f32> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let (t, _) = confluent(100, 4, 20, PressureKind::Paper);
+            let mut t = Tissue::new(t.cells.to_precision::<f32>(), t.params);
+            let mut ws = Workspace::new(&t.cells);
+            t.params.zeta = 0.01;
+            advance(&mut t, &mut ws, 20, &HEUN);
+            t
+        })
+    };
+    let (a, b) = (run32(1), run32(2));
+    assert_eq!(
+        a.cells.phi(),
+        b.cells.phi(),
+        "bit-for-bit identical f32 fields"
+    );
+    assert_eq!(a.centre, b.centre);
+}
+
+/// Single-precision storage rounds every stored value to 2⁻²⁴ ≈ 6e-8 relative; over 100
+/// steps (20 TU at ζ = 0.01, before chaos separates trajectories) the rounding errors add up
+/// to at most about 100 × 6e-8 = 6e-6 in φ if they never cancel. The f32 run must stay that
+/// close to the f64 run from the same state, and must differ from it (it really is f32).
+#[test]
+fn single_precision_storage_tracks_double_precision() {
+    for pressure in PRESSURES {
+        let (mut a, mut wa) = confluent(100, 7, 20, pressure);
+        let mut b = Tissue::new(a.cells.to_precision::<f32>(), a.params);
+        let mut wb = Workspace::new(&b.cells);
+        a.params.zeta = 0.01;
+        b.params.zeta = 0.01;
+        advance(&mut a, &mut wa, 100, &HEUN);
+        advance(&mut b, &mut wb, 100, &HEUN);
+        let lat = a.lattice();
+        let mut e_phi: f64 = 0.0;
+        let mut e_c: f64 = 0.0;
+        for i in 0..a.cells.n_cells() {
+            e_c = e_c.max(lat.distance(a.centre[i], b.centre[i]));
+            for x in 0..lat.lx {
+                for y in 0..lat.ly {
+                    e_phi =
+                        e_phi.max((a.cells.value_at(i, x, y) - b.cells.value_at(i, x, y)).abs());
+                }
+            }
+        }
+        eprintln!("{pressure:?}: f32 against f64 after 100 steps: φ {e_phi:.2e}, centre {e_c:.2e}");
+        assert!(e_phi > 1e-9 && e_phi < 6e-6, "φ error {e_phi:e}");
+        assert!(e_c > 0.0 && e_c < 6e-6, "centre error {e_c:e}");
+    }
 }
 
 /// The lattice fields are the step's own sums: `Σ_x Q = Σ_i S_i Σ_x φ_i`,

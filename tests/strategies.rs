@@ -1,7 +1,7 @@
 //! Shared builders and proptest strategies with named domain constants.
 
 use mechanics::{ModelParams, PressureKind, StepParams, Tissue, Workspace};
-use phasefield::{init, Cells, Lattice, PatchShape};
+use phasefield::{init, Cells, Lattice, PatchShape, Real};
 use proptest::prelude::*;
 
 /// The paper's time step.
@@ -33,7 +33,7 @@ pub fn tissue(cells: Cells, zeta: f64, pressure: PressureKind) -> (Tissue, Works
 }
 
 /// Advances `n` steps, panicking on a step error.
-pub fn advance(t: &mut Tissue, ws: &mut Workspace, n: usize, sp: &StepParams) {
+pub fn advance<T: Real>(t: &mut Tissue<T>, ws: &mut Workspace<T>, n: usize, sp: &StepParams) {
     for _ in 0..n {
         t.step(ws, sp).expect("stable step");
     }

@@ -90,11 +90,7 @@ pub(crate) fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
 
 /// Writes one frame (see the module docs); `ws` must hold the derived quantities of the
 /// current state (call [`Tissue::observe`] or [`Tissue::refresh`] first).
-pub fn write_frame<T: Real>(
-    dir: &Path,
-    tissue: &Tissue<T>,
-    ws: &Workspace<T>,
-) -> Result<PathBuf> {
+pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -> Result<PathBuf> {
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames)?;
     let path = frames.join(format!("frame_{:08}.npz", tissue.step));

@@ -118,21 +118,35 @@ print("ok")
 }
 
 #[test]
-fn the_same_seed_gives_identical_output_with_one_and_two_threads() {
+fn the_same_seed_gives_identical_output_with_one_and_two_threads_in_both_precisions() {
     let a = tempfile::tempdir().unwrap();
     let b = tempfile::tempdir().unwrap();
-    for (dir, threads) in [(&a, "1"), (&b, "2")] {
-        let mut args = SHORT.to_vec();
-        args.extend(["--threads", threads, "--set", "model.zeta=0.01"]);
-        let o = run(&scene_path("paper.toml"), dir.path(), &args);
-        assert!(o.status.success(), "{}", stderr(&o));
+    let mut series = Vec::new();
+    for precision in ["f64", "f32"] {
+        let p = format!("integrator.precision={precision}");
+        for (dir, threads) in [(&a, "1"), (&b, "2")] {
+            let mut args = SHORT.to_vec();
+            args.extend([
+                "--threads",
+                threads,
+                "--set",
+                "model.zeta=0.01",
+                "--set",
+                &p,
+            ]);
+            args.push("--overwrite");
+            let o = run(&scene_path("paper.toml"), dir.path(), &args);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        let read = |d: &Path, f: &str| std::fs::read(d.join(f)).unwrap();
+        assert_eq!(read(a.path(), "series.csv"), read(b.path(), "series.csv"));
+        series.push(read(a.path(), "series.csv"));
+        for t in ["00000000", "00000030", "00000050"] {
+            let f = format!("frames/frame_{t}.npz");
+            assert_eq!(read(a.path(), &f), read(b.path(), &f), "{precision} {f}");
+        }
     }
-    let read = |d: &Path, f: &str| std::fs::read(d.join(f)).unwrap();
-    assert_eq!(read(a.path(), "series.csv"), read(b.path(), "series.csv"));
-    for t in ["00000000", "00000030", "00000050"] {
-        let f = format!("frames/frame_{t}.npz");
-        assert_eq!(read(a.path(), &f), read(b.path(), &f), "{f}");
-    }
+    assert_ne!(series[0], series[1], "f32 storage rounds the fields");
 }
 
 /// Writes a scene to a temporary file, runs it and returns (exit success, stderr).
@@ -164,6 +178,11 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
             "unknown key",
             &["--set", "model.zetta=0.01"],
             &["zetta", "expected one of"],
+        ),
+        (
+            "unknown precision",
+            &["--set", "integrator.precision=f16"],
+            &["integrator.precision", "f64", "f32"],
         ),
         (
             "unknown section",

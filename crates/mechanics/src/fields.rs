@@ -33,8 +33,8 @@ impl<T: Real> Tissue<T> {
     /// the velocities of the last evaluation.
     pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
         let cs = &ws.cell_state;
-        scatter::<2, T, _>(&self.cells, self.cells.phi(), &mut ws.field2, |i, _, p| {
-            [p * cs[i].velocity[0], p * cs[i].velocity[1]]
+        scatter::<2, T, _>(&self.cells, self.cells.phi(), &mut ws.field2, |i, _, s| {
+            [s.c * cs[i].velocity[0], s.c * cs[i].velocity[1]]
         });
     }
 

@@ -254,8 +254,10 @@ impl<T: Real> Tissue<T> {
             cell_state,
         );
         self.check(cell_state, dt)?;
+        // The state moves into `phi_old` without a copy; the predictor overwrites the buffer
+        // that held the previous step's `phi_old`.
+        self.cells.swap_phi(phi_old);
         let phi = self.cells.phi_mut();
-        phi_old.copy_from_slice(phi);
         phi.par_iter_mut()
             .zip(phi_old.par_iter().zip(k1.par_iter()))
             .for_each(|(p, (o, r))| *p = T::from_f64(o.to_f64() + dt * r.to_f64()));
@@ -322,19 +324,16 @@ impl<T: Real> Tissue<T> {
 /// to a blow-up.
 pub const PHI_BOUND: f64 = 2.0;
 
-/// Pass 1 for one cell: area, range, patch Laplacians into `lap` and, with `SHAPE`, the
-/// deformation tensor.
+/// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]
 fn cell_sums<T: Real, const SHAPE: bool>(
     cell: &[T],
     shape: &phasefield::PatchShape,
-    lap: &mut [T],
     st: &mut CellState,
 ) {
     let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for_each_stencil(cell, shape, |k, s| {
-        lap[k] = T::from_f64(s.laplacian());
+    for_each_stencil(cell, shape, |_, s| {
         area += s.c * s.c;
         if SHAPE {
             let (dx, dy) = (s.dx(), s.dy());
@@ -372,15 +371,14 @@ pub fn evaluate<T: Real>(
     let zeta = params.zeta;
 
     // 1. Per cell: area, deformation tensor, range.
-    // The Laplacians go into `rhs` as scratch; pass 3 overwrites them.
     cell_state
         .par_iter_mut()
-        .zip(phi.par_chunks(plen).zip(rhs.par_chunks_mut(plen)))
-        .for_each(|(st, (cell, lap))| {
+        .zip(phi.par_chunks(plen))
+        .for_each(|(st, cell)| {
             if shapes {
-                cell_sums::<T, true>(cell, shape, lap, st);
+                cell_sums::<T, true>(cell, shape, st);
             } else {
-                cell_sums::<T, false>(cell, shape, lap, st);
+                cell_sums::<T, false>(cell, shape, st);
             }
         });
 
@@ -389,14 +387,14 @@ pub fn evaluate<T: Real>(
     let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
-        let lap: &[T] = rhs;
-        scatter::<N_GLOBAL, T, _>(cells, phi, global, |i, k, p| {
+        scatter::<N_GLOBAL, T, _>(cells, phi, global, |i, _, s| {
             let c = &cs[i];
+            let p = s.c;
             let p2 = p * p;
             let u = match kind {
                 PressureKind::Paper => {
                     -coef.repulsion * p2 * p - coef.double_well * p * (1.0 - p) * (1.0 - 2.0 * p)
-                        + coef.gradient * lap[i * plen + k].to_f64()
+                        + coef.gradient * s.laplacian()
                         - coef.area_factor(c.area) * p
                 }
                 PressureKind::Interaction => -coef.repulsion * p2 * p2,

@@ -40,7 +40,11 @@ impl ComTable {
     }
 
     /// The centre of mass of cell `cell_idx` of `cells`.
-    pub fn cell_centre<T: crate::Real>(&self, cells: &crate::Cells<T>, cell_idx: usize) -> [f64; 2] {
+    pub fn cell_centre<T: crate::Real>(
+        &self,
+        cells: &crate::Cells<T>,
+        cell_idx: usize,
+    ) -> [f64; 2] {
         let shape = cells.shape();
         self.centre_of_mass(
             cells.cell_phi(cell_idx),

@@ -14,8 +14,8 @@
 //! All cells' values are one contiguous `Vec<f64>` with stride `patch_len`; within a patch the
 //! storage index is `a * ny + b` (x slow, y contiguous, as on the [`Lattice`]).
 
-use crate::real::Real;
 use crate::lattice::Lattice;
+use crate::real::Real;
 use crate::PhaseFieldError;
 
 /// The shape of every cell's patch and the periodic neighbour tables of its stencils.
@@ -451,6 +451,15 @@ impl<T: Real> Cells<T> {
     /// Where the patches are.
     pub fn map(&self) -> &PatchMap {
         &self.map
+    }
+    /// Exchanges the field buffer with `other` (same length), without copying: a time stepper
+    /// keeps the old state this way.
+    ///
+    /// # Panics
+    /// If the lengths differ.
+    pub fn swap_phi(&mut self, other: &mut Vec<T>) {
+        assert_eq!(other.len(), self.phi.len(), "buffers of different lengths");
+        std::mem::swap(&mut self.phi, other);
     }
     /// The values (mutable) and the patch map (shared) at once, for kernels that write
     /// fields while reading positions.
