@@ -75,8 +75,25 @@ fn study() {
         p.zeta = z;
         cases.push((format!("zeta = {z}"), p));
     }
-    let mut csv =
-        String::from("case,gamma,kappa,lambda,zeta,dt_max_euler,dt_max_heun,dt_linear_estimate\n");
+    // The activity term of the estimate (`ACTIVITY_STIFFNESS`) was fitted at the paper's γ and
+    // κ; these cases test it away from them, and at stronger and contractile activity.
+    for (name, g, k, z) in [
+        ("zeta = 0.04, gamma = 0.005", 0.005, 0.1, 0.04),
+        ("zeta = 0.04, gamma = 0.02", 0.02, 0.1, 0.04),
+        ("zeta = 0.04, kappa = 0.05", 0.01, 0.05, 0.04),
+        ("zeta = 0.04, kappa = 0.4", 0.01, 0.4, 0.04),
+        ("zeta = -0.04", 0.01, 0.1, -0.04),
+        ("zeta = 0.08", 0.01, 0.1, 0.08),
+    ] {
+        let mut p = base;
+        p.energy.gamma = g;
+        p.energy.kappa = k;
+        p.zeta = z;
+        cases.push((name.to_string(), p));
+    }
+    let mut csv = String::from(
+        "case,gamma,kappa,lambda,zeta,dt_max_euler,dt_max_heun,dt_linear_estimate,estimate_safe\n",
+    );
     let mut table = String::from("| parameters (others as the paper, ζ = 0.005) | largest stable dt, Euler | Heun | linear estimate 2/stiffness |\n|---|---|---|---|\n");
     writeln!(
         table,
@@ -91,9 +108,10 @@ fn study() {
             "{name}: Euler {e:.2}, Heun {h:.2}, estimate {:.2}",
             p.max_stable_dt()
         );
+        let safe = p.max_stable_dt() <= e.min(h);
         writeln!(
             csv,
-            "{name},{},{},{},{},{e:.3},{h:.3},{:.3}",
+            "\"{name}\",{},{},{},{},{e:.3},{h:.3},{:.3},{safe}",
             p.energy.gamma,
             p.energy.kappa,
             p.energy.lambda,
@@ -103,8 +121,9 @@ fn study() {
         .unwrap();
         writeln!(
             table,
-            "| {name} | {e:.2} | {h:.2} | {:.2} |",
-            p.max_stable_dt()
+            "| {name} | {e:.2} | {h:.2} | {:.2}{} |",
+            p.max_stable_dt(),
+            if safe { "" } else { " (unsafe)" }
         )
         .unwrap();
     }

@@ -560,7 +560,7 @@ impl Scene {
             self.model.zeta
         };
         Ok(Tissue::new(
-            cells.to_precision::<T>(),
+            cells.into_precision::<T>(),
             self.model_params(zeta),
         ))
     }

@@ -516,6 +516,19 @@ impl<T: Real> Cells<T> {
 }
 
 impl<T: Real> Cells<T> {
+    /// The same cells stored in precision `U`, consuming `self`: without a copy when `U` is
+    /// `T`, else as [`Cells::to_precision`].
+    pub fn into_precision<U: Real>(self) -> Cells<U> {
+        let any: Box<dyn std::any::Any> = Box::new(self);
+        match any.downcast::<Cells<U>>() {
+            Ok(same) => *same,
+            Err(any) => any
+                .downcast::<Self>()
+                .expect("the box holds a Cells<T>")
+                .to_precision(),
+        }
+    }
+
     /// The same cells with their fields stored in precision `U` (each value rounded once).
     pub fn to_precision<U: Real>(&self) -> Cells<U> {
         Cells {
