@@ -55,6 +55,9 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
     std::fs::write(out.join("scene.toml"), scene.to_toml())?;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
     match scene.integrator.precision {
         Precision::F64 => run_in::<f64>(scene, out, quiet),
         Precision::F32 => run_in::<f32>(scene, out, quiet),

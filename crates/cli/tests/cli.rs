@@ -212,7 +212,12 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
         (
             "unstable dt",
             &["--set", "integrator.dt=5"],
-            &["[integrator] dt", "unstable", "use dt ≤"],
+            &[
+                "[integrator] dt",
+                "unstable",
+                "use dt ≤",
+                "stability_check = false",
+            ],
         ),
         (
             "zero dt",
@@ -287,6 +292,8 @@ fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
             "--set",
             "integrator.dt=0.5",
             "--set",
+            "integrator.stability_check=false",
+            "--set",
             "run.time=400",
             "--set",
             "run.output_every=50",
@@ -295,6 +302,10 @@ fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
         ],
     );
     assert!(!ok);
+    assert!(
+        err.contains("warning: [integrator] dt = 0.5 is above"),
+        "{err}"
+    );
     assert!(
         err.contains("at step") && err.contains("cell ") && err.contains("reduce [integrator] dt"),
         "{err}"

@@ -44,7 +44,7 @@ mod tissue;
 
 pub use fields::TissueFields;
 pub use observables::Observables;
-pub use params::{ModelParams, PressureKind, StepParams, ACTIVITY_STIFFNESS};
+pub use params::{ModelParams, PressureKind, StepParams, ACTIVITY_DT};
 pub use simulation::{run, Observer, Protocol};
 pub use tissue::{
     evaluate, pressure, CellState, Tissue, Workspace, G_QXX, G_QXY, G_S1, G_S2, G_U, N_GLOBAL,
