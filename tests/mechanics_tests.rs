@@ -438,3 +438,29 @@ fn no_step_fails_inside_the_stable_region() {
 }
 
 const PHI: f64 = mechanics::PHI_BOUND;
+
+/// The scatter leaves the stripes that no patch overlaps alone once they are zero. When the
+/// cells then move elsewhere, a reused workspace must still hold exactly the sums of a fresh
+/// one: the stripes they left are cleared, the ones they entered start from zero.
+#[test]
+fn a_reused_workspace_has_the_sums_of_a_fresh_one_after_cells_move() {
+    let here = discs(160, 12, &[[20.0, 30.0], [34.0, 30.0]], 7.0);
+    let there = discs(160, 12, &[[110.0, 150.0], [158.0, 10.0]], 7.0);
+    let (mut a, mut ws) = tissue(here, 0.01, PressureKind::Paper);
+    a.refresh(&mut ws);
+    a.observe(&mut ws);
+    let (mut b, mut fresh) = tissue(there, 0.01, PressureKind::Paper);
+    b.refresh(&mut fresh);
+    b.observe(&mut fresh);
+    // The same workspace, now for the moved cells.
+    let _ = b.observe(&mut ws);
+    assert!(ws.global.iter().any(|&v| v != 0.0));
+    assert_eq!(ws.global, fresh.global, "global sums");
+    assert_eq!(ws.field2, fresh.field2, "velocity field");
+    // Nodes far from every patch hold zeros.
+    let lattice = b.lattice();
+    let far = lattice.index(40, 80) * mechanics::N_GLOBAL;
+    assert!(ws.global[far..far + mechanics::N_GLOBAL]
+        .iter()
+        .all(|&v| v == 0.0));
+}

@@ -32,10 +32,20 @@ impl<T: Real> Tissue<T> {
     /// Scatters the tissue velocity `Σ_i φ_i v_i` into `ws.field2` (`[vx, vy]` per node), from
     /// the velocities of the last evaluation.
     pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
-        let cs = &ws.cell_state;
-        scatter::<2, T, _>(&self.cells, self.cells.phi(), &mut ws.field2, |i, _, s| {
-            [s.c * cs[i].velocity[0], s.c * cs[i].velocity[1]]
-        });
+        let Workspace {
+            cell_state,
+            field2,
+            field2_stripes,
+            ..
+        } = ws;
+        let cs: &[_] = cell_state;
+        scatter::<2, T, _>(
+            &self.cells,
+            self.cells.phi(),
+            field2,
+            field2_stripes,
+            |i, _, s| [s.c * cs[i].velocity[0], s.c * cs[i].velocity[1]],
+        );
     }
 
     /// Evaluates the state and returns its lattice fields. Allocates the result; meant for

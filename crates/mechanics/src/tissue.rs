@@ -12,7 +12,7 @@ use phasefield::{for_each_stencil, for_each_stencil_at, Cells, ComTable, Lattice
 use rayon::prelude::*;
 
 use crate::params::{ModelParams, PressureKind, StepParams};
-use crate::scatter::scatter;
+use crate::scatter::{scatter, Stripes};
 use crate::StepError;
 
 /// Components of the global (lattice-wide) sums, per node.
@@ -93,12 +93,16 @@ pub struct Workspace<T: Real = f64> {
     phi_old: Vec<T>,
     k1: Vec<T>,
     k2: Vec<T>,
-    /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices).
+    /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices). Written by each
+    /// evaluation; read it, do not write it (the scatter remembers which stripes are zero).
     pub global: Vec<f64>,
+    pub(crate) global_stripes: Stripes,
     /// Per-cell derived quantities of the last evaluation.
     pub cell_state: Vec<CellState>,
-    /// A two-component lattice buffer for derived fields (e.g. the tissue velocity).
+    /// A two-component lattice buffer for derived fields (e.g. the tissue velocity); read it,
+    /// do not write it.
     pub field2: Vec<f64>,
+    pub(crate) field2_stripes: Stripes,
     com: ComTable,
 }
 
@@ -112,8 +116,10 @@ impl<T: Real> Workspace<T> {
             k1: vec![T::default(); n],
             k2: vec![T::default(); n],
             global: vec![0.0; lattice.len() * N_GLOBAL],
+            global_stripes: Stripes::new(lattice),
             cell_state: vec![CellState::default(); cells.n_cells()],
             field2: vec![0.0; lattice.len() * 2],
+            field2_stripes: Stripes::new(lattice),
             com: ComTable::new(lattice),
         }
     }
@@ -206,6 +212,7 @@ impl<T: Real> Tissue<T> {
         let Workspace {
             k2,
             global,
+            global_stripes,
             cell_state,
             ..
         } = ws;
@@ -216,6 +223,7 @@ impl<T: Real> Tissue<T> {
             true,
             k2,
             global,
+            global_stripes,
             cell_state,
         );
     }
@@ -240,6 +248,7 @@ impl<T: Real> Tissue<T> {
             k1,
             k2,
             global,
+            global_stripes,
             cell_state,
             com,
             ..
@@ -251,6 +260,7 @@ impl<T: Real> Tissue<T> {
             shapes,
             k1,
             global,
+            global_stripes,
             cell_state,
         );
         self.check(cell_state, dt)?;
@@ -269,6 +279,7 @@ impl<T: Real> Tissue<T> {
                 shapes,
                 k2,
                 global,
+                global_stripes,
                 cell_state,
             );
             let phi = self.cells.phi_mut();
@@ -362,6 +373,7 @@ pub fn evaluate<T: Real>(
     shapes: bool,
     rhs: &mut [T],
     global: &mut [f64],
+    stripes: &mut Stripes,
     cell_state: &mut [CellState],
 ) {
     let shape = cells.shape();
@@ -387,7 +399,7 @@ pub fn evaluate<T: Real>(
     let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
-        scatter::<N_GLOBAL, T, _>(cells, phi, global, |i, _, s| {
+        scatter::<N_GLOBAL, T, _>(cells, phi, global, stripes, |i, _, s| {
             let c = &cs[i];
             let p = s.c;
             let p2 = p * p;
