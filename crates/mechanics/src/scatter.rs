@@ -8,7 +8,7 @@
 //! A stripe that no patch overlaps is zeroed once and then left alone ([`Stripes`]), so a
 //! scene of a few cells in a large box does no work per step on the nodes no cell covers.
 
-use phasefield::{Cells, Lattice, Real, Stencil};
+use phasefield::{for_each_stencil_in_column, Cells, Lattice, Real, Stencil};
 use rayon::prelude::*;
 
 /// Lattice x-rows per scatter stripe (fixed, so that the result never depends on threads).
@@ -51,7 +51,7 @@ pub fn scatter<const K: usize, T: Real, F>(
     let lattice: Lattice = cells.lattice();
     let shape = cells.shape();
     let map = cells.map();
-    let (nx, ny, ly) = (shape.nx, shape.ny, lattice.ly);
+    let (nx, ly) = (shape.nx, lattice.ly);
     let plen = shape.len();
     assert_eq!(out.len(), lattice.len() * K);
     assert_eq!(stripes.dirty.len(), lattice.lx.div_ceil(STRIPE_ROWS));
@@ -89,26 +89,13 @@ pub fn scatter<const K: usize, T: Real, F>(
                         continue;
                     }
                     let base = (x - x0) * ly;
-                    let row = &cell[a * ny..(a + 1) * ny];
-                    let row_m = &cell[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
-                    let row_p = &cell[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
-                    for b in 0..ny {
-                        let k = a * ny + b;
-                        let bm = if b == 0 { ny - 1 } else { b - 1 };
-                        let bp = if b + 1 == ny { 0 } else { b + 1 };
-                        let s = Stencil {
-                            c: row[b].to_f64(),
-                            xm: row_m[b].to_f64(),
-                            xp: row_p[b].to_f64(),
-                            ym: row[bm].to_f64(),
-                            yp: row[bp].to_f64(),
-                        };
+                    for_each_stencil_in_column(cell, shape, a, &mut |k, _, b, s| {
                         let v = value(i, k, &s);
                         let node = &mut chunk[(base + ys[b] as usize) * K..][..K];
                         for c in 0..K {
                             node[c] += v[c];
                         }
-                    }
+                    });
                 }
             }
             if !touched && *dirty {

@@ -39,7 +39,10 @@ mod real;
 pub use com::ComTable;
 pub use energy::{EnergyCoefficients, EnergyParams};
 pub use lattice::{min_image, wrap_real, Lattice};
-pub use patch::{for_each_stencil, for_each_stencil_at, Cells, PatchMap, PatchShape, Stencil};
+pub use patch::{
+    for_each_stencil, for_each_stencil_at, for_each_stencil_in_column, Cells, PatchMap, PatchShape,
+    Stencil,
+};
 pub use real::Real;
 
 /// Errors from building lattices, patches and initial states.

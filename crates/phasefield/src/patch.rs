@@ -142,28 +142,31 @@ pub fn for_each_stencil_at<T: Real, F: FnMut(usize, usize, usize, Stencil)>(
     shape: &PatchShape,
     mut f: F,
 ) {
-    let ny = shape.ny;
     assert_eq!(phi.len(), shape.len());
     for a in 0..shape.nx {
-        let row = &phi[a * ny..(a + 1) * ny];
-        let row_m = &phi[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
-        let row_p = &phi[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
-        let k0 = a * ny;
-        if ny == 1 {
-            f(
-                k0,
-                a,
-                0,
-                Stencil {
-                    c: row[0].to_f64(),
-                    xm: row_m[0].to_f64(),
-                    xp: row_p[0].to_f64(),
-                    ym: row[0].to_f64(),
-                    yp: row[0].to_f64(),
-                },
-            );
-            continue;
-        }
+        for_each_stencil_in_column(phi, shape, a, &mut f);
+    }
+}
+
+/// Calls `f(k, a, b, stencil)` for every row `b` of storage column `a` of one patch
+/// (`k = a * ny + b`), with periodic wrap inside the patch: the column loop of
+/// [`for_each_stencil_at`], for kernels that visit only some columns (the lattice scatter).
+///
+/// # Panics
+/// If `phi.len() != shape.len()` or `a >= shape.nx`.
+#[inline(always)]
+pub fn for_each_stencil_in_column<T: Real, F: FnMut(usize, usize, usize, Stencil)>(
+    phi: &[T],
+    shape: &PatchShape,
+    a: usize,
+    f: &mut F,
+) {
+    let ny = shape.ny;
+    let row = &phi[a * ny..(a + 1) * ny];
+    let row_m = &phi[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
+    let row_p = &phi[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
+    let k0 = a * ny;
+    if ny == 1 {
         f(
             k0,
             a,
@@ -172,37 +175,50 @@ pub fn for_each_stencil_at<T: Real, F: FnMut(usize, usize, usize, Stencil)>(
                 c: row[0].to_f64(),
                 xm: row_m[0].to_f64(),
                 xp: row_p[0].to_f64(),
-                ym: row[ny - 1].to_f64(),
-                yp: row[1].to_f64(),
-            },
-        );
-        for b in 1..ny - 1 {
-            f(
-                k0 + b,
-                a,
-                b,
-                Stencil {
-                    c: row[b].to_f64(),
-                    xm: row_m[b].to_f64(),
-                    xp: row_p[b].to_f64(),
-                    ym: row[b - 1].to_f64(),
-                    yp: row[b + 1].to_f64(),
-                },
-            );
-        }
-        f(
-            k0 + ny - 1,
-            a,
-            ny - 1,
-            Stencil {
-                c: row[ny - 1].to_f64(),
-                xm: row_m[ny - 1].to_f64(),
-                xp: row_p[ny - 1].to_f64(),
-                ym: row[ny - 2].to_f64(),
+                ym: row[0].to_f64(),
                 yp: row[0].to_f64(),
             },
         );
+        return;
     }
+    f(
+        k0,
+        a,
+        0,
+        Stencil {
+            c: row[0].to_f64(),
+            xm: row_m[0].to_f64(),
+            xp: row_p[0].to_f64(),
+            ym: row[ny - 1].to_f64(),
+            yp: row[1].to_f64(),
+        },
+    );
+    for b in 1..ny - 1 {
+        f(
+            k0 + b,
+            a,
+            b,
+            Stencil {
+                c: row[b].to_f64(),
+                xm: row_m[b].to_f64(),
+                xp: row_p[b].to_f64(),
+                ym: row[b - 1].to_f64(),
+                yp: row[b + 1].to_f64(),
+            },
+        );
+    }
+    f(
+        k0 + ny - 1,
+        a,
+        ny - 1,
+        Stencil {
+            c: row[ny - 1].to_f64(),
+            xm: row_m[ny - 1].to_f64(),
+            xp: row_p[ny - 1].to_f64(),
+            ym: row[ny - 2].to_f64(),
+            yp: row[0].to_f64(),
+        },
+    );
 }
 
 /// Where each cell's patch sits on the lattice: origins, offsets and the storage-to-lattice
