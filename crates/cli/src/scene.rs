@@ -437,9 +437,7 @@ impl Scene {
                 "use the paper's 0.2",
             ));
         }
-        let params = self.model_params(m.zeta);
-        let dt_max = params.max_stable_dt();
-        if it.dt > dt_max && it.stability_check {
+        if let Some(dt_max) = self.dt_above_estimate().filter(|_| it.stability_check) {
             return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {dt_max:.3} for these parameters (a conservative estimate; docs/stability.csv)"), format!("use dt ≤ {dt_max:.3} (the paper uses 0.2), or set [integrator] stability_check = false to run above the estimate at your own risk")));
         }
         if it.npc > 16 {
@@ -541,15 +539,22 @@ impl Scene {
     /// Warnings about a valid scene: a time step above the stability estimate, allowed by
     /// `[integrator] stability_check = false`.
     pub fn warnings(&self) -> Vec<String> {
+        self.dt_above_estimate()
+            .map(|dt_max| {
+                format!(
+                    "[integrator] dt = {} is above the stability estimate {dt_max:.3}; the run stops if it blows up",
+                    self.integrator.dt
+                )
+            })
+            .into_iter()
+            .collect()
+    }
+
+    /// The stability estimate `ModelParams::max_stable_dt` of the active phase, when the
+    /// scene's dt is above it.
+    fn dt_above_estimate(&self) -> Option<f64> {
         let dt_max = self.model_params(self.model.zeta).max_stable_dt();
-        let mut w = Vec::new();
-        if self.integrator.dt > dt_max {
-            w.push(format!(
-                "[integrator] dt = {} is above the stability estimate {dt_max:.3}; the run stops if it blows up",
-                self.integrator.dt
-            ));
-        }
-        w
+        (self.integrator.dt > dt_max).then_some(dt_max)
     }
 
     /// Builds the initial tissue (at ζ = 0 when there is a relaxation phase), stored in
