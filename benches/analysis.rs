@@ -50,10 +50,7 @@ fn analyse(
 }
 
 fn bench_analysis(c: &mut Criterion) {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
+    let pool = monolayer_benches::pool(2);
     let (lattice, mut t, mut ws) = pool.install(frame);
     let f = pool.install(|| t.fields(&mut ws));
     let mut g = c.benchmark_group("analysis-400");

@@ -5,6 +5,17 @@ use mechanics::{ModelParams, StepParams, Tissue, Workspace};
 use monolayer_cli::scene::Scene;
 use phasefield::{init, Lattice, PatchShape, Real};
 
+/// A rayon pool of `threads` threads, for timing on a fixed number of cores.
+///
+/// # Panics
+/// If the pool cannot be built.
+pub fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+}
+
 /// A shipped scene (`scenes/NAME`) with `--set`-style overrides, built and relaxed for
 /// `relax_steps` steps at ζ = 0 with its own integrator, then set to activity `zeta`, with
 /// the fields stored in precision `T`.

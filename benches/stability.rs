@@ -44,10 +44,7 @@ fn largest_stable_dt(start: &Cells, params: ModelParams, npc: usize) -> f64 {
 }
 
 fn main() {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
+    let pool = monolayer_benches::pool(2);
     pool.install(study);
 }
 

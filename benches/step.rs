@@ -6,9 +6,10 @@
 //!
 //! Run with `cargo bench -p monolayer-benches --bench step`.
 
-use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{criterion_main, BenchmarkGroup, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
-use monolayer_benches::relaxed_scene;
+use monolayer_benches::{pool, relaxed_scene};
 use monolayer_cli::scene::Scene;
 use phasefield::Real;
 
@@ -24,55 +25,39 @@ fn relaxed<T: Real>(scene: &str, margin: usize) -> (Tissue<T>, Workspace<T>, Sce
     )
 }
 
-fn bench_step(c: &mut Criterion) {
-    let mut g = c.benchmark_group("step");
-    g.sample_size(10);
-    for scene in ["paper.toml", "large.toml"] {
-        for margin in [12, 25] {
-            let pool2 = rayon::ThreadPoolBuilder::new()
-                .num_threads(2)
-                .build()
-                .unwrap();
-            let (mut t, mut ws, s) = pool2.install(|| relaxed::<f64>(scene, margin));
-            let sp = s.step_params();
-            g.throughput(Throughput::Elements(
-                (t.cells.n_cells() * t.cells.patch_len()) as u64,
-            ));
-            for threads in [1, 2] {
-                let pool = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()
-                    .unwrap();
-                let id = BenchmarkId::new(
-                    format!("{}-m{margin}", scene.trim_end_matches(".toml")),
-                    format!("threads={threads}"),
-                );
-                g.bench_function(id, |b| {
-                    pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
-                });
-            }
-        }
-    }
-    // Single-precision storage of the large scene.
-    let pool2 = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    let (mut t, mut ws, s) = pool2.install(|| relaxed::<f32>("large.toml", 12));
+/// Times one step of `scene` with patch margin `margin` and fields stored as `T`, on one and
+/// two threads, under the name `name`.
+fn bench_scene<T: Real>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    scene: &str,
+    margin: usize,
+) {
+    let (mut t, mut ws, s) = pool(2).install(|| relaxed::<T>(scene, margin));
     let sp = s.step_params();
     g.throughput(Throughput::Elements(
         (t.cells.n_cells() * t.cells.patch_len()) as u64,
     ));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        let id = BenchmarkId::new("large-m12-f32", format!("threads={threads}"));
+        let pool = pool(threads);
+        let id = BenchmarkId::new(name, format!("threads={threads}"));
         g.bench_function(id, |b| {
             pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
         });
     }
+}
+
+fn bench_step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("step");
+    g.sample_size(10);
+    for scene in ["paper.toml", "large.toml"] {
+        for margin in [12, 25] {
+            let name = format!("{}-m{margin}", scene.trim_end_matches(".toml"));
+            bench_scene::<f64>(&mut g, &name, scene, margin);
+        }
+    }
+    // Single-precision storage of the large scene.
+    bench_scene::<f32>(&mut g, "large-m12-f32", "large.toml", 12);
     g.finish();
 }
 
@@ -82,10 +67,7 @@ fn bench_step(c: &mut Criterion) {
 fn bench_scaling(c: &mut Criterion) {
     let mut g = c.benchmark_group("scaling");
     g.sample_size(10);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
+    let pool = pool(2);
     for (n, l) in [
         (60usize, 100usize),
         (240, 200),

@@ -78,10 +78,7 @@ fn errors<T: Real>(reference: &Tissue, t: &Tissue<T>) -> (f64, f64) {
 
 fn main() {
     // cargo bench passes --bench; nothing else is read.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
+    let pool = monolayer_benches::pool(2);
     pool.install(study);
 }
 

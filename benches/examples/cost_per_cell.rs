@@ -46,10 +46,7 @@ fn main() {
         "integrator.margin=12".into(),
         "integrator.dt=0.2".into(),
     ];
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("thread pool");
+    let pool = monolayer_benches::pool(threads);
     let step_s = pool.install(|| {
         if f32 {
             let (t, ws, s) = relaxed_scene::<f32>("large.toml", &overrides, 3, 0.005);
