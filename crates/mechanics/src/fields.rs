@@ -5,7 +5,7 @@
 use phasefield::Real;
 
 use crate::scatter::scatter;
-use crate::tissue::{pressure, Tissue, Workspace, G_QXX, G_QXY, N_GLOBAL};
+use crate::tissue::{pressure, Tissue, Workspace, G_QXX, G_QXY, G_S1, G_S2, G_U};
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -29,23 +29,25 @@ pub struct TissueFields {
 }
 
 impl<T: Real> Tissue<T> {
-    /// Scatters the tissue velocity `Σ_i φ_i v_i` into `ws.field2` (`[vx, vy]` per node), from
+    /// Scatters the tissue velocity `Σ_i φ_i v_i` into `ws.field2` (fields `vx`, `vy`), from
     /// the velocities of the last evaluation.
     pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
         let Workspace {
-            cell_state,
-            field2,
-            field2_stripes,
-            ..
+            cell_state, field2, ..
         } = ws;
         let cs: &[_] = cell_state;
-        scatter::<2, T, _>(
-            &self.cells,
-            self.cells.phi(),
-            field2,
-            field2_stripes,
-            |i, _, s| [s.c * cs[i].velocity[0], s.c * cs[i].velocity[1]],
-        );
+        scatter::<2, T, _>(&self.cells, self.cells.phi(), field2, |i, run, sums| {
+            let [ux, uy] = cs[i].velocity;
+            let [vx, vy] = sums.map(|f| &mut f[..run.c.len()]);
+            run.map(
+                [],
+                |s, []| [s.c * ux, s.c * uy],
+                |j, [x, y]| {
+                    vx[j] += x;
+                    vy[j] += y;
+                },
+            );
+        });
     }
 
     /// Evaluates the state and returns its lattice fields. Allocates the result; meant for
@@ -57,26 +59,15 @@ impl<T: Real> Tissue<T> {
         let zeta = self.params.zeta;
         let rep = self.params.energy.coefficients().repulsion;
         let mut f = TissueFields {
-            vx: ws.field2.iter().step_by(2).copied().collect(),
-            vy: ws.field2.iter().skip(1).step_by(2).copied().collect(),
-            qxx: ws
-                .global
-                .iter()
-                .skip(G_QXX)
-                .step_by(N_GLOBAL)
-                .copied()
-                .collect(),
-            qxy: ws
-                .global
-                .iter()
-                .skip(G_QXY)
-                .step_by(N_GLOBAL)
-                .copied()
-                .collect(),
-            pressure: ws
-                .global
-                .chunks_exact(N_GLOBAL)
-                .map(|n| pressure(self.params.pressure, rep, n))
+            vx: ws.field2.field(0),
+            vy: ws.field2.field(1),
+            qxx: ws.global.field(G_QXX),
+            qxy: ws.global.field(G_QXY),
+            pressure: (0..n)
+                .map(|k| {
+                    let g = |c| ws.global.get(c, k);
+                    pressure(self.params.pressure, rep, g(G_S1), g(G_S2), g(G_U))
+                })
                 .collect(),
             ..Default::default()
         };

@@ -27,7 +27,7 @@ pub struct Observables {
 
 impl<T: Real> Tissue<T> {
     /// Refreshes the derived quantities into `ws` and computes the observables of the current
-    /// state. Leaves the tissue velocity field `Σ φ_i v_i` in `ws.field2` (`[vx, vy]` per node).
+    /// state. Leaves the tissue velocity field `Σ φ_i v_i` in `ws.field2` (fields `vx`, `vy`).
     pub fn observe(&mut self, ws: &mut Workspace<T>) -> Observables {
         self.refresh(ws);
         self.scatter_velocity(ws);
@@ -36,7 +36,7 @@ impl<T: Real> Tissue<T> {
         } = ws;
         let cs: &[_] = cell_state;
         let n_nodes = self.lattice().len() as f64;
-        let v2: f64 = field2.iter().map(|v| v * v).sum::<f64>() / n_nodes;
+        let v2: f64 = field2.values().iter().map(|v| v * v).sum::<f64>() / n_nodes;
         let n = cs.len().max(1) as f64;
         let mut o = Observables {
             v_rms: v2.sqrt(),

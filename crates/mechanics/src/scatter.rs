@@ -5,64 +5,125 @@
 //! columns that fall inside it. Every lattice node therefore receives its contributions in cell
 //! order, whatever the number of threads: results are bit-for-bit reproducible.
 //!
-//! A stripe that no patch overlaps is zeroed once and then left alone ([`Stripes`]), so a
-//! scene of a few cells in a large box does no work per step on the nodes no cell covers.
+//! The `K` summed fields live in a [`LatticeSums`], stored stripe by stripe and, inside a
+//! stripe, field by field: one lattice column of one field is a contiguous slice, so that a
+//! run of patch rows ([`phasefield::RowRun`]) reads or writes it as one vectorisable loop.
+//!
+//! A stripe that no patch overlaps is zeroed once and then left alone, so a scene of a few
+//! cells in a large box does no work per step on the nodes no cell covers.
 
-use phasefield::{for_each_stencil_in_column, Cells, Lattice, Real, Stencil};
+use phasefield::{for_each_run_in_column, Cells, Lattice, Real, RowRuns, StencilRun};
 use rayon::prelude::*;
 
 /// Lattice x-rows per scatter stripe (fixed, so that the result never depends on threads).
 pub const STRIPE_ROWS: usize = 8;
 
-/// Which stripes of a scattered lattice field may hold non-zero values: the memory that lets
-/// [`scatter`] skip the stripes no cell overlaps. One per field, kept with it.
+/// `K` lattice-wide fields written by [`scatter`]: the sums over cells of per-node values.
+///
+/// Stored stripe by stripe (see the module docs); read a field with [`LatticeSums::column`],
+/// [`LatticeSums::get`] or [`LatticeSums::field`]. It also remembers which stripes may hold
+/// non-zero values, so that the scatter can skip the stripes no cell overlaps.
 #[derive(Debug, Clone)]
-pub struct Stripes {
+pub struct LatticeSums<const K: usize> {
+    lattice: Lattice,
+    data: Vec<f64>,
     dirty: Vec<bool>,
 }
 
-impl Stripes {
-    /// For a field on `lattice` whose content is unknown: every stripe will be zeroed once.
+impl<const K: usize> LatticeSums<K> {
+    /// `K` fields on `lattice`, all zero.
     pub fn new(lattice: Lattice) -> Self {
         Self {
-            dirty: vec![true; lattice.lx.div_ceil(STRIPE_ROWS)],
+            lattice,
+            data: vec![0.0; lattice.len() * K],
+            dirty: vec![false; lattice.lx.div_ceil(STRIPE_ROWS)],
         }
+    }
+
+    /// The lattice.
+    pub fn lattice(&self) -> Lattice {
+        self.lattice
+    }
+
+    /// Where lattice column `x` of field 0 starts, and the distance from one field to the next.
+    #[inline(always)]
+    fn locate(&self, x: usize) -> (usize, usize) {
+        let ly = self.lattice.ly;
+        let x0 = x - x % STRIPE_ROWS;
+        let rows = STRIPE_ROWS.min(self.lattice.lx - x0);
+        (x0 * ly * K + (x - x0) * ly, rows * ly)
+    }
+
+    /// Lattice column `x` (rows `0..ly`) of field `c`.
+    ///
+    /// # Panics
+    /// If `c >= K` or `x >= lx`.
+    #[inline(always)]
+    pub fn column(&self, c: usize, x: usize) -> &[f64] {
+        assert!(c < K && x < self.lattice.lx);
+        let (base, stride) = self.locate(x);
+        let start = base + c * stride;
+        &self.data[start..start + self.lattice.ly]
+    }
+
+    /// Lattice column `x` of every field.
+    #[inline(always)]
+    pub fn columns(&self, x: usize) -> [&[f64]; K] {
+        std::array::from_fn(|c| self.column(c, x))
+    }
+
+    /// Field `c` at lattice node `node = x * ly + y`.
+    pub fn get(&self, c: usize, node: usize) -> f64 {
+        let ly = self.lattice.ly;
+        self.column(c, node / ly)[node % ly]
+    }
+
+    /// Field `c` as one lattice-sized vector, index `x * ly + y`. Allocates.
+    pub fn field(&self, c: usize) -> Vec<f64> {
+        (0..self.lattice.lx)
+            .flat_map(|x| self.column(c, x).iter().copied())
+            .collect()
+    }
+
+    /// Every value of every field, in storage order (for sums whose order does not matter to
+    /// the caller beyond being fixed).
+    pub fn values(&self) -> &[f64] {
+        &self.data
     }
 }
 
-/// Adds `value(cell_idx, k, stencil)` (K components) of every patch node `k` of every cell
-/// to the lattice field `out`, laid out as `out[node * K + component]`. The stencil holds `φ_i`
-/// at the node and its four neighbours on the periodic patch, widened to `f64`, so that a
-/// value may use derivatives of `φ_i` without a buffer of its own. `out` is overwritten:
-/// nodes no patch covers are zero. `stripes` must be the one kept with `out` (nothing else may
-/// write to `out` between calls).
+/// Adds the contributions of every cell's patch to the `K` fields of `out`, which is
+/// overwritten: nodes no patch covers are zero.
 ///
-/// # Panics
-/// If `out.len() != lattice.len() * K` or `stripes` was made for another lattice.
+/// `add(cell_idx, run, dst)` is called for each [`StencilRun`] of each patch column, with
+/// `dst[c]` the slice of field `c` on the lattice rows of the run (`dst[c][j]` is the node
+/// of `run.c[j]`); it adds its values there. The stencil lets a value use derivatives of `φ_i`
+/// without a buffer of its own.
 pub fn scatter<const K: usize, T: Real, F>(
     cells: &Cells<T>,
     phi: &[T],
-    out: &mut [f64],
-    stripes: &mut Stripes,
-    value: F,
+    out: &mut LatticeSums<K>,
+    add: F,
 ) where
-    F: Fn(usize, usize, &Stencil) -> [f64; K] + Sync,
+    F: Fn(usize, &StencilRun<'_, T>, [&mut [f64]; K]) + Sync,
 {
     let lattice: Lattice = cells.lattice();
+    assert_eq!(out.lattice, lattice, "the sums belong to another lattice");
     let shape = cells.shape();
     let map = cells.map();
     let (nx, ly) = (shape.nx, lattice.ly);
     let plen = shape.len();
-    assert_eq!(out.len(), lattice.len() * K);
-    assert_eq!(stripes.dirty.len(), lattice.lx.div_ceil(STRIPE_ROWS));
-    out.par_chunks_mut(STRIPE_ROWS * ly * K)
-        .zip(stripes.dirty.par_iter_mut())
+    out.data
+        .par_chunks_mut(STRIPE_ROWS * ly * K)
+        .zip(out.dirty.par_iter_mut())
         .enumerate()
         .for_each(|(stripe, (chunk, dirty))| {
             // Zeroed before the first contribution, or at the end if there is none.
             let mut touched = false;
             let x0 = stripe * STRIPE_ROWS;
             let rows = chunk.len() / (ly * K);
+            let mut parts = chunk.chunks_exact_mut(rows * ly);
+            let mut fields: [&mut [f64]; K] = std::array::from_fn(|_| parts.next().unwrap());
             for i in 0..cells.n_cells() {
                 let ox = map.origin[i][0];
                 // (x0 − ox) mod lx without a division: this test runs for every cell in
@@ -76,12 +137,12 @@ pub fn scatter<const K: usize, T: Real, F>(
                 }
                 if !touched {
                     if *dirty {
-                        chunk.iter_mut().for_each(|v| *v = 0.0);
+                        fields.iter_mut().for_each(|f| f.fill(0.0));
                     }
                     touched = true;
                 }
                 let xs = map.cell_x(shape, i);
-                let ys = map.cell_y(shape, i);
+                let runs = RowRuns::new(map.cell_y(shape, i));
                 let cell = &phi[i * plen..(i + 1) * plen];
                 for a in 0..nx {
                     let x = xs[a] as usize;
@@ -89,17 +150,15 @@ pub fn scatter<const K: usize, T: Real, F>(
                         continue;
                     }
                     let base = (x - x0) * ly;
-                    for_each_stencil_in_column(cell, shape, a, &mut |k, _, b, s| {
-                        let v = value(i, k, &s);
-                        let node = &mut chunk[(base + ys[b] as usize) * K..][..K];
-                        for c in 0..K {
-                            node[c] += v[c];
-                        }
+                    for_each_run_in_column(cell, shape, &runs, a, &mut |s| {
+                        let start = base + s.run.y0;
+                        let dst = fields.each_mut().map(|f| &mut f[start..start + s.run.len]);
+                        add(i, &s, dst);
                     });
                 }
             }
             if !touched && *dirty {
-                chunk.iter_mut().for_each(|v| *v = 0.0);
+                fields.iter_mut().for_each(|f| f.fill(0.0));
             }
             *dirty = touched;
         });

@@ -8,16 +8,16 @@
 //!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
-use phasefield::{for_each_stencil, for_each_stencil_at, Cells, ComTable, Lattice, Real};
+use phasefield::{for_each_run_in_column, Cells, ComTable, Lattice, Real, RowRuns};
 use rayon::prelude::*;
 
 use crate::params::{ModelParams, PressureKind, StepParams};
-use crate::scatter::{scatter, Stripes};
+use crate::scatter::{scatter, LatticeSums};
 use crate::StepError;
 
-/// Components of the global (lattice-wide) sums, per node.
+/// Fields of the global (lattice-wide) sums.
 pub const N_GLOBAL: usize = 5;
-/// Index of `s1 = Σ φ_i` in a global node record.
+/// Index of the field `s1 = Σ φ_i` in the global sums.
 pub const G_S1: usize = 0;
 /// Index of `s2 = Σ φ_i²`.
 pub const G_S2: usize = 1;
@@ -29,7 +29,7 @@ pub const G_QXX: usize = 3;
 /// Index of `Q_xy = Σ φ_i S_i,xy`.
 pub const G_QXY: usize = 4;
 
-/// The pressure at a node from its global record (MODEL.md §3).
+/// The pressure at a node from its global sums `s1`, `s2` and `U` (MODEL.md §3).
 ///
 /// Paper: `P = (2κ/λ)(s1 s2 − s3) − (8γ/λ)(s1 − 3 s2 + 2 s3) + 2γλ Σ_i ∇²φ_i
 /// + (4μ/πR²)(s1 − sA/πR²)`, of which every term but `(2κ/λ) s1 s2` is a sum over cells of a
@@ -38,10 +38,10 @@ pub const G_QXY: usize = 4;
 /// whose self term `Σ_x ∇²φ_i ∂φ_i` vanishes exactly, so that an isolated cell feels no force.
 /// Interaction: `P = (2κ/λ)(s2² − s4)`, with `U = −(2κ/λ) s4`.
 #[inline(always)]
-pub fn pressure(kind: PressureKind, repulsion: f64, record: &[f64]) -> f64 {
+pub fn pressure(kind: PressureKind, repulsion: f64, s1: f64, s2: f64, u: f64) -> f64 {
     match kind {
-        PressureKind::Paper => repulsion * record[G_S1] * record[G_S2] + record[G_U],
-        PressureKind::Interaction => repulsion * record[G_S2] * record[G_S2] + record[G_U],
+        PressureKind::Paper => repulsion * s1 * s2 + u,
+        PressureKind::Interaction => repulsion * s2 * s2 + u,
     }
 }
 
@@ -93,16 +93,13 @@ pub struct Workspace<T: Real = f64> {
     phi_old: Vec<T>,
     k1: Vec<T>,
     k2: Vec<T>,
-    /// Global sums, `N_GLOBAL` per lattice node (see the `G_*` indices). Written by each
-    /// evaluation; read it, do not write it (the scatter remembers which stripes are zero).
-    pub global: Vec<f64>,
-    pub(crate) global_stripes: Stripes,
+    /// The global sums, `N_GLOBAL` lattice fields (see the `G_*` indices), written by each
+    /// evaluation.
+    pub global: LatticeSums<N_GLOBAL>,
     /// Per-cell derived quantities of the last evaluation.
     pub cell_state: Vec<CellState>,
-    /// A two-component lattice buffer for derived fields (e.g. the tissue velocity); read it,
-    /// do not write it.
-    pub field2: Vec<f64>,
-    pub(crate) field2_stripes: Stripes,
+    /// Two lattice fields for derived quantities (e.g. the tissue velocity).
+    pub field2: LatticeSums<2>,
     com: ComTable,
 }
 
@@ -115,11 +112,9 @@ impl<T: Real> Workspace<T> {
             phi_old: vec![T::default(); n],
             k1: vec![T::default(); n],
             k2: vec![T::default(); n],
-            global: vec![0.0; lattice.len() * N_GLOBAL],
-            global_stripes: Stripes::new(lattice),
+            global: LatticeSums::new(lattice),
             cell_state: vec![CellState::default(); cells.n_cells()],
-            field2: vec![0.0; lattice.len() * 2],
-            field2_stripes: Stripes::new(lattice),
+            field2: LatticeSums::new(lattice),
             com: ComTable::new(lattice),
         }
     }
@@ -212,7 +207,6 @@ impl<T: Real> Tissue<T> {
         let Workspace {
             k2,
             global,
-            global_stripes,
             cell_state,
             ..
         } = ws;
@@ -223,7 +217,6 @@ impl<T: Real> Tissue<T> {
             true,
             k2,
             global,
-            global_stripes,
             cell_state,
         );
     }
@@ -248,7 +241,6 @@ impl<T: Real> Tissue<T> {
             k1,
             k2,
             global,
-            global_stripes,
             cell_state,
             com,
             ..
@@ -260,7 +252,6 @@ impl<T: Real> Tissue<T> {
             shapes,
             k1,
             global,
-            global_stripes,
             cell_state,
         );
         self.check(cell_state, dt)?;
@@ -279,7 +270,6 @@ impl<T: Real> Tissue<T> {
                 shapes,
                 k2,
                 global,
-                global_stripes,
                 cell_state,
             );
             let phi = self.cells.phi_mut();
@@ -340,23 +330,37 @@ pub const PHI_BOUND: f64 = 2.0;
 fn cell_sums<T: Real, const SHAPE: bool>(
     cell: &[T],
     shape: &phasefield::PatchShape,
+    runs: &RowRuns,
     st: &mut CellState,
 ) {
     let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for_each_stencil(cell, shape, |_, s| {
-        area += s.c * s.c;
-        if SHAPE {
-            let (dx, dy) = (s.dx(), s.dy());
-            sxx += 0.5 * (dy * dy - dx * dx);
-            sxy -= dx * dy;
-        }
-        lo = lo.min(s.c);
-        hi = hi.max(s.c);
-    });
+    let (mut hi, mut neg_lo) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for a in 0..shape.nx {
+        for_each_run_in_column(cell, shape, runs, a, &mut |s| {
+            let sums = s.reduce(
+                [],
+                [0.0; 3],
+                |s, []| {
+                    if SHAPE {
+                        let (dx, dy) = (s.dx(), s.dy());
+                        [s.c * s.c, 0.5 * (dy * dy - dx * dx), -(dx * dy)]
+                    } else {
+                        [s.c * s.c, 0.0, 0.0]
+                    }
+                },
+                |x, y| x + y,
+            );
+            let range = s.reduce([], [f64::NEG_INFINITY; 2], |s, []| [s.c, -s.c], f64::max);
+            area += sums[0];
+            sxx += sums[1];
+            sxy += sums[2];
+            hi = hi.max(range[0]);
+            neg_lo = neg_lo.max(range[1]);
+        });
+    }
     st.area = area;
     st.shape = [sxx, sxy];
-    st.phi_min = lo;
+    st.phi_min = -neg_lo;
     st.phi_max = hi;
 }
 
@@ -366,21 +370,26 @@ fn cell_sums<T: Real, const SHAPE: bool>(
 /// With `shapes` false the deformation tensors are not computed (left zero), and so neither is
 /// `Q`: the step passes `shapes = (ζ ≠ 0)`, since only the active force needs them, which saves
 /// 9 % of a passive step (960 cells, 1 thread: 16.2 → 14.7 ms). Observations always compute them.
+///
+/// Every kernel works on runs of patch rows ([`phasefield::StencilRun`]), whose lattice rows
+/// are contiguous, so that its loops compile to SIMD instructions; per-cell sums are taken in
+/// [`phasefield::LANES`] interleaved partial sums ([`phasefield::lanes`]).
+#[allow(clippy::too_many_arguments)]
 pub fn evaluate<T: Real>(
     params: &ModelParams,
     cells: &Cells<T>,
     phi: &[T],
     shapes: bool,
     rhs: &mut [T],
-    global: &mut [f64],
-    stripes: &mut Stripes,
+    global: &mut LatticeSums<N_GLOBAL>,
     cell_state: &mut [CellState],
 ) {
     let shape = cells.shape();
     let plen = shape.len();
-    let lattice = cells.lattice();
+    let ny = shape.ny;
     let energy = params.energy;
     let zeta = params.zeta;
+    let patch_runs = RowRuns::patch(ny);
 
     // 1. Per cell: area, deformation tensor, range.
     cell_state
@@ -388,9 +397,9 @@ pub fn evaluate<T: Real>(
         .zip(phi.par_chunks(plen))
         .for_each(|(st, cell)| {
             if shapes {
-                cell_sums::<T, true>(cell, shape, st);
+                cell_sums::<T, true>(cell, shape, &patch_runs, st);
             } else {
-                cell_sums::<T, false>(cell, shape, st);
+                cell_sums::<T, false>(cell, shape, &patch_runs, st);
             }
         });
 
@@ -399,25 +408,44 @@ pub fn evaluate<T: Real>(
     let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
-        scatter::<N_GLOBAL, T, _>(cells, phi, global, stripes, |i, _, s| {
+        scatter::<N_GLOBAL, T, _>(cells, phi, global, |i, run, sums| {
             let c = &cs[i];
-            let p = s.c;
-            let p2 = p * p;
-            let u = match kind {
-                PressureKind::Paper => {
-                    -coef.repulsion * p2 * p - coef.double_well * p * (1.0 - p) * (1.0 - 2.0 * p)
-                        + coef.gradient * s.laplacian()
-                        - coef.area_factor(c.area) * p
-                }
-                PressureKind::Interaction => -coef.repulsion * p2 * p2,
+            let n = run.c.len();
+            let [s1, s2, u, qxx, qxy] = sums.map(|f| &mut f[..n]);
+            let area_factor = coef.area_factor(c.area);
+            let [sxx, sxy] = c.shape;
+            let store = |j: usize, [p, p2, uj]: [f64; 3]| {
+                s1[j] += p;
+                s2[j] += p2;
+                u[j] += uj;
+                qxx[j] += p * sxx;
+                qxy[j] += p * sxy;
             };
-            [p, p2, u, p * c.shape[0], p * c.shape[1]]
+            match kind {
+                PressureKind::Paper => run.map(
+                    [],
+                    |s, []| {
+                        let p = s.c;
+                        let p2 = p * p;
+                        let u = -coef.repulsion * p2 * p
+                            - coef.double_well * p * (1.0 - p) * (1.0 - 2.0 * p)
+                            + coef.gradient * s.laplacian()
+                            - area_factor * p;
+                        [p, p2, u]
+                    },
+                    store,
+                ),
+                PressureKind::Interaction => run.map(
+                    [],
+                    |s, []| [s.c, s.c * s.c, -coef.repulsion * s.c.powi(4)],
+                    store,
+                ),
+            }
         });
     }
 
     // 3. Forces, velocities and the right-hand side.
-    let ly = lattice.ly;
-    let g: &[f64] = global;
+    let g: &LatticeSums<N_GLOBAL> = global;
     let map = cells.map();
     let xi = params.xi;
     // The paper's P contains cell i's own double-well term −(8γ/λ) φ_i(1−φ_i)(1−2φ_i). Its
@@ -430,33 +458,65 @@ pub fn evaluate<T: Real>(
         PressureKind::Paper => coef.double_well,
         PressureKind::Interaction => 0.0,
     };
+    // P = rep · first · s2 + U, with first = s1 (paper) or s2 (interaction).
+    let first = match params.pressure {
+        PressureKind::Paper => G_S1,
+        PressureKind::Interaction => G_S2,
+    };
     rhs.par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
         .zip(cell_state.par_iter_mut())
         .enumerate()
         .for_each(|(i, ((out, cell), st))| {
             let xs = map.cell_x(shape, i);
-            let ys = map.cell_y(shape, i);
-            let node = |a: usize, b: usize| (xs[a] as usize) * ly + ys[b] as usize;
+            let runs = RowRuns::new(map.cell_y(shape, i));
             let (mut fx, mut fy) = (0.0, 0.0);
-            for_each_stencil_at(cell, shape, |_, a, b, s| {
-                let n = &g[node(a, b) * N_GLOBAL..][..N_GLOBAL];
-                let p = pressure(kind, coef.repulsion, n)
-                    + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
-                let (qxx, qxy) = (n[G_QXX], n[G_QXY]);
-                let (dx, dy) = (s.dx(), s.dy());
-                fx += p * dx + zeta * (qxx * dx + qxy * dy);
-                fy += p * dy + zeta * (qxy * dx - qxx * dy);
-            });
+            for (a, &x) in xs.iter().enumerate() {
+                let cols = g.columns(x as usize);
+                for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
+                    let y = run.run.y0..run.run.y0 + run.run.len;
+                    let fields = [G_S2, G_U, G_QXX, G_QXY, first].map(|c| &cols[c][y.clone()]);
+                    let f = run.reduce(
+                        fields,
+                        [0.0; 2],
+                        |s, [s2, u, qxx, qxy, s_first]| {
+                            let p = coef.repulsion * s_first * s2
+                                + u
+                                + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
+                            let (dx, dy) = (s.dx(), s.dy());
+                            [
+                                p * dx + zeta * (qxx * dx + qxy * dy),
+                                p * dy + zeta * (qxy * dx - qxx * dy),
+                            ]
+                        },
+                        |x, y| x + y,
+                    );
+                    fx += f[0];
+                    fy += f[1];
+                });
+            }
             let (vx, vy) = (fx / xi, fy / xi);
             st.force = [fx, fy];
             st.velocity = [vx, vy];
             let area_factor = coef.area_factor(st.area);
-            for_each_stencil_at(cell, shape, |k, a, b, s| {
-                let others = g[node(a, b) * N_GLOBAL + G_S2] - s.c * s.c;
-                let dfdphi =
-                    coef.ch(s.c, s.laplacian()) + area_factor * s.c + coef.rep(s.c, others);
-                out[k] = T::from_f64(-(vx * s.dx() + vy * s.dy()) - dfdphi);
-            });
+            for (a, &x) in xs.iter().enumerate() {
+                let s2_col = g.column(G_S2, x as usize);
+                let out_col = &mut out[a * ny..(a + 1) * ny];
+                for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
+                    let (y0, b0, n) = (run.run.y0, run.run.b0, run.run.len);
+                    let o = &mut out_col[b0..b0 + n];
+                    run.map(
+                        [&s2_col[y0..y0 + n]],
+                        |s, [s2]| {
+                            let others = s2 - s.c * s.c;
+                            let dfdphi = coef.ch(s.c, s.laplacian())
+                                + area_factor * s.c
+                                + coef.rep(s.c, others);
+                            [-(vx * s.dx() + vy * s.dy()) - dfdphi]
+                        },
+                        |j, [v]| o[j] = T::from_f64(v),
+                    );
+                });
+            }
         });
 }

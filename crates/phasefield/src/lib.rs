@@ -35,6 +35,7 @@ pub mod init;
 mod lattice;
 mod patch;
 mod real;
+mod runs;
 
 pub use com::ComTable;
 pub use energy::{EnergyCoefficients, EnergyParams};
@@ -44,6 +45,7 @@ pub use patch::{
     Stencil,
 };
 pub use real::Real;
+pub use runs::{for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
 
 /// Errors from building lattices, patches and initial states.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
