@@ -8,7 +8,7 @@
 //!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
-use phasefield::{for_each_run_in_column, Cells, ComTable, Lattice, Real, RowRuns};
+use phasefield::{for_each_run_in_column, Cells, ComTable, Lattice, Real, RowRuns, LANES};
 use rayon::prelude::*;
 
 use crate::params::{ModelParams, PressureKind, StepParams};
@@ -333,35 +333,41 @@ fn cell_sums<T: Real, const SHAPE: bool>(
     runs: &RowRuns,
     st: &mut CellState,
 ) {
-    let (mut area, mut sxx, mut sxy) = (0.0, 0.0, 0.0);
-    let (mut hi, mut neg_lo) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-    for a in 0..shape.nx {
-        for_each_run_in_column(cell, shape, runs, a, &mut |s| {
-            let sums = s.reduce(
-                [],
-                [0.0; 3],
-                |s, []| {
-                    if SHAPE {
-                        let (dx, dy) = (s.dx(), s.dy());
-                        [s.c * s.c, 0.5 * (dy * dy - dx * dx), -(dx * dy)]
-                    } else {
-                        [s.c * s.c, 0.0, 0.0]
-                    }
-                },
-                |x, y| x + y,
-            );
-            let range = s.reduce([], [f64::NEG_INFINITY; 2], |s, []| [s.c, -s.c], f64::max);
-            area += sums[0];
-            sxx += sums[1];
-            sxy += sums[2];
-            hi = hi.max(range[0]);
-            neg_lo = neg_lo.max(range[1]);
-        });
+    // Area and range need no stencil: one pass over the patch in LANES partial results.
+    let mut area = [0.0; LANES];
+    let (mut hi, mut neg_lo) = ([f64::NEG_INFINITY; LANES], [f64::NEG_INFINITY; LANES]);
+    let mut chunks = cell.chunks_exact(LANES);
+    for chunk in &mut chunks {
+        for l in 0..LANES {
+            let c = chunk[l].to_f64();
+            area[l] += c * c;
+            hi[l] = hi[l].max(c);
+            neg_lo[l] = neg_lo[l].max(-c);
+        }
     }
-    st.area = area;
+    for (l, c) in chunks.remainder().iter().enumerate() {
+        let c = c.to_f64();
+        area[l] += c * c;
+        hi[l] = hi[l].max(c);
+        neg_lo[l] = neg_lo[l].max(-c);
+    }
+    st.area = area.iter().sum();
+    st.phi_max = hi.into_iter().fold(f64::NEG_INFINITY, f64::max);
+    st.phi_min = -neg_lo.into_iter().fold(f64::NEG_INFINITY, f64::max);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    if SHAPE {
+        for a in 0..shape.nx {
+            for_each_run_in_column(cell, shape, runs, a, &mut |run| {
+                let [xx, xy] = run.sum([], |s, []| {
+                    let (dx, dy) = (s.dx(), s.dy());
+                    [0.5 * (dy * dy - dx * dx), -(dx * dy)]
+                });
+                sxx += xx;
+                sxy += xy;
+            });
+        }
+    }
     st.shape = [sxx, sxy];
-    st.phi_min = -neg_lo;
-    st.phi_max = hi;
 }
 
 /// One evaluation of the right-hand side `R(φ)` into `rhs`, with every intermediate quantity
@@ -476,21 +482,16 @@ pub fn evaluate<T: Real>(
                 for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
                     let y = run.run.y0..run.run.y0 + run.run.len;
                     let fields = [G_S2, G_U, G_QXX, G_QXY, first].map(|c| &cols[c][y.clone()]);
-                    let f = run.reduce(
-                        fields,
-                        [0.0; 2],
-                        |s, [s2, u, qxx, qxy, s_first]| {
-                            let p = coef.repulsion * s_first * s2
-                                + u
-                                + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
-                            let (dx, dy) = (s.dx(), s.dy());
-                            [
-                                p * dx + zeta * (qxx * dx + qxy * dy),
-                                p * dy + zeta * (qxy * dx - qxx * dy),
-                            ]
-                        },
-                        |x, y| x + y,
-                    );
+                    let f = run.sum(fields, |s, [s2, u, qxx, qxy, s_first]| {
+                        let p = coef.repulsion * s_first * s2
+                            + u
+                            + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
+                        let (dx, dy) = (s.dx(), s.dy());
+                        [
+                            p * dx + zeta * (qxx * dx + qxy * dy),
+                            p * dy + zeta * (qxy * dx - qxx * dy),
+                        ]
+                    });
                     fx += f[0];
                     fy += f[1];
                 });

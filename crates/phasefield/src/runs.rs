@@ -8,7 +8,7 @@
 //! A kernel then sees five equal-length slices ([`StencilRun`]) and no index arithmetic, which
 //! is the form in which loops are compiled to SIMD instructions.
 //!
-//! [`StencilRun::reduce`] is the matching reduction: a sum (or maximum) over a run in
+//! [`StencilRun::sum`] is the matching reduction: a sum over a run in
 //! [`LANES`] interleaved partial results, the form in which a floating-point reduction is
 //! vectorised. The order of the additions depends only on the run's length, never on the
 //! number of threads.
@@ -16,7 +16,7 @@
 use crate::patch::{PatchShape, Stencil};
 use crate::real::Real;
 
-/// Interleaved partial results of [`StencilRun::reduce`]: eight `f64`, one AVX-512 register or two AVX2.
+/// Interleaved partial sums of [`StencilRun::sum`]: eight `f64`, one AVX-512 register or two AVX2.
 pub const LANES: usize = 8;
 
 /// Consecutive storage rows `b0..b0 + len` of a patch column that sit on consecutive lattice
@@ -186,11 +186,12 @@ impl<T: Real> StencilRun<'_, T> {
         }
     }
 
-    /// Reduces `value(stencil, values)` over the run with `op`, component by component, where
-    /// `values[m]` is `fields[m][j]`. The reduction runs in [`LANES`] interleaved partial
-    /// results (`acc[l]` takes the elements `j ≡ l (mod LANES)`), combined at the end in lane
-    /// order, which is the form in which a floating-point reduction compiles to SIMD
-    /// instructions. `init` must be the identity of `op` (0 for a sum, −∞ for a maximum).
+    /// Sums `value(stencil, values)` over the run, component by component, where
+    /// `values[m]` is `fields[m][j]`. The sum runs in [`LANES`] interleaved partial sums
+    /// (`acc[l]` takes the elements `j ≡ l (mod LANES)`), added at the end in lane order,
+    /// which is the form in which a floating-point reduction compiles to SIMD instructions.
+    /// The elements past the last whole chunk go to the lanes they have in the chunk that ends
+    /// at the run's end; a run shorter than [`LANES`] goes to lanes `0, 1, …`.
     ///
     /// The result is a fixed function of the values and the run's length, whatever the number
     /// of threads; it may differ in the last bits from a sequential sum.
@@ -198,58 +199,69 @@ impl<T: Real> StencilRun<'_, T> {
     /// # Panics
     /// If a field is shorter than the run.
     #[inline(always)]
-    pub fn reduce<const M: usize, const K: usize>(
+    pub fn sum<const M: usize, const K: usize>(
         &self,
         fields: [&[f64]; M],
-        init: [f64; K],
         value: impl Fn(Stencil, [f64; M]) -> [f64; K],
-        op: impl Fn(f64, f64) -> f64,
     ) -> [f64; K] {
         let n = self.c.len();
         let fields = fields.map(|f| &f[..n]);
-        let mut acc: [[f64; LANES]; K] = init.map(|v| [v; LANES]);
+        let mut acc = [[0.0; LANES]; K];
         let mut j = 0;
         while j + LANES <= n {
-            let c = load(self.c, j);
-            let (xm, xp) = (load(self.xm, j), load(self.xp, j));
-            let (ym, yp) = (load(self.ym, j), load(self.yp, j));
-            let f: [[f64; LANES]; M] = fields.map(|f| load(f, j));
-            for l in 0..LANES {
-                let s = Stencil {
-                    c: c[l],
-                    xm: xm[l],
-                    xp: xp[l],
-                    ym: ym[l],
-                    yp: yp[l],
-                };
-                let v = value(s, std::array::from_fn(|m| f[m][l]));
-                for k in 0..K {
-                    acc[k][l] = op(acc[k][l], v[k]);
-                }
-            }
+            self.sum_chunk(&fields, j, 0, &value, &mut acc);
             j += LANES;
         }
-        // The last `n mod LANES` elements, one at a time, into lanes 0, 1, ...
-        for (l, j) in (j..n).enumerate() {
+        if j < n && n >= LANES {
+            self.sum_chunk(&fields, n - LANES, LANES - (n - j), &value, &mut acc);
+        } else {
+            for (l, j) in (j..n).enumerate() {
+                let s = Stencil {
+                    c: self.c[j].to_f64(),
+                    xm: self.xm[j].to_f64(),
+                    xp: self.xp[j].to_f64(),
+                    ym: self.ym[j].to_f64(),
+                    yp: self.yp[j].to_f64(),
+                };
+                let v = value(s, std::array::from_fn(|m| fields[m][j]));
+                for k in 0..K {
+                    acc[k][l] += v[k];
+                }
+            }
+        }
+        acc.map(|a| a.iter().sum())
+    }
+
+    /// Adds the `LANES` elements from `j` to the partial sums, except the lanes below `skip`
+    /// (already taken by an earlier chunk), which get a weight of zero: a multiply, not a
+    /// branch, so that the chunk stays one SIMD computation.
+    #[inline(always)]
+    fn sum_chunk<const M: usize, const K: usize>(
+        &self,
+        fields: &[&[f64]; M],
+        j: usize,
+        skip: usize,
+        value: &impl Fn(Stencil, [f64; M]) -> [f64; K],
+        acc: &mut [[f64; LANES]; K],
+    ) {
+        let c = load(self.c, j);
+        let (xm, xp) = (load(self.xm, j), load(self.xp, j));
+        let (ym, yp) = (load(self.ym, j), load(self.yp, j));
+        let f: [[f64; LANES]; M] = fields.map(|f| load(f, j));
+        for l in 0..LANES {
             let s = Stencil {
-                c: self.c[j].to_f64(),
-                xm: self.xm[j].to_f64(),
-                xp: self.xp[j].to_f64(),
-                ym: self.ym[j].to_f64(),
-                yp: self.yp[j].to_f64(),
+                c: c[l],
+                xm: xm[l],
+                xp: xp[l],
+                ym: ym[l],
+                yp: yp[l],
             };
-            let v = value(s, std::array::from_fn(|m| fields[m][j]));
+            let v = value(s, std::array::from_fn(|m| f[m][l]));
+            let w = if l >= skip { 1.0 } else { 0.0 };
             for k in 0..K {
-                acc[k][l] = op(acc[k][l], v[k]);
+                acc[k][l] += w * v[k];
             }
         }
-        let mut out = init;
-        for lanes in acc.iter().zip(out.iter_mut()) {
-            for a in lanes.0 {
-                *lanes.1 = op(*lanes.1, *a);
-            }
-        }
-        out
     }
 }
 
@@ -288,5 +300,104 @@ pub fn for_each_run_in_column<'a, T: Real, F: FnMut(StencilRun<'a, T>)>(
             ym: &row[ym0..ym0 + len],
             yp: &row[yp0..yp0 + len],
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::patch::for_each_stencil;
+    use crate::Lattice;
+    use proptest::prelude::*;
+
+    /// Every patch row map (any side, lattice height, origin and offset) is cut into runs that
+    /// cover the rows once, in order, with contiguous lattice rows and the right periodic
+    /// y-neighbours. Exhaustive over small sizes.
+    #[test]
+    fn runs_cover_every_row_once_with_contiguous_lattice_rows() {
+        for ny in 1..=9 {
+            for ly in ny..=12 {
+                for oy in 0..ly {
+                    for fy in 0..ny {
+                        let ys: Vec<u32> = (0..ny)
+                            .map(|b| ((oy + (b + ny - fy) % ny) % ly) as u32)
+                            .collect();
+                        let runs = RowRuns::new(&ys);
+                        let mut next = 0;
+                        for r in runs.as_slice() {
+                            assert_eq!(r.b0, next, "runs in order, no gap: {ys:?}");
+                            assert!(r.len > 0);
+                            for j in 0..r.len {
+                                let b = r.b0 + j;
+                                assert_eq!(ys[b] as usize, r.y0 + j, "lattice rows: {ys:?}");
+                                if ny > 1 {
+                                    assert_eq!(r.ym0 + j, (b + ny - 1) % ny);
+                                    assert_eq!(r.yp0 + j, (b + 1) % ny);
+                                } else {
+                                    assert_eq!((r.ym0, r.yp0), (0, 0));
+                                }
+                            }
+                            next += r.len;
+                        }
+                        assert_eq!(next, ny);
+                    }
+                }
+            }
+        }
+    }
+
+    /// A periodic `nx × ny` patch (the full domain of that lattice).
+    fn shape(nx: usize, ny: usize) -> PatchShape {
+        PatchShape::new(Lattice::new(nx, ny), 0).expect("margin 0 always fits")
+    }
+
+    proptest! {
+        /// `map` hands each node exactly the stencil `for_each_stencil` does, and `sum` equals
+        /// the sequential sum to round-off (the bound is a few ulps of the sum of magnitudes,
+        /// since only the order of the additions differs).
+        #[test]
+        fn map_and_sum_agree_with_the_node_by_node_stencil(
+            nx in 1usize..12,
+            ny in 1usize..40,
+            seed in any::<u64>(),
+        ) {
+            let shape = shape(nx, ny);
+            let mut state = seed | 1;
+            let phi: Vec<f64> = (0..shape.len())
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    (state >> 11) as f64 / (1u64 << 53) as f64 - 0.25
+                })
+                .collect();
+            let value = |s: crate::Stencil, [w]: [f64; 1]| [s.laplacian() * w, s.dx() * s.dy()];
+            let mut expected = vec![[0.0; 2]; shape.len()];
+            let (mut seq, mut mag) = ([0.0; 2], 0.0);
+            for_each_stencil(&phi, &shape, |k, s| {
+                expected[k] = value(s, [k as f64]);
+                seq[0] += expected[k][0];
+                seq[1] += expected[k][1];
+                mag += expected[k][0].abs() + expected[k][1].abs();
+            });
+            let runs = RowRuns::patch(shape.ny);
+            let mut got = vec![[f64::NAN; 2]; shape.len()];
+            let mut total = [0.0; 2];
+            for a in 0..shape.nx {
+                let weights: Vec<f64> = (0..shape.ny).map(|b| (a * shape.ny + b) as f64).collect();
+                for_each_run_in_column(&phi, &shape, &runs, a, &mut |run| {
+                    let (b0, n) = (run.run.b0, run.run.len);
+                    let w = &weights[b0..b0 + n];
+                    let out = &mut got[a * shape.ny + b0..][..n];
+                    run.map([w], value, |j, v| out[j] = v);
+                    let s = run.sum([w], value);
+                    total[0] += s[0];
+                    total[1] += s[1];
+                });
+            }
+            prop_assert_eq!(&got, &expected);
+            let tol = 8.0 * f64::EPSILON * mag;
+            prop_assert!((total[0] - seq[0]).abs() <= tol && (total[1] - seq[1]).abs() <= tol);
+        }
     }
 }
