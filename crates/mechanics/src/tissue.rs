@@ -8,7 +8,9 @@
 //!    [`evaluate`] for the self term), the velocity
 //!    `v_i = F_i/ξ`, then `R_i = −v_i·∇φ_i − δF/δφ_i` on the same patch while it is in cache.
 
-use phasefield::{for_each_run_in_column, Cells, ComTable, Lattice, Real, RowRuns, LANES};
+use phasefield::{
+    add_lanes, for_each_run_in_column, Cells, ComTable, Lattice, Real, RowRuns, Stencil, LANES,
+};
 use rayon::prelude::*;
 
 use crate::params::{ModelParams, PressureKind, StepParams};
@@ -354,20 +356,19 @@ fn cell_sums<T: Real, const SHAPE: bool>(
     st.area = area.iter().sum();
     st.phi_max = hi.into_iter().fold(f64::NEG_INFINITY, f64::max);
     st.phi_min = -neg_lo.into_iter().fold(f64::NEG_INFINITY, f64::max);
-    let (mut sxx, mut sxy) = (0.0, 0.0);
+    let mut acc = [[0.0; LANES]; 2];
     if SHAPE {
         for a in 0..shape.nx {
             for_each_run_in_column(cell, shape, runs, a, &mut |run| {
-                let [xx, xy] = run.sum([], |s, []| {
+                let value = |s: Stencil, []: [f64; 0]| {
                     let (dx, dy) = (s.dx(), s.dy());
                     [0.5 * (dy * dy - dx * dx), -(dx * dy)]
-                });
-                sxx += xx;
-                sxy += xy;
+                };
+                run.sum_into([], value, &mut acc);
             });
         }
     }
-    st.shape = [sxx, sxy];
+    st.shape = add_lanes(&acc);
 }
 
 /// One evaluation of the right-hand side `R(φ)` into `rhs`, with every intermediate quantity
@@ -476,13 +477,13 @@ pub fn evaluate<T: Real>(
         .for_each(|(i, ((out, cell), st))| {
             let xs = map.cell_x(shape, i);
             let runs = RowRuns::new(map.cell_y(shape, i));
-            let (mut fx, mut fy) = (0.0, 0.0);
+            let mut acc = [[0.0; LANES]; 2];
             for (a, &x) in xs.iter().enumerate() {
                 let cols = g.columns(x as usize);
                 for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
                     let y = run.run.y0..run.run.y0 + run.run.len;
                     let fields = [G_S2, G_U, G_QXX, G_QXY, first].map(|c| &cols[c][y.clone()]);
-                    let f = run.sum(fields, |s, [s2, u, qxx, qxy, s_first]| {
+                    let value = |s: Stencil, [s2, u, qxx, qxy, s_first]: [f64; 5]| {
                         let p = coef.repulsion * s_first * s2
                             + u
                             + c_self * s.c * (1.0 - s.c) * (1.0 - 2.0 * s.c);
@@ -491,11 +492,11 @@ pub fn evaluate<T: Real>(
                             p * dx + zeta * (qxx * dx + qxy * dy),
                             p * dy + zeta * (qxy * dx - qxx * dy),
                         ]
-                    });
-                    fx += f[0];
-                    fy += f[1];
+                    };
+                    run.sum_into(fields, value, &mut acc);
                 });
             }
+            let [fx, fy] = add_lanes(&acc);
             let (vx, vy) = (fx / xi, fy / xi);
             st.force = [fx, fy];
             st.velocity = [vx, vy];

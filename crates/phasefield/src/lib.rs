@@ -45,7 +45,7 @@ pub use patch::{
     Stencil,
 };
 pub use real::Real;
-pub use runs::{for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
+pub use runs::{add_lanes, for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
 
 /// Errors from building lattices, patches and initial states.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -1,27 +1,27 @@
 //! Stencils a run of rows at a time, for kernels the compiler can vectorise.
 //!
-//! A patch column (storage column `a`, rows `b = 0..ny`) is cut into at most five
-//! [`RowRun`]s. Inside a run the storage rows are consecutive, the lattice rows are
-//! consecutive (so a lattice field is read or written as one contiguous slice), and the
-//! y-neighbours of the run's rows are the consecutive storage rows `ym0..` and `yp0..`. The
-//! two patch-edge rows, whose y-neighbour wraps around the patch, are runs of one row each.
-//! A kernel then sees five equal-length slices ([`StencilRun`]) and no index arithmetic, which
-//! is the form in which loops are compiled to SIMD instructions.
+//! A patch column (storage column `a`, rows `b = 0..ny`) is cut into [`RowRun`]s: storage
+//! rows that sit on consecutive lattice rows, so that a lattice field is read or written as
+//! one contiguous slice. A patch's rows wrap at most once in the patch (the storage offset)
+//! and once on the lattice, so a column has at most three runs, and usually one or two.
+//! [`for_each_run_in_column`] hands each run to a kernel as five equal-length slices
+//! ([`StencilRun`]): the centres and the four neighbours. The y-neighbours come from a copy of
+//! the column with one wrapped row at each end, so that the patch-periodic wrap costs no run of
+//! its own. A kernel then has no index arithmetic, which is the form in which loops compile
+//! to SIMD instructions.
 //!
-//! [`StencilRun::sum`] is the matching reduction: a sum over a run in
-//! [`LANES`] interleaved partial results, the form in which a floating-point reduction is
-//! vectorised. The order of the additions depends only on the run's length, never on the
-//! number of threads.
+//! [`StencilRun::sum_into`] is the matching reduction: a sum over a run in [`LANES`]
+//! interleaved partial sums, the form in which a floating-point reduction is vectorised. The
+//! order of the additions depends only on the runs, never on the number of threads.
 
 use crate::patch::{PatchShape, Stencil};
 use crate::real::Real;
 
-/// Interleaved partial sums of [`StencilRun::sum`]: eight `f64`, one AVX-512 register or two AVX2.
+/// Interleaved partial sums of [`StencilRun::sum_into`]: eight `f64`, one AVX-512 register or two AVX2.
 pub const LANES: usize = 8;
 
 /// Consecutive storage rows `b0..b0 + len` of a patch column that sit on consecutive lattice
-/// rows `y0..y0 + len`, with their y-neighbours at storage rows `ym0..ym0 + len` and
-/// `yp0..yp0 + len`.
+/// rows `y0..y0 + len`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct RowRun {
     /// First storage row.
@@ -30,17 +30,13 @@ pub struct RowRun {
     pub len: usize,
     /// Lattice row of storage row `b0`.
     pub y0: usize,
-    /// Storage row of the `y − 1` neighbour of `b0`.
-    pub ym0: usize,
-    /// Storage row of the `y + 1` neighbour of `b0`.
-    pub yp0: usize,
 }
 
 /// The runs that cover the rows `0..ny` of every column of one patch (the same for all its
 /// columns, since a patch's storage-to-lattice row map does not depend on the column).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RowRuns {
-    runs: [RowRun; 5],
+    runs: [RowRun; 3],
     n: usize,
 }
 
@@ -49,80 +45,40 @@ impl RowRuns {
     /// [`crate::PatchMap::cell_y`]).
     ///
     /// # Panics
-    /// If `ys` is empty, or if consecutive rows of it jump more than twice (a patch row map
-    /// wraps at most once in the patch and once on the lattice).
+    /// If `ys` is empty, or if it jumps more than twice (a patch row map wraps at most once in
+    /// the patch and once on the lattice).
     pub fn new(ys: &[u32]) -> Self {
-        Self::from_rows(ys.len(), |b| ys[b] as usize)
-    }
-
-    /// The runs of a patch without regard to the lattice: an edge row, the interior, an edge
-    /// row (`y0` is the storage row). For kernels that touch no lattice field.
-    pub fn patch(ny: usize) -> Self {
-        Self::from_rows(ny, |b| b)
-    }
-
-    fn from_rows(ny: usize, ys: impl Fn(usize) -> usize) -> Self {
-        assert!(ny > 0, "a patch has at least one row");
+        assert!(!ys.is_empty(), "a patch has at least one row");
         let mut runs = Self {
-            runs: [RowRun::default(); 5],
+            runs: [RowRun::default(); 3],
             n: 0,
         };
-        if ny == 1 {
-            runs.push(RowRun {
-                b0: 0,
-                len: 1,
-                y0: ys(0),
-                ym0: 0,
-                yp0: 0,
-            });
-            return runs;
-        }
-        runs.push(RowRun {
-            b0: 0,
-            len: 1,
-            y0: ys(0),
-            ym0: ny - 1,
-            yp0: 1,
-        });
-        let mut start = 1;
-        for b in 2..ny {
-            if ys(b) != ys(b - 1) + 1 {
-                runs.push_interior(ys(start), start, b);
+        let mut start = 0;
+        for b in 1..=ys.len() {
+            if b == ys.len() || ys[b] != ys[b - 1] + 1 {
+                assert!(runs.n < 3, "a patch row map jumps at most twice: {ys:?}");
+                runs.runs[runs.n] = RowRun {
+                    b0: start,
+                    len: b - start,
+                    y0: ys[start] as usize,
+                };
+                runs.n += 1;
                 start = b;
             }
         }
-        if ny > 2 {
-            runs.push_interior(ys(start), start, ny - 1);
-        }
-        runs.push(RowRun {
-            b0: ny - 1,
-            len: 1,
-            y0: ys(ny - 1),
-            ym0: ny - 2,
-            yp0: 0,
-        });
         runs
     }
 
-    fn push_interior(&mut self, y0: usize, start: usize, end: usize) {
-        if end > start {
-            self.push(RowRun {
-                b0: start,
-                len: end - start,
-                y0,
-                ym0: start - 1,
-                yp0: start + 1,
-            });
-        }
-    }
-
-    fn push(&mut self, run: RowRun) {
-        assert!(
-            self.n < self.runs.len(),
-            "a patch row map jumps at most twice"
-        );
-        self.runs[self.n] = run;
-        self.n += 1;
+    /// One run of all `ny` rows, for kernels that touch no lattice field (`y0` = 0).
+    pub fn patch(ny: usize) -> Self {
+        assert!(ny > 0, "a patch has at least one row");
+        let mut runs = [RowRun::default(); 3];
+        runs[0] = RowRun {
+            b0: 0,
+            len: ny,
+            y0: 0,
+        };
+        Self { runs, n: 1 }
     }
 
     /// The runs, in storage order.
@@ -186,34 +142,35 @@ impl<T: Real> StencilRun<'_, T> {
         }
     }
 
-    /// Sums `value(stencil, values)` over the run, component by component, where
-    /// `values[m]` is `fields[m][j]`. The sum runs in [`LANES`] interleaved partial sums
-    /// (`acc[l]` takes the elements `j ≡ l (mod LANES)`), added at the end in lane order,
-    /// which is the form in which a floating-point reduction compiles to SIMD instructions.
-    /// The elements past the last whole chunk go to the lanes they have in the chunk that ends
-    /// at the run's end; a run shorter than [`LANES`] goes to lanes `0, 1, …`.
+    /// Adds `value(stencil, values)` of every element of the run to the [`LANES`] partial
+    /// sums `acc`, component by component, where `values[m]` is `fields[m][j]`: element `j`
+    /// goes to lane `j mod LANES`, except the elements past the last whole chunk, which go to
+    /// the lanes they have in the chunk that ends at the run's end (a run shorter than
+    /// [`LANES`] goes to lanes `0, 1, …`). This is the form in which a floating-point sum
+    /// compiles to SIMD instructions; keep `acc` over all the runs of a patch and add its
+    /// lanes once at the end ([`add_lanes`]).
     ///
-    /// The result is a fixed function of the values and the run's length, whatever the number
-    /// of threads; it may differ in the last bits from a sequential sum.
+    /// The result is a fixed function of the values and the runs, whatever the number of
+    /// threads; it may differ in the last bits from a sequential sum.
     ///
     /// # Panics
     /// If a field is shorter than the run.
     #[inline(always)]
-    pub fn sum<const M: usize, const K: usize>(
+    pub fn sum_into<const M: usize, const K: usize>(
         &self,
         fields: [&[f64]; M],
         value: impl Fn(Stencil, [f64; M]) -> [f64; K],
-    ) -> [f64; K] {
+        acc: &mut [[f64; LANES]; K],
+    ) {
         let n = self.c.len();
         let fields = fields.map(|f| &f[..n]);
-        let mut acc = [[0.0; LANES]; K];
         let mut j = 0;
         while j + LANES <= n {
-            self.sum_chunk(&fields, j, 0, &value, &mut acc);
+            self.sum_chunk(&fields, j, 0, &value, acc);
             j += LANES;
         }
         if j < n && n >= LANES {
-            self.sum_chunk(&fields, n - LANES, LANES - (n - j), &value, &mut acc);
+            self.sum_chunk(&fields, n - LANES, LANES - (n - j), &value, acc);
         } else {
             for (l, j) in (j..n).enumerate() {
                 let s = Stencil {
@@ -229,7 +186,6 @@ impl<T: Real> StencilRun<'_, T> {
                 }
             }
         }
-        acc.map(|a| a.iter().sum())
     }
 
     /// Adds the `LANES` elements from `j` to the partial sums, except the lanes below `skip`
@@ -265,6 +221,12 @@ impl<T: Real> StencilRun<'_, T> {
     }
 }
 
+/// The sums of [`LANES`] partial sums, each added in lane order.
+#[inline(always)]
+pub fn add_lanes<const K: usize>(acc: &[[f64; LANES]; K]) -> [f64; K] {
+    acc.map(|a| a.iter().sum())
+}
+
 /// `LANES` values of `s` from element `j`, widened to `f64`.
 #[inline(always)]
 fn load<T: Real>(s: &[T], j: usize) -> [f64; LANES] {
@@ -272,13 +234,18 @@ fn load<T: Real>(s: &[T], j: usize) -> [f64; LANES] {
     a.map(T::to_f64)
 }
 
+/// Columns up to this many rows get their y-neighbours from a copy on the stack (see the
+/// module docs); longer ones (full-domain storage) split their first and last rows into runs
+/// of one row, whose cost is negligible there.
+pub const MAX_COPIED_ROWS: usize = 64;
+
 /// Calls `f` with the [`StencilRun`] of each run of storage column `a` of one patch.
 ///
 /// # Panics
 /// If `phi.len() != shape.len()`, `a >= shape.nx` or the runs are not a patch's of this shape.
 #[inline(always)]
-pub fn for_each_run_in_column<'a, T: Real, F: FnMut(StencilRun<'a, T>)>(
-    phi: &'a [T],
+pub fn for_each_run_in_column<T: Real, F: FnMut(StencilRun<'_, T>)>(
+    phi: &[T],
     shape: &PatchShape,
     runs: &RowRuns,
     a: usize,
@@ -288,17 +255,57 @@ pub fn for_each_run_in_column<'a, T: Real, F: FnMut(StencilRun<'a, T>)>(
     let row = &phi[a * ny..(a + 1) * ny];
     let row_m = &phi[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
     let row_p = &phi[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
-    for &run in runs.as_slice() {
-        let RowRun {
-            b0, len, ym0, yp0, ..
-        } = run;
+    // Each piece is a run with the storage rows of its y∓1 neighbours, taken from `ext` or
+    // from the row itself. One call site of `f`, so that the kernel is inlined once.
+    let mut pieces = [(RowRun::default(), 0, 0); 5];
+    let mut count = 0;
+    // ext[b] is row b − 1, periodic: the y−1 neighbours of rows b0.. are ext[b0..], the y+1
+    // neighbours ext[b0 + 2..].
+    let mut ext = [T::default(); MAX_COPIED_ROWS + 2];
+    let copied = ny <= MAX_COPIED_ROWS;
+    if copied {
+        ext[0] = row[ny - 1];
+        ext[1..=ny].copy_from_slice(row);
+        ext[ny + 1] = row[0];
+        for &run in runs.as_slice() {
+            pieces[count] = (run, run.b0, run.b0 + 2);
+            count += 1;
+        }
+    } else {
+        for &run in runs.as_slice() {
+            // Cut off the patch's first and last rows, whose neighbours wrap.
+            let end = run.b0 + run.len;
+            let first = usize::from(run.b0 == 0);
+            let last = usize::from(end == ny && run.len > first);
+            let piece = |b0: usize, len: usize, ym0: usize, yp0: usize| {
+                let y0 = run.y0 + (b0 - run.b0);
+                (RowRun { b0, len, y0 }, ym0, yp0)
+            };
+            if first == 1 {
+                pieces[count] = piece(0, 1, ny - 1, 1);
+                count += 1;
+            }
+            let (b0, b1) = (run.b0 + first, end - last);
+            if b1 > b0 {
+                pieces[count] = piece(b0, b1 - b0, b0 - 1, b0 + 1);
+                count += 1;
+            }
+            if last == 1 {
+                pieces[count] = piece(ny - 1, 1, ny - 2, 0);
+                count += 1;
+            }
+        }
+    }
+    let neighbours: &[T] = if copied { &ext } else { row };
+    for &(run, ym0, yp0) in &pieces[..count] {
+        let RowRun { b0, len, .. } = run;
         f(StencilRun {
             run,
             c: &row[b0..b0 + len],
             xm: &row_m[b0..b0 + len],
             xp: &row_p[b0..b0 + len],
-            ym: &row[ym0..ym0 + len],
-            yp: &row[yp0..yp0 + len],
+            ym: &neighbours[ym0..ym0 + len],
+            yp: &neighbours[yp0..yp0 + len],
         });
     }
 }
@@ -310,32 +317,31 @@ mod tests {
     use crate::Lattice;
     use proptest::prelude::*;
 
-    /// Every patch row map (any side, lattice height, origin and offset) is cut into runs that
-    /// cover the rows once, in order, with contiguous lattice rows and the right periodic
-    /// y-neighbours. Exhaustive over small sizes.
+    /// The lattice rows of storage rows `0..ny` of a patch with origin row `oy` and storage
+    /// offset `fy` on a lattice of height `ly` (as `PatchMap` builds them).
+    fn rows(ny: usize, ly: usize, oy: usize, fy: usize) -> Vec<u32> {
+        (0..ny)
+            .map(|b| ((oy + (b + ny - fy) % ny) % ly) as u32)
+            .collect()
+    }
+
+    /// Every patch row map (any side, lattice height, origin and offset) is cut into at most
+    /// three runs that cover the rows once, in order, with contiguous lattice rows.
+    /// Exhaustive over small sizes.
     #[test]
     fn runs_cover_every_row_once_with_contiguous_lattice_rows() {
         for ny in 1..=9 {
             for ly in ny..=12 {
                 for oy in 0..ly {
                     for fy in 0..ny {
-                        let ys: Vec<u32> = (0..ny)
-                            .map(|b| ((oy + (b + ny - fy) % ny) % ly) as u32)
-                            .collect();
+                        let ys = rows(ny, ly, oy, fy);
                         let runs = RowRuns::new(&ys);
                         let mut next = 0;
                         for r in runs.as_slice() {
                             assert_eq!(r.b0, next, "runs in order, no gap: {ys:?}");
                             assert!(r.len > 0);
                             for j in 0..r.len {
-                                let b = r.b0 + j;
-                                assert_eq!(ys[b] as usize, r.y0 + j, "lattice rows: {ys:?}");
-                                if ny > 1 {
-                                    assert_eq!(r.ym0 + j, (b + ny - 1) % ny);
-                                    assert_eq!(r.yp0 + j, (b + 1) % ny);
-                                } else {
-                                    assert_eq!((r.ym0, r.yp0), (0, 0));
-                                }
+                                assert_eq!(ys[r.b0 + j] as usize, r.y0 + j, "{ys:?}");
                             }
                             next += r.len;
                         }
@@ -352,16 +358,22 @@ mod tests {
     }
 
     proptest! {
-        /// `map` hands each node exactly the stencil `for_each_stencil` does, and `sum` equals
-        /// the sequential sum to round-off (the bound is a few ulps of the sum of magnitudes,
-        /// since only the order of the additions differs).
+        /// `map` hands each node exactly the stencil `for_each_stencil` does, and `sum_into`
+        /// gives the sequential sum to round-off (the bound is a few ulps of the sum of
+        /// magnitudes, since only the order of the additions differs): on runs cut by any row
+        /// map, for columns copied to the stack and for longer ones.
         #[test]
         fn map_and_sum_agree_with_the_node_by_node_stencil(
-            nx in 1usize..12,
-            ny in 1usize..40,
+            nx in 1usize..8,
+            ny in prop_oneof![1usize..40, MAX_COPIED_ROWS - 2..MAX_COPIED_ROWS + 6],
+            extra in 0usize..5,
+            oy in 0usize..1000,
+            fy in 0usize..1000,
             seed in any::<u64>(),
         ) {
             let shape = shape(nx, ny);
+            let ly = ny + extra;
+            let runs = RowRuns::new(&rows(ny, ly, oy % ly, fy % ny));
             let mut state = seed | 1;
             let phi: Vec<f64> = (0..shape.len())
                 .map(|_| {
@@ -380,9 +392,8 @@ mod tests {
                 seq[1] += expected[k][1];
                 mag += expected[k][0].abs() + expected[k][1].abs();
             });
-            let runs = RowRuns::patch(shape.ny);
             let mut got = vec![[f64::NAN; 2]; shape.len()];
-            let mut total = [0.0; 2];
+            let mut acc = [[0.0; LANES]; 2];
             for a in 0..shape.nx {
                 let weights: Vec<f64> = (0..shape.ny).map(|b| (a * shape.ny + b) as f64).collect();
                 for_each_run_in_column(&phi, &shape, &runs, a, &mut |run| {
@@ -390,12 +401,11 @@ mod tests {
                     let w = &weights[b0..b0 + n];
                     let out = &mut got[a * shape.ny + b0..][..n];
                     run.map([w], value, |j, v| out[j] = v);
-                    let s = run.sum([w], value);
-                    total[0] += s[0];
-                    total[1] += s[1];
+                    run.sum_into([w], value, &mut acc);
                 });
             }
             prop_assert_eq!(&got, &expected);
+            let total = add_lanes(&acc);
             let tol = 8.0 * f64::EPSILON * mag;
             prop_assert!((total[0] - seq[0]).abs() <= tol && (total[1] - seq[1]).abs() <= tol);
         }
