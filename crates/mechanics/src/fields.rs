@@ -38,7 +38,9 @@ impl<T: Real> Tissue<T> {
         let cs: &[_] = cell_state;
         scatter::<2, T, _>(&self.cells, self.cells.phi(), field2, |i, run, sums| {
             let [ux, uy] = cs[i].velocity;
-            let [vx, vy] = sums.map(|f| &mut f[..run.c.len()]);
+            let [vx, vy] = sums;
+            let n = run.c.len();
+            let (vx, vy) = (&mut vx[..n], &mut vy[..n]);
             run.map(
                 [],
                 |s, []| [s.c * ux, s.c * uy],

@@ -152,7 +152,11 @@ pub fn scatter<const K: usize, T: Real, F>(
                     let base = (x - x0) * ly;
                     for_each_run_in_column(cell, shape, &runs, a, &mut |s| {
                         let start = base + s.run.y0;
-                        let dst = fields.each_mut().map(|f| &mut f[start..start + s.run.len]);
+                        let mut parts = fields.iter_mut();
+                        let dst = std::array::from_fn(|_| {
+                            let f = parts.next().expect("K fields");
+                            &mut f[start..start + s.run.len]
+                        });
                         add(i, &s, dst);
                     });
                 }

@@ -418,7 +418,9 @@ pub fn evaluate<T: Real>(
         scatter::<N_GLOBAL, T, _>(cells, phi, global, |i, run, sums| {
             let c = &cs[i];
             let n = run.c.len();
-            let [s1, s2, u, qxx, qxy] = sums.map(|f| &mut f[..n]);
+            let [s1, s2, u, qxx, qxy] = sums;
+            let (s1, s2, u) = (&mut s1[..n], &mut s2[..n], &mut u[..n]);
+            let (qxx, qxy) = (&mut qxx[..n], &mut qxy[..n]);
             let area_factor = coef.area_factor(c.area);
             let [sxx, sxy] = c.shape;
             let store = |j: usize, [p, p2, uj]: [f64; 3]| {
@@ -482,7 +484,13 @@ pub fn evaluate<T: Real>(
                 let cols = g.columns(x as usize);
                 for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
                     let y = run.run.y0..run.run.y0 + run.run.len;
-                    let fields = [G_S2, G_U, G_QXX, G_QXY, first].map(|c| &cols[c][y.clone()]);
+                    let fields = [
+                        &cols[G_S2][y.clone()],
+                        &cols[G_U][y.clone()],
+                        &cols[G_QXX][y.clone()],
+                        &cols[G_QXY][y.clone()],
+                        &cols[first][y],
+                    ];
                     let value = |s: Stencil, [s2, u, qxx, qxy, s_first]: [f64; 5]| {
                         let p = coef.repulsion * s_first * s2
                             + u

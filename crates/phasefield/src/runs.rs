@@ -129,7 +129,7 @@ impl<T: Real> StencilRun<'_, T> {
             &self.ym[..n],
             &self.yp[..n],
         );
-        let fields = fields.map(|f| &f[..n]);
+        let fields: [&[f64]; M] = std::array::from_fn(|m| &fields[m][..n]);
         for j in 0..n {
             let s = Stencil {
                 c: c[j].to_f64(),
@@ -163,7 +163,7 @@ impl<T: Real> StencilRun<'_, T> {
         acc: &mut [[f64; LANES]; K],
     ) {
         let n = self.c.len();
-        let fields = fields.map(|f| &f[..n]);
+        let fields: [&[f64]; M] = std::array::from_fn(|m| &fields[m][..n]);
         let mut j = 0;
         while j + LANES <= n {
             self.sum_chunk(&fields, j, 0, &value, acc);
@@ -203,7 +203,7 @@ impl<T: Real> StencilRun<'_, T> {
         let c = load(self.c, j);
         let (xm, xp) = (load(self.xm, j), load(self.xp, j));
         let (ym, yp) = (load(self.ym, j), load(self.yp, j));
-        let f: [[f64; LANES]; M] = fields.map(|f| load(f, j));
+        let f: [[f64; LANES]; M] = std::array::from_fn(|m| load(fields[m], j));
         for l in 0..LANES {
             let s = Stencil {
                 c: c[l],
@@ -224,14 +224,14 @@ impl<T: Real> StencilRun<'_, T> {
 /// The sums of [`LANES`] partial sums, each added in lane order.
 #[inline(always)]
 pub fn add_lanes<const K: usize>(acc: &[[f64; LANES]; K]) -> [f64; K] {
-    acc.map(|a| a.iter().sum())
+    std::array::from_fn(|k| acc[k].iter().sum())
 }
 
 /// `LANES` values of `s` from element `j`, widened to `f64`.
 #[inline(always)]
 fn load<T: Real>(s: &[T], j: usize) -> [f64; LANES] {
-    let a: &[T; LANES] = s[j..j + LANES].try_into().expect("LANES elements");
-    a.map(T::to_f64)
+    let a = &s[j..j + LANES];
+    std::array::from_fn(|l| a[l].to_f64())
 }
 
 /// Columns up to this many rows get their y-neighbours from a copy on the stack (see the
