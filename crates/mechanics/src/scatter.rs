@@ -28,6 +28,10 @@ pub struct LatticeSums<const K: usize> {
     lattice: Lattice,
     data: Vec<f64>,
     dirty: Vec<bool>,
+    /// The cells that overlap each stripe, in index order: `members[offsets[s]..offsets[s + 1]]`
+    /// (rebuilt by every scatter; kept here so that it is allocated once).
+    offsets: Vec<usize>,
+    members: Vec<u32>,
 }
 
 impl<const K: usize> LatticeSums<K> {
@@ -37,7 +41,72 @@ impl<const K: usize> LatticeSums<K> {
             lattice,
             data: vec![0.0; lattice.len() * K],
             dirty: vec![false; lattice.lx.div_ceil(STRIPE_ROWS)],
+            offsets: vec![0; lattice.lx.div_ceil(STRIPE_ROWS) + 1],
+            members: Vec::new(),
         }
+    }
+
+    /// `K` fields on `lattice`, all zero, with room to index `n_cells` patches `nx` columns
+    /// wide, so that no scatter of such cells allocates.
+    pub fn for_cells(lattice: Lattice, n_cells: usize, nx: usize) -> Self {
+        let mut sums = Self::new(lattice);
+        sums.members
+            .reserve_exact(n_cells * Self::most_stripes(sums.dirty.len(), nx));
+        sums
+    }
+
+    /// The most stripes a patch `nx` columns wide can overlap.
+    fn most_stripes(n_stripes: usize, nx: usize) -> usize {
+        (nx / STRIPE_ROWS + 3).min(n_stripes)
+    }
+
+    /// Lists the cells that overlap each stripe, in index order (a counting sort by stripe):
+    /// O(cells), where testing every cell in every stripe is O(cells × stripes).
+    fn index_stripes(&mut self, origins: &[[usize; 2]], nx: usize) {
+        let lx = self.lattice.lx;
+        let n_stripes = self.dirty.len();
+        // The stripes of the patch columns x = ox .. ox + nx (mod lx), each once: the part up
+        // to the lattice's edge, then the wrapped part, without the stripes the first part
+        // already holds.
+        let stripes = |ox: usize| {
+            let end = ox + nx;
+            let first = ox / STRIPE_ROWS..=(end.min(lx) - 1) / STRIPE_ROWS;
+            let wrapped = if end > lx {
+                0..((end - lx - 1) / STRIPE_ROWS + 1).min(ox / STRIPE_ROWS)
+            } else {
+                0..0
+            };
+            first.chain(wrapped)
+        };
+        self.offsets.fill(0);
+        for o in origins {
+            for s in stripes(o[0]) {
+                self.offsets[s + 1] += 1;
+            }
+        }
+        for s in 0..n_stripes {
+            self.offsets[s + 1] += self.offsets[s];
+        }
+        let total = self.offsets[n_stripes];
+        if self.members.capacity() < total {
+            // Room for every cell in its largest possible number of stripes, so that cells
+            // moving later never make this grow again.
+            let most = Self::most_stripes(n_stripes, nx);
+            self.members.reserve_exact(origins.len() * most);
+        }
+        self.members.resize(total, 0);
+        // `offsets[s]` is now the next free slot of stripe s; afterwards it is the end of
+        // stripe s, which is the start of stripe s + 1, hence the shift below.
+        for (i, o) in origins.iter().enumerate() {
+            for s in stripes(o[0]) {
+                self.members[self.offsets[s]] = i as u32;
+                self.offsets[s] += 1;
+            }
+        }
+        for s in (1..=n_stripes).rev() {
+            self.offsets[s] = self.offsets[s - 1];
+        }
+        self.offsets[0] = 0;
     }
 
     /// The lattice.
@@ -113,34 +182,25 @@ pub fn scatter<const K: usize, T: Real, F>(
     let map = cells.map();
     let (nx, ly) = (shape.nx, lattice.ly);
     let plen = shape.len();
+    out.index_stripes(&map.origin, nx);
+    let (offsets, members) = (&out.offsets, &out.members);
     out.data
         .par_chunks_mut(STRIPE_ROWS * ly * K)
         .zip(out.dirty.par_iter_mut())
         .enumerate()
         .for_each(|(stripe, (chunk, dirty))| {
-            // Zeroed before the first contribution, or at the end if there is none.
-            let mut touched = false;
             let x0 = stripe * STRIPE_ROWS;
             let rows = chunk.len() / (ly * K);
             let mut parts = chunk.chunks_exact_mut(rows * ly);
             let mut fields: [&mut [f64]; K] = std::array::from_fn(|_| parts.next().unwrap());
-            for i in 0..cells.n_cells() {
-                let ox = map.origin[i][0];
-                // (x0 − ox) mod lx without a division: this test runs for every cell in
-                // every stripe.
-                let mut u0 = x0 + lattice.lx - ox;
-                if u0 >= lattice.lx {
-                    u0 -= lattice.lx;
-                }
-                if u0 >= nx && u0 + rows <= lattice.lx {
-                    continue;
-                }
-                if !touched {
-                    if *dirty {
-                        fields.iter_mut().for_each(|f| f.fill(0.0));
-                    }
-                    touched = true;
-                }
+            let overlapping = &members[offsets[stripe]..offsets[stripe + 1]];
+            // A stripe that is not dirty holds zeros already.
+            if *dirty {
+                fields.iter_mut().for_each(|f| f.fill(0.0));
+            }
+            *dirty = !overlapping.is_empty();
+            for &i in overlapping {
+                let i = i as usize;
                 let xs = map.cell_x(shape, i);
                 let runs = RowRuns::new(map.cell_y(shape, i));
                 let cell = &phi[i * plen..(i + 1) * plen];
@@ -161,9 +221,38 @@ pub fn scatter<const K: usize, T: Real, F>(
                     });
                 }
             }
-            if !touched && *dirty {
-                fields.iter_mut().for_each(|f| f.fill(0.0));
-            }
-            *dirty = touched;
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stripe index lists each cell, in index order, in exactly the stripes that its patch
+    /// columns fall in: exhaustive over origins, for lattices whose width is and is not a
+    /// multiple of the stripe, and patches up to the lattice's width.
+    #[test]
+    fn each_stripe_lists_exactly_the_cells_whose_columns_fall_in_it() {
+        for lx in [8, 13, 24, 30] {
+            let lattice = Lattice::new(lx, 5);
+            let n_stripes = lx.div_ceil(STRIPE_ROWS);
+            for nx in [1, 3, 7, 9, lx - 1, lx] {
+                let origins: Vec<[usize; 2]> = (0..lx).map(|ox| [ox, 0]).collect();
+                let mut sums = LatticeSums::<1>::for_cells(lattice, origins.len(), nx);
+                let capacity = sums.members.capacity();
+                sums.index_stripes(&origins, nx);
+                assert_eq!(sums.members.capacity(), capacity, "no allocation");
+                for s in 0..n_stripes {
+                    let listed: Vec<usize> = sums.members[sums.offsets[s]..sums.offsets[s + 1]]
+                        .iter()
+                        .map(|&i| i as usize)
+                        .collect();
+                    let expected: Vec<usize> = (0..origins.len())
+                        .filter(|&i| (0..nx).any(|u| (origins[i][0] + u) % lx / STRIPE_ROWS == s))
+                        .collect();
+                    assert_eq!(listed, expected, "lx {lx}, nx {nx}, stripe {s}");
+                }
+            }
+        }
+    }
 }

@@ -114,9 +114,9 @@ impl<T: Real> Workspace<T> {
             phi_old: vec![T::default(); n],
             k1: vec![T::default(); n],
             k2: vec![T::default(); n],
-            global: LatticeSums::new(lattice),
+            global: LatticeSums::for_cells(lattice, cells.n_cells(), cells.shape().nx),
             cell_state: vec![CellState::default(); cells.n_cells()],
-            field2: LatticeSums::new(lattice),
+            field2: LatticeSums::for_cells(lattice, cells.n_cells(), cells.shape().nx),
             com: ComTable::new(lattice),
         }
     }
