@@ -81,6 +81,17 @@ impl PatchShape {
     pub fn is_full_domain(&self) -> bool {
         self.margin.is_none()
     }
+
+    /// Storage column `a` of one patch's values and its periodic neighbours `a − 1`, `a + 1`.
+    ///
+    /// # Panics
+    /// If `phi.len() != self.len()` or `a >= self.nx`.
+    #[inline(always)]
+    pub fn column_and_neighbours<'a, T>(&self, phi: &'a [T], a: usize) -> [&'a [T]; 3] {
+        let ny = self.ny;
+        let col = |c: usize| &phi[c * ny..(c + 1) * ny];
+        [col(a), col(self.xm[a]), col(self.xp[a])]
+    }
 }
 
 /// The values of the five-point stencil around one node.
@@ -162,9 +173,7 @@ pub fn for_each_stencil_in_column<T: Real, F: FnMut(usize, usize, usize, Stencil
     f: &mut F,
 ) {
     let ny = shape.ny;
-    let row = &phi[a * ny..(a + 1) * ny];
-    let row_m = &phi[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
-    let row_p = &phi[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
+    let [row, row_m, row_p] = shape.column_and_neighbours(phi, a);
     let k0 = a * ny;
     if ny == 1 {
         f(

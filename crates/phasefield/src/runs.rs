@@ -252,9 +252,7 @@ pub fn for_each_run_in_column<T: Real, F: FnMut(StencilRun<'_, T>)>(
     f: &mut F,
 ) {
     let ny = shape.ny;
-    let row = &phi[a * ny..(a + 1) * ny];
-    let row_m = &phi[shape.xm[a] * ny..(shape.xm[a] + 1) * ny];
-    let row_p = &phi[shape.xp[a] * ny..(shape.xp[a] + 1) * ny];
+    let [row, row_m, row_p] = shape.column_and_neighbours(phi, a);
     // Each piece is a run with the storage rows of its y∓1 neighbours, taken from `ext` or
     // from the row itself. One call site of `f`, so that the kernel is inlined once.
     let mut pieces = [(RowRun::default(), 0, 0); 5];
@@ -316,6 +314,8 @@ mod tests {
     use crate::patch::for_each_stencil;
     use crate::Lattice;
     use proptest::prelude::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
 
     /// The lattice rows of storage rows `0..ny` of a patch with origin row `oy` and storage
     /// offset `fy` on a lattice of height `ly` (as `PatchMap` builds them).
@@ -374,15 +374,8 @@ mod tests {
             let shape = shape(nx, ny);
             let ly = ny + extra;
             let runs = RowRuns::new(&rows(ny, ly, oy % ly, fy % ny));
-            let mut state = seed | 1;
-            let phi: Vec<f64> = (0..shape.len())
-                .map(|_| {
-                    state ^= state << 13;
-                    state ^= state >> 7;
-                    state ^= state << 17;
-                    (state >> 11) as f64 / (1u64 << 53) as f64 - 0.25
-                })
-                .collect();
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let phi: Vec<f64> = (0..shape.len()).map(|_| rng.random_range(-0.25..0.75)).collect();
             let value = |s: crate::Stencil, [w]: [f64; 1]| [s.laplacian() * w, s.dx() * s.dy()];
             let mut expected = vec![[0.0; 2]; shape.len()];
             let (mut seq, mut mag) = ([0.0; 2], 0.0);
