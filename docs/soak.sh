@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Soak run of issue 4: 1000 cells at the paper's density (408² lattice), 100 TU relaxation,
-# then 10^4 TU at zeta = 0.005 with the default integrator (margin 16, dt 0.5, Heun), on
+# then 10^4 TU at zeta = 0.005 with the default integrator (margin 16, dt 0.5, Heun, f32), on
 # 2 threads. Prints the wall time, the peak memory, the mean cell area over three windows
 # (a drift would show there) and the range of phi over the whole run.
 # Usage: bash docs/soak.sh [OUT_DIR] [--set key=value ...]   (about 5 minutes on 2 cores)
