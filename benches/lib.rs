@@ -40,6 +40,18 @@ pub fn relaxed_scene<T: Real>(
     (t, ws, s)
 }
 
+/// The `--set` overrides of the scaling runs: `n` cells in an `l × l` box with the paper's
+/// margin 12 and dt 0.2 (`large.toml` has the paper's density).
+pub fn scaling_overrides(n: usize, l: usize) -> [String; 5] {
+    [
+        format!("cells.count={n}"),
+        format!("domain.lx={l}"),
+        format!("domain.ly={l}"),
+        "integrator.margin=12".into(),
+        "integrator.dt=0.2".into(),
+    ]
+}
+
 /// The studies' starting state: 60 cells in 100² (paper parameters, seed 1) relaxed for
 /// 50 TU at ζ = 0 with dt 0.2 and the given patch margin.
 pub fn relaxed_paper_state(margin: usize) -> Tissue {

@@ -9,7 +9,7 @@
 use criterion::measurement::WallTime;
 use criterion::{criterion_main, BenchmarkGroup, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
-use monolayer_benches::{pool, relaxed_scene};
+use monolayer_benches::{pool, relaxed_scene, scaling_overrides};
 use monolayer_cli::scene::Scene;
 use phasefield::Real;
 
@@ -75,13 +75,7 @@ fn bench_scaling(c: &mut Criterion) {
         (3840, 800),
         (9600, 1265),
     ] {
-        let overrides = [
-            format!("cells.count={n}"),
-            format!("domain.lx={l}"),
-            format!("domain.ly={l}"),
-            "integrator.margin=12".into(),
-            "integrator.dt=0.2".into(),
-        ];
+        let overrides = scaling_overrides(n, l);
         let (mut t, mut ws, s) =
             pool.install(|| relaxed_scene::<f64>("large.toml", &overrides, RELAX_STEPS, 0.005));
         let sp = s.step_params();

@@ -39,13 +39,7 @@ fn main() {
     let steps: usize = args.get(2).map_or(10, |a| a.parse().expect(usage));
     let threads: usize = args.get(3).map_or(2, |a| a.parse().expect(usage));
     let f32 = args.get(4).is_some_and(|a| a == "f32");
-    let overrides = [
-        format!("cells.count={n}"),
-        format!("domain.lx={l}"),
-        format!("domain.ly={l}"),
-        "integrator.margin=12".into(),
-        "integrator.dt=0.2".into(),
-    ];
+    let overrides = monolayer_benches::scaling_overrides(n, l);
     let pool = monolayer_benches::pool(threads);
     let step_s = pool.install(|| {
         if f32 {

@@ -171,20 +171,13 @@ impl<T: Real> StencilRun<'_, T> {
         }
         if j < n && n >= LANES {
             self.sum_chunk(&fields, n - LANES, LANES - (n - j), &value, acc);
-        } else {
-            for (l, j) in (j..n).enumerate() {
-                let s = Stencil {
-                    c: self.c[j].to_f64(),
-                    xm: self.xm[j].to_f64(),
-                    xp: self.xp[j].to_f64(),
-                    ym: self.ym[j].to_f64(),
-                    yp: self.yp[j].to_f64(),
-                };
-                let v = value(s, std::array::from_fn(|m| fields[m][j]));
+        } else if n < LANES {
+            // A short run, one element at a time into lanes 0, 1, …
+            self.map(fields, &value, |l, v| {
                 for k in 0..K {
                     acc[k][l] += v[k];
                 }
-            }
+            });
         }
     }
 
