@@ -22,7 +22,7 @@ use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
 use crate::output::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
-use crate::scene::Scene;
+use scene::{Scene, SceneFile};
 
 /// Options of `monolayer analyze`.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,13 +117,13 @@ fn read_scene(run_dir: &Path) -> Result<Scene> {
             run_dir.display()
         )
     })?;
-    let scene = Scene::parse(&text, &[]).with_context(|| {
+    let file = SceneFile::parse(&text, &[]).with_context(|| {
         format!(
             "{} does not parse with this version of monolayer",
             path.display()
         )
     })?;
-    scene
+    let scene = file
         .validate()
         .with_context(|| format!("in {}", path.display()))?;
     Ok(scene)
@@ -167,7 +167,7 @@ fn load_frame(
         lattice.lx,
         lattice.ly
     );
-    let n = scene.cells.count;
+    let n = scene.file().cells.count;
     let want = vec![n as u64, shape.nx as u64, shape.ny as u64];
     ensure!(
         phi.shape == want,
@@ -187,14 +187,7 @@ fn load_frame(
         .chunks_exact(2)
         .map(|s| [s[0], s[1]])
         .collect();
-    let tissue = Tissue {
-        centre: vec![[0.0; 2]; n],
-        cell_id: (0..n).collect(),
-        cells,
-        params: scene.model_params(zeta),
-        time,
-        step,
-    };
+    let tissue = Tissue::from_state(cells, scene.model_params(zeta), time, step, (0..n).collect());
     Ok((tissue, shapes, step))
 }
 
@@ -227,14 +220,14 @@ fn csv(path: &Path) -> Result<BufWriter<File>> {
 /// On a missing, partial or foreign run directory, with what is wrong.
 pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let scene = read_scene(run_dir)?;
-    let lattice = Lattice::new(scene.domain.lx, scene.domain.ly);
-    let shape = PatchShape::new(lattice, scene.integrator.margin)?;
+    let lattice = scene.lattice();
+    let shape = scene.patch_shape();
     let (frames, partial) = list_frames(run_dir)?;
     if partial > 0 {
         eprintln!("note: skipping {partial} partially written frame(s)");
     }
-    let from = opts.from.unwrap_or(scene.run.relax_time);
-    let radius = scene.cells.radius;
+    let from = opts.from.unwrap_or(scene.file().run.relax_time);
+    let radius = scene.file().cells.radius;
     let box_side = opts
         .box_side
         .unwrap_or_else(|| paper_box_side(radius).min(lattice.lx.min(lattice.ly) | 1));
@@ -289,8 +282,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
     for path in &selected {
-        let (mut tissue, shapes, step) = load_frame(path, &scene, &shape, lattice)?;
-        let ws = ws.get_or_insert_with(|| Workspace::new(&tissue.cells));
+        let (tissue, shapes, step) = load_frame(path, &scene, &shape, lattice)?;
+        let ws = ws.get_or_insert_with(|| Workspace::new(tissue.cells()));
         let f = tissue.fields(ws);
         let smooth = |v: &[f64]| box_smooth(lattice, v, box_side).expect("checked above");
         let (svx, svy) = (smooth(&f.vx), smooth(&f.vy));
@@ -301,7 +294,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         corr[2].add(&[&sqxx, &sqxy]);
         let found = detect(lattice, &sqxx, &sqxy);
         let tracks = tracker.push(&found);
-        let time = tissue.time;
+        let time = tissue.time();
         for (d, t) in found.iter().zip(&tracks.track) {
             writeln!(
                 defects_csv,

@@ -6,7 +6,8 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use monolayer_cli::analyze::{analyze, AnalyzeOptions};
-use monolayer_cli::{run, scene::Scene};
+use monolayer_cli::run;
+use scene::Scene;
 
 /// Multi-phase-field simulations of cell monolayers (Mueller, Yeomans & Doostmohammadi, PRL 2019).
 #[derive(Parser)]
@@ -91,9 +92,6 @@ fn real_main() -> Result<()> {
             let text = std::fs::read_to_string(&scene)
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
             let parsed = Scene::parse(&text, &set)
-                .with_context(|| format!("in scene {}", scene.display()))?;
-            parsed
-                .validate()
                 .with_context(|| format!("in scene {}", scene.display()))?;
             run::prepare_output(&out, overwrite)?;
             let pool = pool(threads)?;

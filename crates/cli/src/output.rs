@@ -53,9 +53,9 @@ impl SeriesWriter {
         writeln!(
             self.out,
             "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}",
-            tissue.step,
-            tissue.time,
-            tissue.params.zeta,
+            tissue.iteration(),
+            tissue.time(),
+            tissue.params().zeta,
             o.v_rms,
             o.s_rms,
             o.area_mean,
@@ -93,27 +93,27 @@ pub(crate) fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
 pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -> Result<PathBuf> {
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames)?;
-    let path = frames.join(format!("frame_{:08}.npz", tissue.step));
-    let n = tissue.cells.n_cells();
-    let shape = tissue.cells.shape();
+    let path = frames.join(format!("frame_{:08}.npz", tissue.iteration()));
+    let n = tissue.n_cells();
+    let shape = tissue.cells().shape();
     let (nx, ny) = (shape.nx, shape.ny);
-    let cs = &ws.cell_state;
+    let cs = ws.cells();
     let lattice = tissue.lattice();
     // Cells are written in identity order, whatever their storage order.
     let slots = tissue.slots();
     let cs: Vec<_> = slots.iter().map(|&s| cs[s]).collect();
-    let centre: Vec<[f64; 2]> = slots.iter().map(|&s| tissue.centre[s]).collect();
-    let origin = &tissue.cells.map().origin;
+    let centre: Vec<[f64; 2]> = slots.iter().map(|&s| ws.centres()[s]).collect();
+    let origin = &tissue.cells().map().origin;
     let mut phi = vec![0.0; n * nx * ny];
     for (chunk, &slot) in phi.chunks_exact_mut(nx * ny).zip(&slots) {
-        tissue.cells.unrolled_into(slot, chunk);
+        tissue.cells().unrolled_into(slot, chunk);
     }
     let n64 = n as u64;
     let arrays: Vec<(&str, Vec<u8>)> = vec![
         ("format", npy(&[], [FRAME_FORMAT])?),
-        ("step", npy(&[], [tissue.step as i64])?),
-        ("time", npy(&[], [tissue.time])?),
-        ("zeta", npy(&[], [tissue.params.zeta])?),
+        ("step", npy(&[], [tissue.iteration() as i64])?),
+        ("time", npy(&[], [tissue.time()])?),
+        ("zeta", npy(&[], [tissue.params().zeta])?),
         (
             "lattice",
             npy(&[2], [lattice.lx as i64, lattice.ly as i64])?,
@@ -121,13 +121,13 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
         ("centre", npy(&[n64, 2], centre.iter().flatten().copied())?),
         (
             "velocity",
-            npy(&[n64, 2], cs.iter().flat_map(|c| c.velocity))?,
+            npy(&[n64, 2], cs.iter().flat_map(|c| [c.velocity.x, c.velocity.y]))?,
         ),
-        ("force", npy(&[n64, 2], cs.iter().flat_map(|c| c.force))?),
+        ("force", npy(&[n64, 2], cs.iter().flat_map(|c| [c.force.x, c.force.y]))?),
         ("area", npy(&[n64], cs.iter().map(|c| c.area))?),
         (
             "shape_tensor",
-            npy(&[n64, 2], cs.iter().flat_map(|c| c.shape))?,
+            npy(&[n64, 2], cs.iter().flat_map(|c| c.shape.components()))?,
         ),
         (
             "origin",

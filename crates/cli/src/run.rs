@@ -1,17 +1,18 @@
-//! `monolayer run`: relaxation at ζ = 0, then the active phase, with series rows and frames
-//! on their schedules.
+//! `monolayer run`: builds the scene's [`Simulation`] and adds the output writers of a run
+//! directory (series rows, frames) and a progress report, each on its schedule.
 
+use std::cell::Cell;
 use std::io::IsTerminal;
-use std::path::Path;
-use std::time::Instant;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mechanics::{Observables, Observer, Tissue, Workspace};
+use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
 use phasefield::Real;
+use scene::Scene;
 
 use crate::output::{write_frame, SeriesWriter};
-use crate::scene::{Precision, Scene};
 
 /// What a finished run reports.
 #[derive(Debug, Clone, Copy)]
@@ -49,8 +50,11 @@ pub fn prepare_output(out: &Path, overwrite: bool) -> Result<()> {
     Ok(())
 }
 
-/// Runs a validated scene, writing into `out`. On a step error the output written so far is
+/// Runs a valid scene, writing into `out`. On a step error the output written so far is
 /// kept and the error is returned.
+///
+/// # Errors
+/// When the directory cannot be written or the run stops early.
 pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     std::fs::create_dir_all(out)
         .with_context(|| format!("cannot create output directory {}", out.display()))?;
@@ -58,82 +62,98 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
-    match scene.integrator.precision {
+    match scene.precision() {
         Precision::F64 => run_in::<f64>(scene, out, quiet),
         Precision::F32 => run_in::<f32>(scene, out, quiet),
     }
 }
 
 fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
-    let mut tissue: Tissue<T> = scene.build_in()?;
-    let mut ws = Workspace::new(&tissue.cells);
-    let protocol = scene.protocol();
-    let sched = scene.schedule();
-    let mut writer = Writer {
-        out,
-        series: SeriesWriter::create(out)?,
-        frame_every: sched.frame_every,
-        series_every: sched.series_every,
-        frames: 0,
-        progress: Progress::new(protocol.total_steps(), quiet),
-    };
-    let start = Instant::now();
-    mechanics::run(&mut tissue, &mut ws, &protocol, &mut writer).with_context(|| {
+    let counts = scene.step_counts();
+    let mut sim = scene.simulation::<T>();
+    let frames = Rc::new(Cell::new(0));
+    sim.add_output_writer(
+        "series.csv",
+        Schedule::IterationInterval(counts.series_every),
+        FinalToo::new(SeriesRows(SeriesWriter::create(out)?)),
+    );
+    sim.add_output_writer(
+        "frame writer",
+        Schedule::IterationInterval(counts.frame_every),
+        FinalToo::new(Frames {
+            out: out.to_path_buf(),
+            written: frames.clone(),
+        }),
+    );
+    sim.add_output_writer(
+        "progress",
+        Schedule::IterationInterval(counts.series_every.min(counts.frame_every)),
+        FinalToo::new(Progress::new(counts.total_steps(), quiet)),
+    );
+    let result = sim.run();
+    let info = result.with_context(|| {
         format!(
             "the run stopped; output up to step {} is kept in {}",
-            tissue.step,
+            sim.tissue().iteration(),
             out.display()
         )
     })?;
-    writer.progress.finish();
     Ok(RunInfo {
-        steps: protocol.total_steps(),
-        wall_s: start.elapsed().as_secs_f64(),
-        frames: writer.frames,
+        steps: info.iterations,
+        wall_s: info.wall_time.as_secs_f64(),
+        frames: frames.get(),
     })
 }
 
-/// Writes series rows and frames on their schedules.
-struct Writer<'a> {
-    out: &'a Path,
-    series: SeriesWriter,
-    frame_every: u64,
-    series_every: u64,
-    frames: usize,
-    progress: Progress,
+/// A writer that also writes the final state, unless its schedule just did.
+struct FinalToo<W> {
+    inner: W,
+    last: Option<u64>,
 }
 
-impl Writer<'_> {
-    fn wants_frame(&self, step: u64, total: u64) -> bool {
-        step.is_multiple_of(self.frame_every) || step == total
-    }
-    fn wants_series(&self, step: u64, total: u64) -> bool {
-        step.is_multiple_of(self.series_every) || step == total
+impl<W> FinalToo<W> {
+    fn new(inner: W) -> Self {
+        Self { inner, last: None }
     }
 }
 
-impl Observer for Writer<'_> {
-    type Error = anyhow::Error;
-
-    fn wants(&self, step: u64, total: u64) -> bool {
-        self.wants_frame(step, total) || self.wants_series(step, total)
+impl<T: Real, W: Callback<T>> Callback<T> for FinalToo<W> {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        self.last = Some(obs.iteration());
+        self.inner.call(obs)
     }
 
-    fn observe<T: Real>(
-        &mut self,
-        tissue: &Tissue<T>,
-        ws: &Workspace<T>,
-        o: &Observables,
-    ) -> Result<()> {
-        let total = self.progress.total;
-        if self.wants_series(tissue.step, total) {
-            self.series.row(tissue, o)?;
+    fn finalize(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        if self.last != Some(obs.iteration()) {
+            self.call(obs)?;
         }
-        if self.wants_frame(tissue.step, total) {
-            write_frame(self.out, tissue, ws)?;
-            self.frames += 1;
-        }
-        self.progress.report(tissue.step, tissue.time, o.v_rms);
+        self.inner.finalize(obs)
+    }
+}
+
+/// Rows of `series.csv`.
+struct SeriesRows(SeriesWriter);
+
+impl<T: Real> Callback<T> for SeriesRows {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        let o = obs.observables();
+        self.0.row(obs.tissue(), &o)?;
+        Ok(())
+    }
+}
+
+/// Frames in `frames/`.
+struct Frames {
+    out: PathBuf,
+    written: Rc<Cell<usize>>,
+}
+
+impl<T: Real> Callback<T> for Frames {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        let tissue = obs.tissue();
+        let ws = obs.workspace();
+        write_frame(&self.out, tissue, ws)?;
+        self.written.set(self.written.get() + 1);
         Ok(())
     }
 }
@@ -143,7 +163,7 @@ struct Progress {
     bar: Option<ProgressBar>,
     total: u64,
     quiet: bool,
-    next_line: std::cell::Cell<u64>,
+    next_line: u64,
 }
 
 impl Progress {
@@ -162,26 +182,31 @@ impl Progress {
             bar,
             total,
             quiet,
-            next_line: std::cell::Cell::new(0),
+            next_line: 0,
         }
     }
+}
 
-    fn report(&self, step: u64, time: f64, v_rms: f64) {
+impl<T: Real> Callback<T> for Progress {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        let (step, time, v_rms) = (obs.iteration(), obs.time(), obs.observables().v_rms);
         if let Some(b) = &self.bar {
             b.set_position(step);
             b.set_message(format!("t = {time:.1}  v_rms = {v_rms:.3e}"));
-        } else if !self.quiet && (step >= self.next_line.get() || step == self.total) {
+        } else if !self.quiet && (step >= self.next_line || step == self.total) {
             eprintln!(
                 "step {step}/{}  t = {time:.1}  v_rms = {v_rms:.3e}",
                 self.total
             );
-            self.next_line.set(step + self.total.div_ceil(10).max(1));
+            self.next_line = step + self.total.div_ceil(10).max(1);
         }
+        Ok(())
     }
 
-    fn finish(&self) {
+    fn finalize(&mut self, _: &mut Observation<'_, T>) -> Result<(), CallbackError> {
         if let Some(b) = &self.bar {
             b.finish();
         }
+        Ok(())
     }
 }

@@ -4,8 +4,11 @@
 
 use phasefield::Real;
 
+use crate::equations::pressure;
+use crate::geometry::TracelessTensor;
 use crate::scatter::scatter;
-use crate::tissue::{pressure, Tissue, Workspace, G_QXX, G_QXY, G_S1, G_S2, G_U};
+use crate::tissue::Tissue;
+use crate::workspace::{SumField, Workspace};
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -29,15 +32,17 @@ pub struct TissueFields {
 }
 
 impl<T: Real> Tissue<T> {
-    /// Scatters the tissue velocity `Σ_i φ_i v_i` into `ws.field2` (fields `vx`, `vy`), from
-    /// the velocities of the last evaluation.
+    /// Scatters the tissue velocity `Σ_i φ_i v_i` into the workspace, from the velocities
+    /// of the last evaluation.
     pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
         let Workspace {
-            cell_state, field2, ..
+            cell_state,
+            velocity_field,
+            ..
         } = ws;
         let cs: &[_] = cell_state;
-        scatter::<2, T, _>(&self.cells, self.cells.phi(), field2, |i, run, sums| {
-            let [ux, uy] = cs[i].velocity;
+        scatter::<2, T, _>(&self.cells, self.cells.phi(), velocity_field, |i, run, sums| {
+            let [ux, uy] = [cs[i].velocity.x, cs[i].velocity.y];
             let [vx, vy] = sums;
             let n = run.c.len();
             let (vx, vy) = (&mut vx[..n], &mut vy[..n]);
@@ -54,28 +59,41 @@ impl<T: Real> Tissue<T> {
 
     /// Evaluates the state and returns its lattice fields. Allocates the result; meant for
     /// output steps, not for the time step.
-    pub fn fields(&mut self, ws: &mut Workspace<T>) -> TissueFields {
+    ///
+    /// The pressure is [`crate::equations::pressure`] of the lattice sums, the formula the
+    /// force kernel uses.
+    pub fn fields(&self, ws: &mut Workspace<T>) -> TissueFields {
         self.refresh(ws);
         self.scatter_velocity(ws);
-        let n = self.lattice().len();
         let zeta = self.params.zeta;
-        let rep = self.params.energy.coefficients().repulsion;
+        let coef = self.params.energy.coefficients();
+        let [vx, vy] = ws.velocity_field();
+        let [s1, s2, u] = [SumField::S1, SumField::S2, SumField::U].map(|f| ws.sum_field(f));
         let mut f = TissueFields {
-            vx: ws.field2.field(0),
-            vy: ws.field2.field(1),
-            qxx: ws.global.field(G_QXX),
-            qxy: ws.global.field(G_QXY),
-            pressure: (0..n)
-                .map(|k| {
-                    let g = |c| ws.global.get(c, k);
-                    pressure(self.params.pressure, rep, g(G_S1), g(G_S2), g(G_U))
-                })
+            vx,
+            vy,
+            qxx: ws.sum_field(SumField::Qxx),
+            qxy: ws.sum_field(SumField::Qxy),
+            pressure: s1
+                .iter()
+                .zip(&s2)
+                .zip(&u)
+                .map(|((&s1, &s2), &u)| pressure(self.params.pressure, &coef, s1, s2, u))
                 .collect(),
             ..Default::default()
         };
+        let n = f.pressure.len();
         f.sigma_xx = (0..n).map(|k| -f.pressure[k] - zeta * f.qxx[k]).collect();
         f.sigma_yy = (0..n).map(|k| -f.pressure[k] + zeta * f.qxx[k]).collect();
         f.sigma_xy = (0..n).map(|k| -zeta * f.qxy[k]).collect();
         f
+    }
+}
+
+impl TissueFields {
+    /// The nematic field `Q` at lattice node `node` as a tensor (its axis is the local
+    /// director).
+    pub fn q(&self, node: usize) -> TracelessTensor {
+        TracelessTensor::new(self.qxx[node], self.qxy[node])
     }
 }

@@ -4,52 +4,88 @@
 //! advances it in time (MODEL.md §3–4; Mueller, Yeomans & Doostmohammadi, PRL 122, 048004, 2019).
 //!
 //! Principal types:
-//! - [`ModelParams`] (with [`PressureKind`]) and [`StepParams`]: the physics and the integrator.
-//! - [`Tissue`]: fields, parameters and clock; [`Tissue::step`] advances by one time step.
+//! - [`ModelParams`] (with [`PressureKind`]) and [`StepParams`]: the physics and the
+//!   integrator, with documented defaults.
+//! - [`Tissue`]: the model, fields, parameters and clock; [`Tissue::step`] advances it by
+//!   one time step, [`Tissue::observe`] and [`Tissue::fields`] evaluate it without stepping.
 //! - [`Workspace`]: all scratch memory of a step, built once; the step allocates nothing.
-//! - [`Observables`]: `v_rms`, `S_rms` and the area statistics of a state.
-//! - [`run`] with a [`Protocol`] (relaxation, then activity) and an [`Observer`]: a whole run.
+//! - [`Simulation`]: the driver, with stop criteria and scheduled [`Callback`]s and output
+//!   writers ([`Schedule`], [`Observation`]).
+//! - [`equations`]: each equation of MODEL.md §3–4 as one named function.
+//! - [`Observables`], [`TissueFields`]: what a state looks like, as scalars or lattice fields;
+//!   vectors are nalgebra [`Vector2`]s and `S_i`, `Q` are [`TracelessTensor`]s.
 //!
-//! The equations, as implemented:
-//! - stress `σ = −P𝕀 − ζQ`, with `Q(x) = Σ_i φ_i(x) S_i`;
-//! - force `F_i = Σ_x [P ∇φ_i + ζ Q·∇φ_i]`, velocity `v_i = F_i/ξ`;
-//! - `∂_t φ_i = −v_i·∇φ_i − δF/δφ_i`, by Heun's predictor–corrector (or forward Euler).
+//! The equations, as implemented (see [`equations`] for each, and the crate `phasefield` for
+//! `δF/δφ_i`):
+//! - deformation `S_i = −Σ_x [∇φ_i ∇φ_iᵀ − ½|∇φ_i|²𝕀]`, nematic field `Q(x) = Σ_i φ_i(x) S_i`;
+//! - stress `σ = −P𝕀 − ζQ`, with the pressure `P` of [`equations::pressure`];
+//! - force `F_i = Σ_x [(P − P_i^self) ∇φ_i + ζ Q·∇φ_i]`, velocity `v_i = F_i/ξ`;
+//! - `∂_t φ_i = R_i = −v_i·∇φ_i − δF/δφ_i`, by Heun's predictor–corrector (or forward Euler).
 //!
 //! Every result is independent of the number of rayon threads, bit for bit: per-cell sums run
-//! inside one task and lattice-wide sums add cells in index order ([`scatter`]).
+//! inside one task and lattice-wide sums add cells in index order.
+//!
+//! Stepping a tissue by hand, then its observables and fields:
 //!
 //! ```
-//! use mechanics::{ModelParams, StepParams, Tissue, Workspace};
+//! use mechanics::prelude::*;
 //! use phasefield::{init, Lattice, PatchShape};
 //!
 //! let lattice = Lattice::new(48, 48);
 //! let shape = PatchShape::new(lattice, 12).unwrap();
 //! let cells = init::discs(lattice, shape, &[[16.0, 24.0], [30.0, 24.0]], 7.0, 2.5);
-//! let mut tissue = Tissue::new(cells, ModelParams::paper(0.0));
-//! let mut ws = Workspace::new(&tissue.cells);
+//! let mut tissue = Tissue::new(cells, ModelParams::paper(0.005));
+//! let mut ws = Workspace::new(tissue.cells());
 //! for _ in 0..10 {
-//!     tissue.step(&mut ws, &StepParams { dt: 0.2, npc: 1 }).unwrap();
+//!     tissue.step(&mut ws, &StepParams::paper()).unwrap();
 //! }
 //! let o = tissue.observe(&mut ws);
 //! assert!(o.area_mean > 100.0 && o.v_rms.is_finite());
+//! // The two cells repel: their velocities point apart along x.
+//! let (v0, v1) = (ws.cell(0).velocity, ws.cell(1).velocity);
+//! assert!(v0.x < 0.0 && v1.x > 0.0);
+//! // The long axis of a cell from its deformation tensor.
+//! let (_, axis) = ws.cell(0).shape.axis();
+//! assert!((axis.norm() - 1.0).abs() < 1e-12);
+//! // Lattice fields: pressure, Q, velocity and stress.
+//! let f = tissue.fields(&mut ws);
+//! assert_eq!(f.pressure.len(), 48 * 48);
 //! ```
 #![deny(missing_docs)]
 
+pub mod equations;
 mod fields;
+mod geometry;
+mod kernels;
 mod observables;
 mod params;
-pub mod scatter;
+mod scatter;
 mod simulation;
+mod step;
 mod tissue;
+mod workspace;
 
 pub use fields::TissueFields;
+pub use geometry::TracelessTensor;
+pub use nalgebra::Vector2;
 pub use observables::Observables;
-pub use params::{ModelParams, PressureKind, StepParams, ACTIVITY_DT};
-pub use simulation::{run, Observer, Protocol};
-pub use tissue::{
-    evaluate, pressure, CellState, Tissue, Workspace, G_QXX, G_QXY, G_S1, G_S2, G_U, N_GLOBAL,
-    PHI_BOUND, SORT_BLOCK,
+pub use params::{ModelParams, Precision, PressureKind, StepParams, ACTIVITY_DT};
+pub use simulation::{
+    Callback, CallbackError, Observation, RunInfo, Schedule, Simulation, SimulationError,
+    DEFAULT_SORT_EVERY,
 };
+pub use step::{CheckPoint, StateCheck, StepCheck, PHI_BOUND};
+pub use tissue::Tissue;
+pub use workspace::{CellState, SumField, Workspace};
+
+/// The types most programs need: `use mechanics::prelude::*;`.
+pub mod prelude {
+    pub use crate::{
+        Callback, CallbackError, ModelParams, Observables, Observation, Precision, PressureKind,
+        Schedule, Simulation, StepParams, Tissue, TissueFields, TracelessTensor, Vector2,
+        Workspace,
+    };
+}
 
 /// Why a time step could not be taken.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -2,7 +2,8 @@
 
 use phasefield::Real;
 
-use crate::tissue::{Tissue, Workspace};
+use crate::tissue::Tissue;
+use crate::workspace::Workspace;
 
 /// Scalar summary of one state, computed on output steps only.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -26,17 +27,21 @@ pub struct Observables {
 }
 
 impl<T: Real> Tissue<T> {
-    /// Refreshes the derived quantities into `ws` and computes the observables of the current
-    /// state. Leaves the tissue velocity field `Σ φ_i v_i` in `ws.field2` (fields `vx`, `vy`).
-    pub fn observe(&mut self, ws: &mut Workspace<T>) -> Observables {
+    /// Refreshes the derived quantities into `ws` ([`Tissue::refresh`]) and computes the
+    /// observables of the current state. Leaves the tissue velocity field `Σ φ_i v_i` in the
+    /// workspace ([`Workspace::velocity_field`]). Takes `&self`: observing never changes the
+    /// dynamics.
+    pub fn observe(&self, ws: &mut Workspace<T>) -> Observables {
         self.refresh(ws);
         self.scatter_velocity(ws);
         let Workspace {
-            cell_state, field2, ..
+            cell_state,
+            velocity_field,
+            ..
         } = ws;
         let cs: &[_] = cell_state;
         let n_nodes = self.lattice().len() as f64;
-        let v2: f64 = field2.values().iter().map(|v| v * v).sum::<f64>() / n_nodes;
+        let v2: f64 = velocity_field.values().iter().map(|v| v * v).sum::<f64>() / n_nodes;
         let n = cs.len().max(1) as f64;
         let mut o = Observables {
             v_rms: v2.sqrt(),
@@ -48,8 +53,8 @@ impl<T: Real> Tissue<T> {
         };
         let (mut s2, mut a, mut u2) = (0.0, 0.0, 0.0);
         for c in cs {
-            s2 += c.shape[0] * c.shape[0] + c.shape[1] * c.shape[1];
-            u2 += c.velocity[0] * c.velocity[0] + c.velocity[1] * c.velocity[1];
+            s2 += c.shape.xx * c.shape.xx + c.shape.xy * c.shape.xy;
+            u2 += c.velocity.x * c.velocity.x + c.velocity.y * c.velocity.y;
             a += c.area;
             o.area_min = o.area_min.min(c.area);
             o.area_max = o.area_max.max(c.area);

@@ -7,12 +7,13 @@
 //!
 //! The `K` summed fields live in a [`LatticeSums`], stored stripe by stripe and, inside a
 //! stripe, field by field: one lattice column of one field is a contiguous slice, so that a
-//! run of patch rows ([`phasefield::RowRun`]) reads or writes it as one vectorisable loop.
+//! run of patch rows (`phasefield::kernel::RowRun`) reads or writes it as one vectorisable loop.
 //!
 //! A stripe that no patch overlaps is zeroed once and then left alone, so a scene of a few
 //! cells in a large box does no work per step on the nodes no cell covers.
 
-use phasefield::{for_each_run_in_column, Cells, Lattice, Real, RowRuns, StencilRun};
+use phasefield::kernel::{for_each_run_in_column, RowRuns, StencilRun};
+use phasefield::{Cells, Lattice, Real};
 use rayon::prelude::*;
 
 /// Lattice x-rows per scatter stripe (fixed, so that the result never depends on threads).
@@ -107,11 +108,6 @@ impl<const K: usize> LatticeSums<K> {
             self.offsets[s] = self.offsets[s - 1];
         }
         self.offsets[0] = 0;
-    }
-
-    /// The lattice.
-    pub fn lattice(&self) -> Lattice {
-        self.lattice
     }
 
     /// Where lattice column `x` of field 0 starts, and the distance from one field to the next.

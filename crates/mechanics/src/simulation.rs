@@ -1,107 +1,525 @@
-//! The driver of a whole run: relaxation at ζ = 0, then activity, with an observer called on
-//! the steps it asks for (after Oceananigans' `Simulation` and ripgrep's `Sink`).
+//! The driver of a run, in the Oceananigans way: a [`Simulation`] owns the model (a
+//! [`Tissue`] and its [`Workspace`]), the stop criteria, and any number of callbacks and
+//! output writers, each with a [`Schedule`].
+//!
+//! # The order of one iteration
+//!
+//! [`Simulation::run`] first calls every callback's and writer's
+//! [`Callback::initialize`], then fires the schedules at the starting state. Then, until a
+//! stop criterion holds:
+//!
+//! 1. the activity switch ([`Simulation::activity_from`]) sets ζ if its iteration is reached;
+//! 2. every `sort_every` iterations the cells are re-sorted in memory
+//!    ([`Tissue::sort_cells`]);
+//! 3. the tissue takes one step; the state check ([`Simulation::set_check`], by default
+//!    [`StateCheck`] at every step) runs at the step's chokepoint, before anything is
+//!    overwritten;
+//! 4. the callbacks whose schedules fire run, in the order they were added, then the output
+//!    writers whose schedules fire, in the order they were added.
+//!
+//! At the end every [`Callback::finalize`] runs (a writer can write the final state there).
+//!
+//! Callbacks see the state through an [`Observation`], which holds the tissue by shared
+//! reference: observing cannot change what the dynamics use, so a run's results are
+//! bit-identical whatever is observed and how often. Derived quantities are computed lazily,
+//! once per iteration, the first time a callback asks ([`Observation::observables`]).
+
+use std::time::{Duration, Instant};
 
 use phasefield::Real;
 
+use crate::fields::TissueFields;
 use crate::observables::Observables;
 use crate::params::StepParams;
-use crate::tissue::{Tissue, Workspace};
+use crate::step::{StateCheck, StepCheck};
+use crate::tissue::Tissue;
+use crate::workspace::Workspace;
 use crate::StepError;
 
-/// What a run does, in steps.
+/// Iterations between re-sortings of the cells in memory by default
+/// ([`Simulation::sort_every`]): cells move a fraction of a node per TU, so every few hundred
+/// steps is plenty.
+pub const DEFAULT_SORT_EVERY: u64 = 250;
+
+/// When a callback, writer or check fires (after Oceananigans' schedules).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Protocol {
-    /// Steps at ζ = 0 before the activity is switched on (MODEL.md §6).
-    pub relax_steps: u64,
-    /// Steps at activity `zeta`.
-    pub active_steps: u64,
-    /// The activity after relaxation.
-    pub zeta: f64,
-    /// The integrator.
-    pub step: StepParams,
-    /// Steps between re-sortings of the cells along a space-filling curve
-    /// ([`Tissue::sort_cells`]); `None` never sorts. Cells move a fraction of a node per TU,
-    /// so every few hundred steps is plenty.
-    pub sort_every: Option<u64>,
+#[non_exhaustive]
+pub enum Schedule {
+    /// At every iteration that is a multiple of `n` (the starting state included).
+    IterationInterval(u64),
+    /// At the starting state and at the first iteration at or after each multiple of the
+    /// interval, in model time (to within 10⁻⁹ of the interval).
+    TimeInterval(f64),
+    /// At the first iteration after each interval of wall-clock time since the last firing
+    /// (not at the starting state). Wall time never affects the results, only when an
+    /// observation happens.
+    WallTimeInterval(Duration),
 }
 
-impl Protocol {
-    /// Total steps.
-    pub fn total_steps(&self) -> u64 {
-        self.relax_steps + self.active_steps
+/// The running state of a [`Schedule`].
+#[derive(Debug, Clone)]
+struct Timer {
+    schedule: Schedule,
+    next_time: f64,
+    last_wall: Instant,
+}
+
+impl Timer {
+    fn new(schedule: Schedule) -> Self {
+        Self {
+            schedule,
+            next_time: f64::NEG_INFINITY,
+            last_wall: Instant::now(),
+        }
+    }
+
+    fn fires(&mut self, iteration: u64, time: f64, initial: bool) -> bool {
+        match self.schedule {
+            Schedule::IterationInterval(n) => iteration.is_multiple_of(n.max(1)),
+            Schedule::TimeInterval(dt) => {
+                let tol = 1e-9 * dt;
+                if time >= self.next_time - tol {
+                    self.next_time = (((time + tol) / dt).floor() + 1.0) * dt;
+                    true
+                } else {
+                    false
+                }
+            }
+            Schedule::WallTimeInterval(d) => {
+                if initial {
+                    self.last_wall = Instant::now();
+                    return false;
+                }
+                let now = Instant::now();
+                if now.duration_since(self.last_wall) >= d {
+                    self.last_wall = now;
+                    true
+                } else {
+                    false
+                }
+            }
+        }
     }
 }
 
-/// Receives the state on the steps it asks for. Observables are computed only on those steps.
-pub trait Observer {
-    /// The observer's own error; step errors convert into it.
-    type Error: From<StepError>;
+/// The error a callback returns.
+pub type CallbackError = Box<dyn std::error::Error + Send + Sync>;
 
-    /// Whether to observe the state after `step` steps of the run (`0..=total`).
-    fn wants(&self, step: u64, total: u64) -> bool;
+/// Why a simulation stopped early.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimulationError {
+    /// A step failed its check; the tissue holds the last good state.
+    #[error(transparent)]
+    Step(#[from] StepError),
+    /// A callback or writer failed.
+    #[error("{name} failed at step {iteration}: {source}")]
+    Callback {
+        /// The name it was added under.
+        name: String,
+        /// The iteration it was called at.
+        iteration: u64,
+        /// Its error.
+        source: CallbackError,
+    },
+    /// Nothing would stop the run.
+    #[error("the simulation has no stop criterion: set stop_iteration, stop_time or wall_time_limit")]
+    NoStop,
+}
 
-    /// Called with the tissue, its freshly evaluated workspace and its observables.
+/// Something called on a schedule during a run: a diagnostic, an output writer, a progress
+/// report (after Oceananigans' `Callback` and ripgrep's `Sink`). Only [`Callback::call`] is
+/// required; closures `FnMut(&mut Observation<T>) -> Result<(), CallbackError>` are callbacks.
+pub trait Callback<T: Real> {
+    /// Called when the schedule fires.
     ///
     /// # Errors
     /// Whatever stops the run (e.g. a failed write).
-    fn observe<T: Real>(
-        &mut self,
-        tissue: &Tissue<T>,
-        ws: &Workspace<T>,
-        obs: &Observables,
-    ) -> Result<(), Self::Error>;
-}
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError>;
 
-/// No observer: `&mut ()` runs the protocol and observes nothing.
-impl Observer for () {
-    type Error = StepError;
-    fn wants(&self, _: u64, _: u64) -> bool {
-        false
+    /// Called once before the run, with the starting state (before the schedules fire).
+    ///
+    /// # Errors
+    /// Whatever stops the run.
+    fn initialize(&mut self, _obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        Ok(())
     }
-    fn observe<T: Real>(
-        &mut self,
-        _: &Tissue<T>,
-        _: &Workspace<T>,
-        _: &Observables,
-    ) -> Result<(), StepError> {
+
+    /// Called once after the run (also after an error), with the final state.
+    ///
+    /// # Errors
+    /// Whatever should be reported.
+    fn finalize(&mut self, _obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
         Ok(())
     }
 }
 
-/// Runs `protocol` on `tissue`, calling `observer` on the steps it wants.
-///
-/// ζ is 0 during relaxation and `protocol.zeta` from step `relax_steps` on.
-///
-/// # Errors
-/// The first step error or observer error; the tissue is left at the last good state.
-pub fn run<T: Real, O: Observer>(
-    tissue: &mut Tissue<T>,
-    ws: &mut Workspace<T>,
-    protocol: &Protocol,
-    observer: &mut O,
-) -> Result<(), O::Error> {
-    let total = protocol.total_steps();
-    let mut scratch = Vec::new();
-    tissue.params.zeta = if protocol.relax_steps > 0 {
-        0.0
-    } else {
-        protocol.zeta
-    };
-    for s in 0..=total {
-        if s == protocol.relax_steps {
-            tissue.params.zeta = protocol.zeta;
-        }
-        if observer.wants(s, total) {
-            let o = tissue.observe(ws);
-            observer.observe(tissue, ws, &o)?;
-        }
-        if s == total {
-            break;
-        }
-        if protocol.sort_every.is_some_and(|k| s % k == 0) {
-            tissue.sort_cells(&mut scratch);
-        }
-        tissue.step(ws, &protocol.step)?;
+impl<T: Real, F> Callback<T> for F
+where
+    F: FnMut(&mut Observation<'_, T>) -> Result<(), CallbackError>,
+{
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        self(obs)
     }
-    Ok(())
+}
+
+/// The state as a callback sees it: the tissue (read-only), the clock and derived quantities
+/// computed on demand and cached for this iteration.
+pub struct Observation<'a, T: Real> {
+    tissue: &'a Tissue<T>,
+    ws: &'a mut Workspace<T>,
+    observables: &'a mut Option<Observables>,
+    wall_time: Duration,
+    stop: &'a mut bool,
+}
+
+impl<'a, T: Real> Observation<'a, T> {
+    /// The tissue (borrowed for the whole observation, so that it can be held next to
+    /// [`Observation::workspace`]).
+    pub fn tissue(&self) -> &'a Tissue<T> {
+        self.tissue
+    }
+
+    /// Steps taken.
+    pub fn iteration(&self) -> u64 {
+        self.tissue.iteration()
+    }
+
+    /// Model time.
+    pub fn time(&self) -> f64 {
+        self.tissue.time()
+    }
+
+    /// Wall time since [`Simulation::run`] was called.
+    pub fn wall_time(&self) -> Duration {
+        self.wall_time
+    }
+
+    /// The observables of the current state, computed at the first call in this iteration
+    /// ([`Tissue::observe`]) and cached for the other callbacks.
+    pub fn observables(&mut self) -> Observables {
+        if self.observables.is_none() {
+            *self.observables = Some(self.tissue.observe(self.ws));
+        }
+        self.observables.expect("just computed")
+    }
+
+    /// The workspace, holding the per-cell quantities, lattice sums, tissue velocity and
+    /// measured centres of the current state (evaluated on first use, as
+    /// [`Observation::observables`]).
+    pub fn workspace(&mut self) -> &Workspace<T> {
+        self.observables();
+        self.ws
+    }
+
+    /// The lattice fields of the current state ([`Tissue::fields`]). Allocates.
+    pub fn fields(&mut self) -> TissueFields {
+        self.tissue.fields(self.ws)
+    }
+
+    /// Asks the simulation to stop after this iteration's callbacks.
+    pub fn request_stop(&mut self) {
+        *self.stop = true;
+    }
+}
+
+/// Which hook of the callbacks [`Simulation::fire`] runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Hook {
+    /// `call`, where the schedule fires after a step.
+    Call,
+    /// `call`, where the schedule fires at the starting state.
+    Start,
+    /// `initialize`, always.
+    Initialize,
+    /// `finalize`, always.
+    Finalize,
+}
+
+struct Entry<T: Real> {
+    name: String,
+    timer: Timer,
+    callback: Box<dyn Callback<T>>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct RunInfo {
+    /// Steps taken by this call of [`Simulation::run`].
+    pub iterations: u64,
+    /// Wall time of the call.
+    pub wall_time: Duration,
+}
+
+/// A time-stepping driver: model, integrator, stop criteria and scheduled callbacks.
+///
+/// ```
+/// use mechanics::prelude::*;
+/// use phasefield::{init, Lattice, PatchShape};
+///
+/// let lattice = Lattice::new(48, 48);
+/// let shape = PatchShape::new(lattice, 12).unwrap();
+/// let cells = init::discs(lattice, shape, &[[16.0, 24.0], [30.0, 24.0]], 7.0, 2.5);
+/// let tissue = Tissue::new(cells, ModelParams::paper(0.0));
+/// let mut v_rms = Vec::new();
+/// let mut sim = Simulation::new(tissue, StepParams::paper()).stop_iteration(20);
+/// sim.add_callback("v_rms", Schedule::IterationInterval(10), move |o: &mut Observation<f64>| {
+///     assert!(o.observables().v_rms.is_finite());
+///     Ok(())
+/// });
+/// let info = sim.run().unwrap();
+/// assert_eq!((info.iterations, sim.tissue().iteration()), (20, 20));
+/// ```
+pub struct Simulation<T: Real = f64> {
+    tissue: Tissue<T>,
+    workspace: Workspace<T>,
+    step_params: StepParams,
+    stop_iteration: Option<u64>,
+    stop_time: Option<f64>,
+    wall_time_limit: Option<Duration>,
+    activity: Option<(u64, f64)>,
+    sort_every: Option<u64>,
+    check: (Timer, Box<dyn StepCheck>),
+    callbacks: Vec<Entry<T>>,
+    writers: Vec<Entry<T>>,
+    sort_scratch: Vec<T>,
+    initialized: bool,
+}
+
+impl<T: Real> Simulation<T> {
+    /// A simulation of `tissue` with the integrator `step_params`, the default check at every
+    /// step, re-sorting every [`DEFAULT_SORT_EVERY`] iterations, no callbacks and no stop
+    /// criterion yet.
+    pub fn new(tissue: Tissue<T>, step_params: StepParams) -> Self {
+        let workspace = Workspace::new(tissue.cells());
+        Self {
+            tissue,
+            workspace,
+            step_params,
+            stop_iteration: None,
+            stop_time: None,
+            wall_time_limit: None,
+            activity: None,
+            sort_every: Some(DEFAULT_SORT_EVERY),
+            check: (
+                Timer::new(Schedule::IterationInterval(1)),
+                Box::new(StateCheck::default()),
+            ),
+            callbacks: Vec::new(),
+            writers: Vec::new(),
+            sort_scratch: Vec::new(),
+            initialized: false,
+        }
+    }
+
+    /// Stops when the tissue has taken `n` steps in all.
+    pub fn stop_iteration(mut self, n: u64) -> Self {
+        self.stop_iteration = Some(n);
+        self
+    }
+
+    /// Stops at the first iteration at or after model time `t` (to within 10⁻⁹ dt).
+    pub fn stop_time(mut self, t: f64) -> Self {
+        self.stop_time = Some(t);
+        self
+    }
+
+    /// Stops after this much wall time.
+    pub fn wall_time_limit(mut self, limit: Duration) -> Self {
+        self.wall_time_limit = Some(limit);
+        self
+    }
+
+    /// Holds ζ = 0 until iteration `iteration` and switches to activity `zeta` there (the
+    /// relaxation protocol of MODEL.md §6). With `iteration = 0` the activity is on from the
+    /// start.
+    pub fn activity_from(mut self, iteration: u64, zeta: f64) -> Self {
+        self.activity = Some((iteration, zeta));
+        self.apply_activity();
+        self
+    }
+
+    /// Re-sorts the cells in memory every `n` iterations (`None`: never). Sorting changes
+    /// sums over cells at round-off and speeds up large scenes.
+    pub fn sort_every(mut self, n: Option<u64>) -> Self {
+        self.sort_every = n.filter(|&n| n > 0);
+        self
+    }
+
+    /// Replaces the state check at the step chokepoint and its schedule (by default
+    /// [`StateCheck`] at every step). `Box::new(())` checks nothing.
+    pub fn set_check(&mut self, schedule: Schedule, check: Box<dyn StepCheck>) {
+        self.check = (Timer::new(schedule), check);
+    }
+
+    /// Adds a callback, run when `schedule` fires, before the output writers.
+    pub fn add_callback(
+        &mut self,
+        name: impl Into<String>,
+        schedule: Schedule,
+        callback: impl Callback<T> + 'static,
+    ) {
+        self.callbacks.push(Entry {
+            name: name.into(),
+            timer: Timer::new(schedule),
+            callback: Box::new(callback),
+        });
+    }
+
+    /// Adds an output writer, run when `schedule` fires, after the callbacks.
+    pub fn add_output_writer(
+        &mut self,
+        name: impl Into<String>,
+        schedule: Schedule,
+        writer: impl Callback<T> + 'static,
+    ) {
+        self.writers.push(Entry {
+            name: name.into(),
+            timer: Timer::new(schedule),
+            callback: Box::new(writer),
+        });
+    }
+
+    /// The tissue.
+    pub fn tissue(&self) -> &Tissue<T> {
+        &self.tissue
+    }
+
+    /// The workspace (holding what the last evaluation left).
+    pub fn workspace(&self) -> &Workspace<T> {
+        &self.workspace
+    }
+
+    /// The integrator.
+    pub fn step_params(&self) -> &StepParams {
+        &self.step_params
+    }
+
+    /// The tissue and its workspace.
+    pub fn into_parts(self) -> (Tissue<T>, Workspace<T>) {
+        (self.tissue, self.workspace)
+    }
+
+    /// The iteration the run stops at, when a stop iteration is set.
+    pub fn stop_at_iteration(&self) -> Option<u64> {
+        self.stop_iteration
+    }
+
+    fn apply_activity(&mut self) {
+        if let Some((at, zeta)) = self.activity {
+            self.tissue.params.zeta = if self.tissue.iteration() >= at {
+                zeta
+            } else {
+                0.0
+            };
+        }
+    }
+
+    fn done(&self, start: Instant) -> bool {
+        let t = &self.tissue;
+        self.stop_iteration.is_some_and(|n| t.iteration() >= n)
+            || self
+                .stop_time
+                .is_some_and(|s| t.time() >= s - 1e-9 * self.step_params.dt)
+            || self.wall_time_limit.is_some_and(|w| start.elapsed() >= w)
+    }
+
+    /// Runs `hook` of the callbacks, then of the writers (`call` only where the schedule
+    /// fires).
+    fn fire(&mut self, start: Instant, hook: Hook, stop: &mut bool) -> Result<(), SimulationError> {
+        let mut observables = None;
+        let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
+        for entry in self.callbacks.iter_mut().chain(self.writers.iter_mut()) {
+            let go = match hook {
+                Hook::Call | Hook::Start => entry.timer.fires(iteration, time, hook == Hook::Start),
+                Hook::Initialize | Hook::Finalize => true,
+            };
+            if !go {
+                continue;
+            }
+            let mut obs = Observation {
+                tissue: &self.tissue,
+                ws: &mut self.workspace,
+                observables: &mut observables,
+                wall_time: start.elapsed(),
+                stop,
+            };
+            let r = match hook {
+                Hook::Initialize => entry.callback.initialize(&mut obs),
+                Hook::Finalize => entry.callback.finalize(&mut obs),
+                Hook::Call | Hook::Start => entry.callback.call(&mut obs),
+            };
+            r.map_err(|source| SimulationError::Callback {
+                name: entry.name.clone(),
+                iteration,
+                source,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Runs until a stop criterion holds (see the module docs for the order of one
+    /// iteration). It can be called again after raising the stop criterion, to continue:
+    /// the initializers and the firing at the starting state happen in the first call only,
+    /// the finalizers at the end of every call.
+    ///
+    /// # Errors
+    /// [`SimulationError::NoStop`] without a stop criterion; the first step error (the tissue
+    /// then holds the last good state) or callback error. The finalizers run in every case
+    /// but the first.
+    pub fn run(&mut self) -> Result<RunInfo, SimulationError> {
+        if self.stop_iteration.is_none() && self.stop_time.is_none() && self.wall_time_limit.is_none()
+        {
+            return Err(SimulationError::NoStop);
+        }
+        let start = Instant::now();
+        let first = self.tissue.iteration();
+        let mut stop = false;
+        let result = self.run_loop(start, &mut stop);
+        let fin = self.fire(start, Hook::Finalize, &mut stop);
+        result.and(fin)?;
+        Ok(RunInfo {
+            iterations: self.tissue.iteration() - first,
+            wall_time: start.elapsed(),
+        })
+    }
+
+    fn run_loop(&mut self, start: Instant, stop: &mut bool) -> Result<(), SimulationError> {
+        self.apply_activity();
+        if !self.initialized {
+            self.initialized = true;
+            self.fire(start, Hook::Initialize, stop)?;
+            self.fire(start, Hook::Start, stop)?;
+        }
+        let mut none = ();
+        while !*stop && !self.done(start) {
+            self.apply_activity();
+            let it = self.tissue.iteration();
+            if self.sort_every.is_some_and(|k| it.is_multiple_of(k)) {
+                self.tissue.sort_cells(&mut self.sort_scratch);
+            }
+            let (timer, check) = &mut self.check;
+            let checked = timer.fires(it, self.tissue.time(), false);
+            let check: &mut dyn StepCheck = if checked { check.as_mut() } else { &mut none };
+            self.tissue
+                .step_checked(&mut self.workspace, &self.step_params, &mut DynCheck(check))?;
+            self.apply_activity();
+            self.fire(start, Hook::Call, stop)?;
+        }
+        Ok(())
+    }
+}
+
+/// A `&mut dyn StepCheck` as a sized check.
+struct DynCheck<'a>(&'a mut dyn StepCheck);
+
+impl StepCheck for DynCheck<'_> {
+    fn check(
+        &mut self,
+        at: crate::step::CheckPoint,
+        cells: &[crate::workspace::CellState],
+    ) -> Result<(), StepError> {
+        self.0.check(at, cells)
+    }
 }

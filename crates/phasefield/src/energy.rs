@@ -18,7 +18,11 @@ use crate::lattice::Lattice;
 use crate::patch::Cells;
 
 /// The parameters of the free energy.
+///
+/// Build it from [`EnergyParams::paper`] (also the [`Default`]) and change the fields you
+/// need; the struct is `#[non_exhaustive]`, so new knobs do not break callers.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct EnergyParams {
     /// Interface stiffness γ (paper: 0.01). Larger values make cells rounder and raise the
     /// activity threshold linearly.
@@ -31,6 +35,13 @@ pub struct EnergyParams {
     pub kappa: f64,
     /// Target radius R (paper: 8); the target area is πR².
     pub radius: f64,
+}
+
+impl Default for EnergyParams {
+    /// [`EnergyParams::paper`].
+    fn default() -> Self {
+        Self::paper()
+    }
 }
 
 impl EnergyParams {
@@ -147,5 +158,25 @@ impl EnergyCoefficients {
     #[inline(always)]
     pub fn rep(&self, phi: f64, others_sq: f64) -> f64 {
         self.repulsion * phi * others_sq
+    }
+
+    /// The whole functional derivative of the free energy at one node (MODEL.md §2):
+    ///
+    /// ```text
+    /// δF/δφ_i = (8γ/λ) φ(1−φ)(1−2φ) − 2γλ ∇²φ − (4μ/πR²)(1 − A_i/πR²) φ + (2κ/λ) φ Σ_{k≠i} φ_k²
+    /// ```
+    ///
+    /// given `φ = φ_i(x)`, its five-point Laplacian, the cell's [`area_factor`](Self::area_factor)
+    /// and `Σ_{k≠i} φ_k²` at the node. It is the exact gradient of the discrete
+    /// [`EnergyParams::free_energy`] (tested against finite differences).
+    #[inline(always)]
+    pub fn free_energy_derivative(
+        &self,
+        phi: f64,
+        laplacian: f64,
+        area_factor: f64,
+        others_sq: f64,
+    ) -> f64 {
+        self.ch(phi, laplacian) + area_factor * phi + self.rep(phi, others_sq)
     }
 }

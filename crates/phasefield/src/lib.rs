@@ -40,12 +40,18 @@ mod runs;
 pub use com::ComTable;
 pub use energy::{EnergyCoefficients, EnergyParams};
 pub use lattice::{min_image, wrap_real, Lattice};
-pub use patch::{
-    for_each_stencil, for_each_stencil_at, for_each_stencil_in_column, Cells, PatchMap, PatchShape,
-    Stencil,
-};
+pub use patch::{for_each_stencil, for_each_stencil_at, Cells, PatchMap, PatchShape, Stencil};
 pub use real::Real;
-pub use runs::{add_lanes, for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
+
+/// The SIMD machinery of the step's kernels: runs of patch rows, their stencils and lane sums.
+///
+/// Public only so that `mechanics` can build its kernels on it; it is not part of the stable
+/// API and may change with any release. Use [`for_each_stencil`] (node by node) instead.
+#[doc(hidden)]
+pub mod kernel {
+    pub use crate::patch::for_each_stencil_in_column;
+    pub use crate::runs::{add_lanes, for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
+}
 
 /// Errors from building lattices, patches and initial states.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

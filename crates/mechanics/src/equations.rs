@@ -1,0 +1,185 @@
+//! The equations of MODEL.md §3–4, one named function each, at one lattice node.
+//!
+//! The kernels ([`crate::Tissue::step`], [`crate::TissueFields`]) are built from these
+//! functions and nothing else, so that each formula exists once. All are
+//! `#[inline(always)]`: they are called inside the SIMD loops of the kernels, where a call
+//! would stop the vectorisation.
+//!
+//! Notation: `φ = φ_i(x)` is cell i's field at node x, `∂φ = (∂_x φ, ∂_y φ)` its central
+//! differences, `∇²φ` its five-point Laplacian, all on the cell's periodic patch;
+//! `s_n = Σ_k φ_k^n` are sums over all cells at the node.
+//! The free-energy derivative `δF/δφ_i` is
+//! [`phasefield::EnergyCoefficients::free_energy_derivative`].
+
+use phasefield::EnergyCoefficients;
+
+use crate::params::PressureKind;
+
+/// The integrand of the deformation tensor (MODEL.md §3):
+///
+/// ```text
+/// S_i = −Σ_x [ ∇φ_i ∇φ_iᵀ − ½ |∇φ_i|² 𝕀 ],   so   S_xx = Σ_x ½(∂_yφ² − ∂_xφ²),  S_xy = −Σ_x ∂_xφ ∂_yφ
+/// ```
+///
+/// returned as `[S_xx, S_xy]` (`S_yy = −S_xx`). An elongated cell has its positive
+/// eigenvector along its long axis.
+#[inline(always)]
+pub fn shape_tensor_density(grad: [f64; 2]) -> [f64; 2] {
+    let [dx, dy] = grad;
+    [0.5 * (dy * dy - dx * dx), -(dx * dy)]
+}
+
+/// Cell i's contribution `φ_i S_i` to the nematic field `Q(x) = Σ_i φ_i(x) S_i`
+/// (MODEL.md §3), as `[Q_xx, Q_xy]`.
+#[inline(always)]
+pub fn nematic_density(phi: f64, shape: [f64; 2]) -> [f64; 2] {
+    [phi * shape[0], phi * shape[1]]
+}
+
+/// The part `U_i` of the pressure that depends on cell i's field alone; the scatter sums it
+/// over cells into `U = Σ_i U_i`, and [`pressure`] adds the cross term.
+///
+/// Paper: `U_i = −(2κ/λ) φ³ − (8γ/λ) φ(1−φ)(1−2φ) + 2γλ ∇²φ − a_i φ`, with
+/// `a_i` the cell's [`EnergyCoefficients::area_factor`]; summed over cells, together with
+/// `(2κ/λ) s1 s2`, it is
+/// `P = (2κ/λ)(s1 s2 − s3) − (8γ/λ)(s1 − 3 s2 + 2 s3) + 2γλ Σ_i ∇²φ_i + (4μ/πR²)(s1 − sA/πR²)`.
+/// The Laplacians are taken on each cell's patch: on the full domain this is `2γλ ∇² s1`,
+/// and on patches it is the form whose self term `Σ_x ∇²φ_i ∂φ_i` vanishes exactly, so that an
+/// isolated cell feels no force.
+///
+/// Interaction: `U_i = −(2κ/λ) φ⁴`, so that `P = (2κ/λ)(s2² − s4)`.
+#[inline(always)]
+pub fn pressure_cell_part(
+    kind: PressureKind,
+    coef: &EnergyCoefficients,
+    phi: f64,
+    laplacian: f64,
+    area_factor: f64,
+) -> f64 {
+    match kind {
+        PressureKind::Paper => {
+            -coef.repulsion * (phi * phi) * phi
+                - coef.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
+                + coef.gradient * laplacian
+                - area_factor * phi
+        }
+        PressureKind::Interaction => -coef.repulsion * (phi * phi) * (phi * phi),
+    }
+}
+
+/// The tissue pressure `P` at a node from its sums `s1 = Σ φ_i`, `s2 = Σ φ_i²` and
+/// `U = Σ_i U_i` ([`pressure_cell_part`]) (MODEL.md §3):
+/// `P = (2κ/λ) s1 s2 + U` (paper) or `P = (2κ/λ) s2² + U` (interaction).
+///
+/// This is the one formula of the pressure: the force kernel, [`crate::TissueFields`] and
+/// the docs all use it.
+#[inline(always)]
+pub fn pressure(kind: PressureKind, coef: &EnergyCoefficients, s1: f64, s2: f64, u: f64) -> f64 {
+    match kind {
+        PressureKind::Paper => coef.repulsion * s1 * s2 + u,
+        PressureKind::Interaction => coef.repulsion * s2 * s2 + u,
+    }
+}
+
+/// The part of `P` that cell i's own double-well term puts there, `−(8γ/λ) φ(1−φ)(1−2φ)` in
+/// the paper form (zero in the interaction form), which the force on cell i leaves out.
+///
+/// Its contribution to `F_i` is the integral of a gradient, zero in the continuum, but its
+/// central-difference sum is not zero on the lattice and would propel an isolated cell
+/// (|v| ~ 2e-7 off the lattice's symmetry points). The other self terms (`∇²φ_i ∂φ_i` with
+/// the patch Laplacian, and `φ_i ∂φ_i`) already sum to zero exactly on a periodic patch.
+#[inline(always)]
+pub fn pressure_self_part(kind: PressureKind, coef: &EnergyCoefficients, phi: f64) -> f64 {
+    match kind {
+        PressureKind::Paper => -coef.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi),
+        PressureKind::Interaction => 0.0,
+    }
+}
+
+/// The integrand of the interface force on cell i (MODEL.md §3), the divergence of the
+/// stress `σ = −P𝕀 − ζQ` against `φ_i`, integrated by parts:
+///
+/// ```text
+/// F_i = Σ_x [ (P − P_i^self) ∂φ_i + ζ Q·∂φ_i ],   Q·∂φ = (Q_xx ∂_xφ + Q_xy ∂_yφ, Q_xy ∂_xφ − Q_xx ∂_yφ)
+/// ```
+///
+/// with `p_cell = P − P_i^self` ([`pressure_self_part`]) and `q = [Q_xx, Q_xy]`.
+#[inline(always)]
+pub fn force_density(p_cell: f64, zeta: f64, q: [f64; 2], grad: [f64; 2]) -> [f64; 2] {
+    let [qxx, qxy] = q;
+    let [dx, dy] = grad;
+    [
+        p_cell * dx + zeta * (qxx * dx + qxy * dy),
+        p_cell * dy + zeta * (qxy * dx - qxx * dy),
+    ]
+}
+
+/// The velocity of a cell from the force on it, overdamped on the substrate:
+/// `ξ v_i = F_i` (MODEL.md §3).
+#[inline(always)]
+pub fn velocity(force: [f64; 2], xi: f64) -> [f64; 2] {
+    [force[0] / xi, force[1] / xi]
+}
+
+/// The right-hand side of the dynamics at a node (MODEL.md §4):
+/// `R_i = ∂_t φ_i = −v_i·∂φ_i − δF/δφ_i`, advection by the cell's velocity plus the
+/// relaxation of the free energy.
+#[inline(always)]
+pub fn rhs(velocity: [f64; 2], grad: [f64; 2], dfdphi: f64) -> f64 {
+    -(velocity[0] * grad[0] + velocity[1] * grad[1]) - dfdphi
+}
+
+/// The Heun predictor (a forward-Euler step): `φ* = φⁿ + Δt R(φⁿ)` (MODEL.md §4).
+#[inline(always)]
+pub fn heun_predictor(phi_old: f64, dt: f64, r_old: f64) -> f64 {
+    phi_old + dt * r_old
+}
+
+/// The Heun corrector (the trapezoidal rule on the predicted state):
+/// `φⁿ⁺¹ = φⁿ + ½Δt [R(φⁿ) + R(φ*)]` (MODEL.md §4). Applied `npc` times, each on the latest
+/// state; with `npc = 0` the step is forward Euler.
+#[inline(always)]
+pub fn heun_corrector(phi_old: f64, dt: f64, r_old: f64, r_new: f64) -> f64 {
+    phi_old + 0.5 * dt * (r_old + r_new)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use phasefield::EnergyParams;
+
+    /// The paper pressure of one cell alone at a node is its own part plus the cross term of
+    /// `φ` with itself, `(2κ/λ) φ³`; so `P − P_self` there is the rest of `U_i`, exactly.
+    #[test]
+    fn the_pressure_of_one_cell_is_its_own_terms() {
+        let coef = EnergyParams::paper().coefficients();
+        for &phi in &[0.0, 0.3, 0.5, 0.9, 1.0] {
+            let (lap, a) = (0.07, -0.01);
+            let u = pressure_cell_part(PressureKind::Paper, &coef, phi, lap, a);
+            let p = pressure(PressureKind::Paper, &coef, phi, phi * phi, u);
+            let expected = coef.gradient * lap - a * phi
+                - coef.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi);
+            assert!((p - expected).abs() <= 1e-15, "{p} {expected}");
+            let u = pressure_cell_part(PressureKind::Interaction, &coef, phi, lap, a);
+            let p = pressure(PressureKind::Interaction, &coef, phi, phi * phi, u);
+            assert!(p.abs() <= 1e-16, "one cell has no interaction pressure: {p}");
+        }
+    }
+
+    /// The force density is rotation-covariant: rotating ∂φ by θ and Q by 2θ rotates the
+    /// density by θ, to round-off.
+    #[test]
+    fn the_force_density_rotates_with_the_fields() {
+        let (p, zeta, q, g) = (0.3, 0.01, [0.2, -0.7], [0.4, 1.1]);
+        let f = force_density(p, zeta, q, g);
+        for &theta in &[0.3f64, 1.0, 2.5] {
+            let (c, s) = (theta.cos(), theta.sin());
+            let (c2, s2) = ((2.0 * theta).cos(), (2.0 * theta).sin());
+            let gr = [c * g[0] - s * g[1], s * g[0] + c * g[1]];
+            let qr = [c2 * q[0] - s2 * q[1], s2 * q[0] + c2 * q[1]];
+            let fr = force_density(p, zeta, qr, gr);
+            let expected = [c * f[0] - s * f[1], s * f[0] + c * f[1]];
+            assert!((fr[0] - expected[0]).abs() < 1e-15 && (fr[1] - expected[1]).abs() < 1e-15);
+        }
+    }
+}

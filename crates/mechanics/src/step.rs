@@ -1,0 +1,207 @@
+//! The time step (Heun's predictor–corrector, MODEL.md §4), the check at its chokepoint, and
+//! the evaluations that observe a state without stepping it.
+
+use phasefield::Real;
+use rayon::prelude::*;
+
+use crate::equations::{heun_corrector, heun_predictor};
+use crate::kernels::evaluate;
+use crate::params::StepParams;
+use crate::tissue::Tissue;
+use crate::workspace::{CellState, Workspace};
+use crate::StepError;
+
+/// How far outside `[0, 1]` a phase field may go before the step is declared unstable.
+///
+/// Central-difference advection lets φ reach about −0.05 and 1.5 at ζ = 0.01 in stable runs
+/// (reference code, `../shared/reference`); a value beyond `−2` or `3` only occurs on the way
+/// to a blow-up.
+pub const PHI_BOUND: f64 = 2.0;
+
+/// A check at the step chokepoint: called with the per-cell quantities of the step's first
+/// evaluation of the current state, before anything is overwritten, so that an error leaves
+/// the tissue at the last good state (after rapier's quarantine and Oceananigans' NaN
+/// checker, never inside a kernel).
+///
+/// `()` checks nothing; [`StateCheck`] is the default.
+pub trait StepCheck {
+    /// Checks the state about to be stepped.
+    ///
+    /// # Errors
+    /// The reason not to take the step.
+    fn check(&mut self, at: CheckPoint, cells: &[CellState]) -> Result<(), StepError>;
+}
+
+/// Where a [`StepCheck`] is called: the clock of the state about to be stepped and the step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct CheckPoint {
+    /// Steps taken so far.
+    pub iteration: u64,
+    /// Model time.
+    pub time: f64,
+    /// The time step about to be taken.
+    pub dt: f64,
+}
+
+impl StepCheck for () {
+    fn check(&mut self, _: CheckPoint, _: &[CellState]) -> Result<(), StepError> {
+        Ok(())
+    }
+}
+
+/// The default check: every area, force and field range is finite
+/// ([`StepError::NonFinite`]), and every field stays inside `[−bound, 1 + bound]`
+/// ([`StepError::Unstable`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StateCheck {
+    /// The band around `[0, 1]` (default [`PHI_BOUND`]).
+    pub bound: f64,
+}
+
+impl Default for StateCheck {
+    fn default() -> Self {
+        Self { bound: PHI_BOUND }
+    }
+}
+
+impl StepCheck for StateCheck {
+    fn check(&mut self, at: CheckPoint, cells: &[CellState]) -> Result<(), StepError> {
+        let b = self.bound;
+        for (i, c) in cells.iter().enumerate() {
+            let finite = c.area.is_finite()
+                && c.force.iter().all(|f| f.is_finite())
+                && c.phi_min.is_finite()
+                && c.phi_max.is_finite();
+            if !finite {
+                return Err(StepError::NonFinite {
+                    step: at.iteration,
+                    time: at.time,
+                    cell_idx: i,
+                });
+            }
+            if c.phi_min < -b || c.phi_max > 1.0 + b {
+                return Err(StepError::Unstable {
+                    step: at.iteration,
+                    time: at.time,
+                    cell_idx: i,
+                    phi: if c.phi_min < -b { c.phi_min } else { c.phi_max },
+                    dt: at.dt,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<T: Real> Tissue<T> {
+    /// Advances the state by one time step `dt` with `npc` Heun corrector passes, with the
+    /// default [`StateCheck`] at the chokepoint.
+    ///
+    /// Allocates nothing. On error the tissue is left at the last good state.
+    ///
+    /// # Errors
+    /// [`StepError::NonFinite`] if a cell's area or force is not finite, and
+    /// [`StepError::Unstable`] if a field has left `[−PHI_BOUND, 1 + PHI_BOUND]`.
+    pub fn step(
+        &mut self,
+        ws: &mut Workspace<T>,
+        step_params: &StepParams,
+    ) -> Result<(), StepError> {
+        self.step_checked(ws, step_params, &mut StateCheck::default())
+    }
+
+    /// [`Tissue::step`] with the given check at the chokepoint (`&mut ()` for none).
+    ///
+    /// # Errors
+    /// Whatever `check` returns; the tissue is then left unchanged.
+    pub fn step_checked(
+        &mut self,
+        ws: &mut Workspace<T>,
+        step_params: &StepParams,
+        check: &mut impl StepCheck,
+    ) -> Result<(), StepError> {
+        let dt = step_params.dt;
+        let shapes = self.params.zeta != 0.0;
+        let Workspace {
+            phi_old,
+            k1,
+            k2,
+            sums,
+            cell_state,
+            com,
+            ..
+        } = ws;
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            shapes,
+            k1,
+            sums,
+            cell_state,
+        );
+        let at = CheckPoint {
+            iteration: self.iteration,
+            time: self.time,
+            dt,
+        };
+        check.check(at, cell_state)?;
+        // The state moves into `phi_old` without a copy; the predictor overwrites the buffer
+        // that held the previous step's `phi_old`.
+        self.cells.swap_phi(phi_old);
+        let phi = self.cells.phi_mut();
+        phi.par_iter_mut()
+            .zip(phi_old.par_iter().zip(k1.par_iter()))
+            .for_each(|(p, (o, r))| *p = T::from_f64(heun_predictor(o.to_f64(), dt, r.to_f64())));
+        for _ in 0..step_params.npc {
+            evaluate(
+                &self.params,
+                &self.cells,
+                self.cells.phi(),
+                shapes,
+                k2,
+                sums,
+                cell_state,
+            );
+            let phi = self.cells.phi_mut();
+            phi.par_iter_mut()
+                .zip(phi_old.par_iter())
+                .zip(k1.par_iter().zip(k2.par_iter()))
+                .for_each(|((p, o), (r1, r2))| {
+                    *p = T::from_f64(heun_corrector(o.to_f64(), dt, r1.to_f64(), r2.to_f64()))
+                });
+        }
+        self.iteration += 1;
+        self.time += dt;
+        self.update_centres(com);
+        Ok(())
+    }
+
+    /// Evaluates the derived quantities of the current state (areas, shapes, forces,
+    /// velocities, the lattice sums) into `ws`, and measures the centres of mass of the
+    /// stored values into [`Workspace::centres`], without stepping.
+    ///
+    /// Takes `&self`: observing never changes what the dynamics use, and the next step
+    /// overwrites everything this leaves in `ws`.
+    pub fn refresh(&self, ws: &mut Workspace<T>) {
+        let Workspace {
+            k2,
+            sums,
+            cell_state,
+            observed_centre,
+            com,
+            ..
+        } = ws;
+        self.compute_centres_into(com, observed_centre);
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            true,
+            k2,
+            sums,
+            cell_state,
+        );
+    }
+}

@@ -1,0 +1,134 @@
+//! The scratch memory of a step ([`Workspace`]) and what an evaluation leaves in it:
+//! per-cell quantities ([`CellState`]) and the lattice sums ([`SumField`]).
+
+use nalgebra::Vector2;
+use phasefield::{Cells, ComTable, Real};
+
+use crate::geometry::TracelessTensor;
+use crate::scatter::LatticeSums;
+
+/// Fields of the lattice-wide sums of one evaluation.
+pub(crate) const N_SUMS: usize = 5;
+
+/// A lattice-wide sum left in the [`Workspace`] by an evaluation (read it with
+/// [`Workspace::sum`] or [`Workspace::sum_field`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum SumField {
+    /// `s1 = Σ_i φ_i`.
+    S1,
+    /// `s2 = Σ_i φ_i²`.
+    S2,
+    /// `U = Σ_i U_i`, the part of the pressure that is a sum of single-cell terms
+    /// ([`crate::equations::pressure_cell_part`]).
+    U,
+    /// `Q_xx = Σ_i φ_i S_i,xx`.
+    Qxx,
+    /// `Q_xy = Σ_i φ_i S_i,xy`.
+    Qxy,
+}
+
+impl SumField {
+    /// Every field, in storage order.
+    pub const ALL: [SumField; N_SUMS] = [Self::S1, Self::S2, Self::U, Self::Qxx, Self::Qxy];
+
+    /// Index in the storage of the sums.
+    #[inline(always)]
+    pub(crate) const fn index(self) -> usize {
+        match self {
+            Self::S1 => 0,
+            Self::S2 => 1,
+            Self::U => 2,
+            Self::Qxx => 3,
+            Self::Qxy => 4,
+        }
+    }
+}
+
+/// Per-cell quantities derived from the fields by one evaluation (by slot).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[non_exhaustive]
+pub struct CellState {
+    /// Area `A_i = Σ_x φ_i²`.
+    pub area: f64,
+    /// Deformation tensor `S_i` (MODEL.md §3).
+    pub shape: TracelessTensor,
+    /// Interface force `F_i`.
+    pub force: Vector2<f64>,
+    /// Velocity `v_i = F_i / ξ`.
+    pub velocity: Vector2<f64>,
+    /// Smallest `φ_i` on the patch.
+    pub phi_min: f64,
+    /// Largest `φ_i` on the patch.
+    pub phi_max: f64,
+}
+
+/// Scratch memory for [`crate::Tissue::step`] and the observations: built once, reused,
+/// never serialised (after rapier's pipeline and faer's scratch memory).
+///
+/// After an evaluation (a step, or [`crate::Tissue::refresh`] / [`crate::Tissue::observe`])
+/// it holds the per-cell quantities ([`Workspace::cells`]) and the lattice sums
+/// ([`Workspace::sum_field`]) of the state evaluated last; after a step that is the state of
+/// its last corrector pass, not the new state: observe to evaluate the current one.
+#[derive(Debug, Clone)]
+pub struct Workspace<T: Real = f64> {
+    pub(crate) phi_old: Vec<T>,
+    pub(crate) k1: Vec<T>,
+    pub(crate) k2: Vec<T>,
+    pub(crate) sums: LatticeSums<N_SUMS>,
+    pub(crate) cell_state: Vec<CellState>,
+    pub(crate) velocity_field: LatticeSums<2>,
+    pub(crate) observed_centre: Vec<[f64; 2]>,
+    pub(crate) com: ComTable,
+}
+
+impl<T: Real> Workspace<T> {
+    /// Scratch memory for a tissue of this size.
+    pub fn new(cells: &Cells<T>) -> Self {
+        let n = cells.n_cells() * cells.patch_len();
+        let lattice = cells.lattice();
+        Self {
+            phi_old: vec![T::default(); n],
+            k1: vec![T::default(); n],
+            k2: vec![T::default(); n],
+            sums: LatticeSums::for_cells(lattice, cells.n_cells(), cells.shape().nx),
+            cell_state: vec![CellState::default(); cells.n_cells()],
+            velocity_field: LatticeSums::for_cells(lattice, cells.n_cells(), cells.shape().nx),
+            observed_centre: vec![[0.0; 2]; cells.n_cells()],
+            com: ComTable::new(lattice),
+        }
+    }
+
+    /// The per-cell quantities of the last evaluation, by slot.
+    pub fn cells(&self) -> &[CellState] {
+        &self.cell_state
+    }
+
+    /// The per-cell quantities of slot `slot` in the last evaluation.
+    pub fn cell(&self, slot: usize) -> &CellState {
+        &self.cell_state[slot]
+    }
+
+    /// The sum `field` of the last evaluation at lattice node `node = x * ly + y`.
+    pub fn sum(&self, field: SumField, node: usize) -> f64 {
+        self.sums.get(field.index(), node)
+    }
+
+    /// The sum `field` of the last evaluation as one lattice-sized vector (index
+    /// `x * ly + y`). Allocates.
+    pub fn sum_field(&self, field: SumField) -> Vec<f64> {
+        self.sums.field(field.index())
+    }
+
+    /// The tissue velocity `v = Σ_i φ_i v_i` of the last observation
+    /// ([`crate::Tissue::observe`]), as `[v_x, v_y]` lattice-sized vectors. Allocates.
+    pub fn velocity_field(&self) -> [Vec<f64>; 2] {
+        [self.velocity_field.field(0), self.velocity_field.field(1)]
+    }
+
+    /// The centres of mass of the stored values, by slot, as the last observation measured
+    /// them (see [`crate::Tissue::centres`] for the centres the step uses).
+    pub fn centres(&self) -> &[[f64; 2]] {
+        &self.observed_centre
+    }
+}

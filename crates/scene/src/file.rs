@@ -1,0 +1,263 @@
+//! The scene file as written ([`SceneFile`]): one TOML document that describes a run
+//! completely, with `deny_unknown_fields` on every table and `--set section.key=value`
+//! overrides (ripgrep's low-level arguments: close to the file, checked only for syntax).
+
+use mechanics::{ModelParams, Precision, PressureKind, StepParams};
+use phasefield::PatchShape;
+use serde::{Deserialize, Serialize};
+
+use crate::validate::SceneError;
+
+/// `[domain]`: the periodic lattice.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Domain {
+    /// Nodes along x.
+    pub lx: usize,
+    /// Nodes along y.
+    pub ly: usize,
+}
+
+/// How the cells are placed initially.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum InitKind {
+    /// Uniformly random, reproducible from `[run] seed`, initial discs not overlapping.
+    #[default]
+    Random,
+    /// A near-hexagonal packing.
+    Hexagonal,
+    /// The centres in `[cells] positions`.
+    Positions,
+}
+
+/// `[cells]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellsSpec {
+    /// Number of cells.
+    pub count: usize,
+    /// Target radius R (target area πR²; paper: 8).
+    #[serde(default = "default_radius")]
+    pub radius: f64,
+    /// Initial layout.
+    #[serde(default)]
+    pub init: InitKind,
+    /// Centres for `init = "positions"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub positions: Option<Vec<[f64; 2]>>,
+    /// Radius of the initial discs (default R/2: cells start smaller than their target and
+    /// grow during relaxation, MODEL.md §6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub init_radius: Option<f64>,
+}
+
+fn default_radius() -> f64 {
+    8.0
+}
+
+/// `[model]`: the paper's parameters by default.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Model {
+    /// Interface stiffness γ.
+    pub gamma: f64,
+    /// Area constraint μ.
+    pub mu: f64,
+    /// Interface width λ.
+    pub lambda: f64,
+    /// Repulsion κ.
+    pub kappa: f64,
+    /// Substrate friction ξ.
+    pub xi: f64,
+    /// Activity ζ after relaxation.
+    pub zeta: f64,
+    /// Pressure definition.
+    pub pressure: PressureKind,
+}
+
+impl Default for Model {
+    /// The paper's parameters ([`ModelParams::paper`]) at ζ = 0.
+    fn default() -> Self {
+        let p = ModelParams::paper(0.0);
+        let e = p.energy;
+        Self {
+            gamma: e.gamma,
+            mu: e.mu,
+            lambda: e.lambda,
+            kappa: e.kappa,
+            xi: p.xi,
+            zeta: p.zeta,
+            pressure: p.pressure,
+        }
+    }
+}
+
+/// `[integrator]`.
+///
+/// The defaults (margin 16, dt 0.5, Heun, f32 storage) come from the front of the
+/// work–precision study (`docs/performance.md`): for less than the cost of the paper's margin
+/// 12 and dt 0.2 they make the
+/// centre-of-mass error after 20 TU 20× smaller (4.6e-4 against 1.0e-2 nodes), because at
+/// margin 12 the neglected patch tail dominates every time-step error. dt 0.5 is stable with
+/// a factor 8 to spare at the paper's parameters and a factor 2 at ζ = 0.04
+/// (`docs/stability.csv`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Integrator {
+    /// Time step (default 0.5; the paper's scenes use 0.2).
+    pub dt: f64,
+    /// Heun corrector passes (1: predictor–corrector; 0: forward Euler).
+    pub npc: usize,
+    /// Patch margin m (patch side 2m+1; default 16, the paper's 12); 0 stores every cell on
+    /// the full domain.
+    pub margin: usize,
+    /// Storage precision of the fields, `"f32"` (default) or `"f64"`. Arithmetic is always
+    /// `f64`; `"f32"` rounds each stored value, which halves the memory the step moves and
+    /// makes it up to 18 % faster. At the default margin and dt its error is that of `"f64"`
+    /// to two digits after 20 TU and to five in the long-run statistics (work–precision
+    /// study, `docs/performance.md`); it adds a floor of about 1e-6 in the centres and 1e-5
+    /// in φ, so use `"f64"` for runs that aim below that (margin ≥ 20 with dt ≤ 0.1, or the
+    /// full domain).
+    pub precision: Precision,
+    /// Refuse a `dt` above the stability estimate (default true). The estimate is 1.1–3.3×
+    /// below the measured limits (`docs/stability.csv`); with `false` a run may go above it,
+    /// and the step check still stops it, with its output kept, if it blows up.
+    pub stability_check: bool,
+}
+
+impl Default for Integrator {
+    /// The library's tuned defaults: [`StepParams::default`],
+    /// [`PatchShape::DEFAULT_MARGIN`] and [`Precision::default`].
+    fn default() -> Self {
+        let step = StepParams::default();
+        Self {
+            dt: step.dt,
+            npc: step.npc,
+            margin: PatchShape::DEFAULT_MARGIN,
+            precision: Precision::default(),
+            stability_check: true,
+        }
+    }
+}
+
+/// `[run]`: times in model time units.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Run {
+    /// Relaxation at ζ = 0 before the activity is switched on.
+    pub relax_time: f64,
+    /// Active time after relaxation.
+    pub time: f64,
+    /// Seed of the random initial positions.
+    pub seed: u64,
+    /// Interval between frames (full fields).
+    pub output_every: f64,
+    /// Interval between rows of `series.csv` (default: `output_every`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub series_every: Option<f64>,
+}
+
+impl Default for Run {
+    fn default() -> Self {
+        Self {
+            relax_time: 0.0,
+            time: 100.0,
+            seed: 1,
+            output_every: 10.0,
+            series_every: None,
+        }
+    }
+}
+
+/// A whole scene file, as written: parsed, not yet validated (validate it into a
+/// [`crate::Scene`] with [`SceneFile::validate`]).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// `[domain]`.
+    pub domain: Domain,
+    /// `[cells]`.
+    pub cells: CellsSpec,
+    /// `[model]`.
+    #[serde(default)]
+    pub model: Model,
+    /// `[integrator]`.
+    #[serde(default)]
+    pub integrator: Integrator,
+    /// `[run]`.
+    #[serde(default)]
+    pub run: Run,
+}
+
+impl SceneFile {
+    /// Parses a scene from TOML text, applying `--set section.key=value` overrides first.
+    ///
+    /// # Errors
+    /// [`SceneError::Parse`] on bad syntax, unknown keys, wrong types or bad overrides.
+    pub fn parse(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
+        let mut table: toml::Table =
+            toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string()))?;
+        for o in overrides {
+            apply_override(&mut table, o)?;
+        }
+        table
+            .try_into()
+            .map_err(|e: toml::de::Error| SceneError::Parse(e.to_string()))
+    }
+
+    /// The scene as TOML, with every default filled in.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("scenes always serialise")
+    }
+
+    /// Radius of the initial discs.
+    pub fn init_radius(&self) -> f64 {
+        self.cells.init_radius.unwrap_or(0.5 * self.cells.radius)
+    }
+
+    /// The model parameters at activity `zeta`.
+    pub fn model_params(&self, zeta: f64) -> ModelParams {
+        let m = &self.model;
+        let mut energy = phasefield::EnergyParams::paper();
+        energy.gamma = m.gamma;
+        energy.mu = m.mu;
+        energy.lambda = m.lambda;
+        energy.kappa = m.kappa;
+        energy.radius = self.cells.radius;
+        ModelParams::paper(zeta)
+            .with_energy(energy)
+            .with_xi(m.xi)
+            .with_pressure(m.pressure)
+    }
+
+    /// The integrator parameters.
+    pub fn step_params(&self) -> StepParams {
+        StepParams::new(self.integrator.dt, self.integrator.npc)
+    }
+}
+
+fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
+    let bad = |why: &str| {
+        SceneError::Parse(format!(
+            "--set {o}: {why}; write --set section.key=value, e.g. --set model.zeta=0.005"
+        ))
+    };
+    let (path, value) = o.split_once('=').ok_or_else(|| bad("no '='"))?;
+    let (section, key) = path
+        .trim()
+        .split_once('.')
+        .ok_or_else(|| bad("the key needs a section"))?;
+    let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {}", value.trim())) {
+        Ok(mut t) => t.remove("v").expect("parsed"),
+        Err(_) => toml::Value::String(value.trim().to_string()),
+    };
+    let sec = table
+        .entry(section.to_string())
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let toml::Value::Table(sec) = sec else {
+        return Err(bad("that section is not a table"));
+    };
+    sec.insert(key.to_string(), value);
+    Ok(())
+}

@@ -1,0 +1,184 @@
+//! # scene
+//!
+//! Scene files of monolayer: one TOML document describes a run completely. Reading one is
+//! in two steps, after ripgrep's low- and high-level arguments:
+//!
+//! - [`SceneFile`] mirrors the file (every table rejects unknown keys) and takes
+//!   `--set section.key=value` overrides;
+//! - [`SceneFile::validate`] checks every value once and returns a [`Scene`], a type that
+//!   cannot hold an invalid scene; its error, [`SceneError`], names the key and the fix.
+//!
+//! A [`Scene`] builds the library objects: the initial [`Tissue`] and a ready
+//! [`Simulation`] (relaxation at ζ = 0, then activity, stopping at the scene's end). The
+//! defaults of every key come from the libraries ([`mechanics::StepParams::default`],
+//! [`phasefield::PatchShape::DEFAULT_MARGIN`], [`mechanics::ModelParams::paper`]).
+//!
+//! Running a relaxed paper scene from Rust and printing v_rms, in a few lines:
+//!
+//! ```
+//! use mechanics::prelude::*;
+//! use scene::Scene;
+//!
+//! let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/paper.toml"))?;
+//! // The paper's scene, shortened: 20 TU of relaxation, then 10 TU at its ζ.
+//! let scene = Scene::parse(&text, &["run.relax_time=20".into(), "run.time=10".into()])?;
+//! let mut sim = scene.simulation::<f32>();
+//! sim.add_callback("print", Schedule::TimeInterval(10.0), |o: &mut Observation<f32>| {
+//!     println!("t = {:5.1}  v_rms = {:.3e}", o.time(), o.observables().v_rms);
+//!     Ok(())
+//! });
+//! sim.run()?;
+//! assert!((sim.tissue().time() - 30.0).abs() < 1e-9);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![deny(missing_docs)]
+
+mod file;
+mod validate;
+
+pub use file::{CellsSpec, Domain, InitKind, Integrator, Model, Run, SceneFile};
+pub use validate::SceneError;
+
+use mechanics::{ModelParams, Precision, Simulation, StepParams, Tissue};
+use phasefield::{init, Lattice, PatchShape, Real};
+
+/// A valid scene: only [`SceneFile::validate`] (or [`Scene::parse`]) makes one, so every
+/// value in it has been checked, and building from it cannot fail.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub(crate) file: SceneFile,
+    /// The initial centres, computed by the validation (which checks that they fit).
+    pub(crate) centres: Vec<[f64; 2]>,
+}
+
+/// A scene's durations in steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct StepCounts {
+    /// Relaxation steps at ζ = 0.
+    pub relax_steps: u64,
+    /// Active steps.
+    pub active_steps: u64,
+    /// Steps between frames.
+    pub frame_every: u64,
+    /// Steps between series rows.
+    pub series_every: u64,
+}
+
+impl StepCounts {
+    /// All steps of the run.
+    pub fn total_steps(&self) -> u64 {
+        self.relax_steps + self.active_steps
+    }
+}
+
+impl Scene {
+    /// Parses and validates a scene from TOML text, applying `--set section.key=value`
+    /// overrides first.
+    ///
+    /// # Errors
+    /// [`SceneError::Parse`] on bad syntax, unknown keys, wrong types or bad overrides, and
+    /// [`SceneError::Invalid`] for the first bad value.
+    pub fn parse(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
+        SceneFile::parse(text, overrides)?.validate()
+    }
+
+    /// The scene's values, every default filled in.
+    pub fn file(&self) -> &SceneFile {
+        &self.file
+    }
+
+    /// The scene as TOML, with every default filled in: parsing it gives this scene again.
+    pub fn to_toml(&self) -> String {
+        self.file.to_toml()
+    }
+
+    /// The lattice.
+    pub fn lattice(&self) -> Lattice {
+        Lattice::new(self.file.domain.lx, self.file.domain.ly)
+    }
+
+    /// The patch shape.
+    pub fn patch_shape(&self) -> PatchShape {
+        PatchShape::new(self.lattice(), self.file.integrator.margin).expect("validated")
+    }
+
+    /// The storage precision of the fields.
+    pub fn precision(&self) -> Precision {
+        self.file.integrator.precision
+    }
+
+    /// The model parameters at activity `zeta`.
+    pub fn model_params(&self, zeta: f64) -> ModelParams {
+        self.file.model_params(zeta)
+    }
+
+    /// The integrator.
+    pub fn step_params(&self) -> StepParams {
+        self.file.step_params()
+    }
+
+    /// The activity after relaxation.
+    pub fn zeta(&self) -> f64 {
+        self.file.model.zeta
+    }
+
+    /// Steps for each phase and output interval (durations divided by dt, rounded).
+    pub fn step_counts(&self) -> StepCounts {
+        let dt = self.file.integrator.dt;
+        let steps = |t: f64| (t / dt).round() as u64;
+        let r = &self.file.run;
+        StepCounts {
+            relax_steps: steps(r.relax_time),
+            active_steps: steps(r.time),
+            frame_every: steps(r.output_every).max(1),
+            series_every: steps(r.series_every.unwrap_or(r.output_every)).max(1),
+        }
+    }
+
+    /// Warnings about the scene: a time step above the stability estimate, allowed by
+    /// `[integrator] stability_check = false`.
+    pub fn warnings(&self) -> Vec<String> {
+        self.file
+            .dt_above_estimate()
+            .map(|dt_max| {
+                format!(
+                    "[integrator] dt = {} is above the stability estimate {dt_max:.3}; the run stops if it blows up",
+                    self.file.integrator.dt
+                )
+            })
+            .into_iter()
+            .collect()
+    }
+
+    /// The initial tissue (at ζ = 0 when there is a relaxation phase), with its fields stored
+    /// in precision `T`: the initial discs are computed in `f64` and rounded once.
+    pub fn tissue<T: Real>(&self) -> Tissue<T> {
+        let f = &self.file;
+        let r0 = f.init_radius();
+        let cells = init::discs(
+            self.lattice(),
+            self.patch_shape(),
+            &self.centres,
+            r0,
+            f.model.lambda,
+        );
+        let zeta = if self.step_counts().relax_steps > 0 {
+            0.0
+        } else {
+            f.model.zeta
+        };
+        Tissue::new(cells.into_precision::<T>(), self.model_params(zeta))
+    }
+
+    /// A simulation of the scene with fields stored in precision `T` (choose it from
+    /// [`Scene::precision`]): the initial tissue, the integrator, ζ = 0 for `relax_time` and
+    /// the scene's ζ after, stopping after `relax_time + time`. Add callbacks and writers,
+    /// then [`Simulation::run`] it.
+    pub fn simulation<T: Real>(&self) -> Simulation<T> {
+        let counts = self.step_counts();
+        Simulation::new(self.tissue::<T>(), self.step_params())
+            .activity_from(counts.relax_steps, self.zeta())
+            .stop_iteration(counts.total_steps())
+    }
+}

@@ -1,0 +1,279 @@
+//! Validation of a [`SceneFile`] into a [`Scene`], once: the error names the key, the value,
+//! what is wrong and how to fix it (ripgrep's `ConfigError`).
+
+use phasefield::{init, Lattice, PatchShape};
+
+use crate::file::{InitKind, SceneFile};
+use crate::Scene;
+
+/// A problem with a scene, naming the key and the fix.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The file could not be parsed (syntax, unknown key, wrong type).
+    #[error("{0}")]
+    Parse(String),
+    /// A value is out of range.
+    #[error("[{section}] {key} = {value}: {problem}; {fix}")]
+    Invalid {
+        /// The TOML table.
+        section: &'static str,
+        /// The key in it.
+        key: &'static str,
+        /// The offending value, as written.
+        value: String,
+        /// What is wrong.
+        problem: String,
+        /// What to do.
+        fix: String,
+    },
+}
+
+fn invalid(
+    section: &'static str,
+    key: &'static str,
+    value: impl ToString,
+    problem: impl Into<String>,
+    fix: impl Into<String>,
+) -> SceneError {
+    SceneError::Invalid {
+        section,
+        key,
+        value: value.to_string(),
+        problem: problem.into(),
+        fix: fix.into(),
+    }
+}
+
+impl SceneFile {
+    /// Checks every value once and returns the valid [`Scene`]; the error names the first bad
+    /// key and how to fix it.
+    ///
+    /// # Errors
+    /// [`SceneError::Invalid`] for the first problem found.
+    pub fn validate(self) -> Result<Scene, SceneError> {
+        let d = &self.domain;
+        for (key, v) in [("lx", d.lx), ("ly", d.ly)] {
+            if v < 8 {
+                return Err(invalid(
+                    "domain",
+                    key,
+                    v,
+                    "the domain is too small",
+                    "use at least 8 nodes per side (the paper uses 100)",
+                ));
+            }
+        }
+        let c = &self.cells;
+        if c.count == 0 {
+            return Err(invalid(
+                "cells",
+                "count",
+                0,
+                "a scene needs at least one cell",
+                "set count to 1 or more",
+            ));
+        }
+        if !(c.radius.is_finite() && c.radius > 0.0) {
+            return Err(invalid(
+                "cells",
+                "radius",
+                c.radius,
+                "the radius must be positive",
+                "use a radius of a few nodes (paper: 8)",
+            ));
+        }
+        let r0 = self.init_radius();
+        if !(r0.is_finite() && r0 > 0.0 && r0 <= c.radius) {
+            return Err(invalid(
+                "cells",
+                "init_radius",
+                r0,
+                "the initial disc radius must be positive and at most the radius",
+                "leave it out (default R/2) or choose a value in (0, radius]",
+            ));
+        }
+        match (c.init, &c.positions) {
+            (InitKind::Positions, None) => {
+                return Err(invalid(
+                    "cells",
+                    "init",
+                    "\"positions\"",
+                    "no positions are given",
+                    "add positions = [[x, y], ...] with one pair per cell",
+                ));
+            }
+            (InitKind::Random | InitKind::Hexagonal, Some(_)) => {
+                return Err(invalid(
+                    "cells",
+                    "positions",
+                    "[...]",
+                    "positions are only read with init = \"positions\"",
+                    "set init = \"positions\" or remove positions",
+                ));
+            }
+            _ => {}
+        }
+        let m = &self.model;
+        for (key, v) in [("gamma", m.gamma), ("mu", m.mu), ("kappa", m.kappa)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(invalid(
+                    "model",
+                    key,
+                    v,
+                    "must be zero or positive",
+                    "use the paper's value (gamma 0.01, mu 3, kappa 0.1) as a start",
+                ));
+            }
+        }
+        if !(m.lambda.is_finite() && m.lambda > 0.0) {
+            return Err(invalid(
+                "model",
+                "lambda",
+                m.lambda,
+                "the interface width must be positive",
+                "use a width of a few nodes (paper: 2.5)",
+            ));
+        }
+        if !(m.xi.is_finite() && m.xi > 0.0) {
+            return Err(invalid(
+                "model",
+                "xi",
+                m.xi,
+                "the friction must be positive",
+                "use the paper's value 2",
+            ));
+        }
+        if !m.zeta.is_finite() {
+            return Err(invalid(
+                "model",
+                "zeta",
+                m.zeta,
+                "the activity must be a finite number",
+                "use a value between -0.01 and 0.01",
+            ));
+        }
+        let it = &self.integrator;
+        if !(it.dt.is_finite() && it.dt > 0.0) {
+            return Err(invalid(
+                "integrator",
+                "dt",
+                it.dt,
+                "the time step must be positive",
+                "use the paper's 0.2",
+            ));
+        }
+        if let Some(dt_max) = self.dt_above_estimate().filter(|_| it.stability_check) {
+            return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {dt_max:.3} for these parameters (a conservative estimate; docs/stability.csv)"), format!("use dt ≤ {dt_max:.3} (the paper uses 0.2), or set [integrator] stability_check = false to run above the estimate at your own risk")));
+        }
+        if it.npc > 16 {
+            return Err(invalid(
+                "integrator",
+                "npc",
+                it.npc,
+                "more than 16 corrector passes buy no accuracy",
+                "use 1 (Heun) or 0 (Euler)",
+            ));
+        }
+        if it.margin != 0 && (it.margin as f64) < c.radius {
+            return Err(invalid(
+                "integrator",
+                "margin",
+                it.margin,
+                format!(
+                    "a patch margin smaller than the cell radius {} cuts the cells",
+                    c.radius
+                ),
+                format!(
+                    "use margin ≥ radius + 2λ ≈ {}, the paper's 12, or 0 for the full domain",
+                    (c.radius + 2.0 * m.lambda).ceil()
+                ),
+            ));
+        }
+        let lattice = Lattice::new(d.lx, d.ly);
+        if let Err(e) = PatchShape::new(lattice, it.margin) {
+            return Err(invalid(
+                "integrator",
+                "margin",
+                it.margin,
+                e.to_string(),
+                "reduce the margin",
+            ));
+        }
+        let r = &self.run;
+        for (key, v) in [("relax_time", r.relax_time), ("time", r.time)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(invalid(
+                    "run",
+                    key,
+                    v,
+                    "times must be zero or positive",
+                    "give the time in model units (paper: 0.2 per step)",
+                ));
+            }
+        }
+        for (key, v) in [
+            ("output_every", Some(r.output_every)),
+            ("series_every", r.series_every),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v >= it.dt) {
+                    return Err(invalid(
+                        "run",
+                        key,
+                        v,
+                        format!("the interval must be at least one time step ({})", it.dt),
+                        "use a multiple of dt",
+                    ));
+                }
+            }
+        }
+        let layout = self.layout();
+        let centres = match init::positions(lattice, c.count, r0, &layout) {
+            Ok(centres) => centres,
+            Err(e) => {
+            let key = if c.init == InitKind::Positions {
+                "positions"
+            } else {
+                "count"
+            };
+            return Err(invalid(
+                "cells",
+                key,
+                if key == "count" {
+                    c.count.to_string()
+                } else {
+                    "[...]".into()
+                },
+                e.to_string(),
+                "use fewer cells, smaller init_radius or a larger [domain]",
+            ));
+            }
+        };
+        Ok(Scene {
+            file: self,
+            centres,
+        })
+    }
+
+    fn layout(&self) -> init::Layout {
+        match self.cells.init {
+            InitKind::Random => init::Layout::Random {
+                seed: self.run.seed,
+            },
+            InitKind::Hexagonal => init::Layout::Hexagonal,
+            InitKind::Positions => {
+                init::Layout::Positions(self.cells.positions.clone().unwrap_or_default())
+            }
+        }
+    }
+
+    /// The stability estimate `ModelParams::max_stable_dt` of the active phase, when the
+    /// scene's dt is above it.
+    pub(crate) fn dt_above_estimate(&self) -> Option<f64> {
+        let dt_max = self.model_params(self.model.zeta).max_stable_dt();
+        (self.integrator.dt > dt_max).then_some(dt_max)
+    }
+
+
+}
