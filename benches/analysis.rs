@@ -6,6 +6,7 @@
 //! Run with `cargo bench -p monolayer-benches --bench analysis`.
 
 use analysis::correlation::Correlator;
+use analysis::crop::CropFields;
 use analysis::crop::DefectAverage;
 use analysis::defects::detect;
 use analysis::fields::vorticity;
@@ -13,17 +14,16 @@ use analysis::smooth::box_smooth;
 use analysis::tracking::{TrackParams, Tracker};
 use criterion::{criterion_main, Criterion};
 use mechanics::{TissueFields, Workspace};
-use monolayer_cli::analyze::crop_fields;
-use monolayer_cli::scene::Scene;
 use phasefield::Lattice;
+use scene::Scene;
 
 fn frame() -> (Lattice, mechanics::Tissue, Workspace) {
     let path = format!("{}/../scenes/large.toml", env!("CARGO_MANIFEST_DIR"));
     let s = Scene::parse(&std::fs::read_to_string(path).unwrap(), &[]).unwrap();
-    let mut t = s.build().unwrap();
-    let mut ws = Workspace::new(&t.cells);
+    let mut t = s.tissue::<f64>();
+    let mut ws = Workspace::new(t.cells());
     for k in 0..300 {
-        t.params.zeta = if k < 200 { 0.0 } else { 0.005 };
+        t.params_mut().zeta = if k < 200 { 0.0 } else { 0.005 };
         t.step(&mut ws, &s.step_params()).unwrap();
     }
     (t.lattice(), t, ws)
@@ -44,14 +44,23 @@ fn analyse(
     corr[2].add(&[&sqxx, &sqxy]);
     let found = detect(lattice, &sqxx, &sqxy);
     tracker.push(&found);
-    let cf = crop_fields(f);
+    let cf = CropFields {
+        vx: &f.vx,
+        vy: &f.vy,
+        sigma_xx: &f.sigma_xx,
+        sigma_yy: &f.sigma_yy,
+        sigma_xy: &f.sigma_xy,
+        pressure: &f.pressure,
+        qxx: &f.qxx,
+        qxy: &f.qxy,
+    };
     avg.add(lattice, &cf, &found);
     found.len()
 }
 
 fn bench_analysis(c: &mut Criterion) {
     let pool = monolayer_benches::pool(2);
-    let (lattice, mut t, mut ws) = pool.install(frame);
+    let (lattice, t, mut ws) = pool.install(frame);
     let f = pool.install(|| t.fields(&mut ws));
     let mut g = c.benchmark_group("analysis-400");
     g.sample_size(10);

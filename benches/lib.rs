@@ -2,8 +2,8 @@
 //! `analysis.rs`, `work_precision.rs`, `stability.rs`).
 
 use mechanics::{ModelParams, StepParams, Tissue, Workspace};
-use monolayer_cli::scene::Scene;
 use phasefield::{init, Lattice, PatchShape, Real};
+use scene::Scene;
 
 /// A rayon pool of `threads` threads, for timing on a fixed number of cores.
 ///
@@ -30,13 +30,13 @@ pub fn relaxed_scene<T: Real>(
 ) -> (Tissue<T>, Workspace<T>, Scene) {
     let path = format!("{}/../scenes/{name}", env!("CARGO_MANIFEST_DIR"));
     let s = Scene::parse(&std::fs::read_to_string(path).unwrap(), overrides).unwrap();
-    let mut t = s.build_in::<T>().unwrap();
-    let mut ws = Workspace::new(&t.cells);
-    t.params.zeta = 0.0;
+    let mut t = s.tissue::<T>();
+    let mut ws = Workspace::new(t.cells());
+    t.params_mut().zeta = 0.0;
     for _ in 0..relax_steps {
         t.step(&mut ws, &s.step_params()).unwrap();
     }
-    t.params.zeta = zeta;
+    t.params_mut().zeta = zeta;
     (t, ws, s)
 }
 
@@ -65,11 +65,9 @@ pub fn relaxed_paper_state(margin: usize) -> Tissue {
         2.5,
     );
     let mut relax = Tissue::new(cells, ModelParams::paper(0.0));
-    let mut ws = Workspace::new(&relax.cells);
+    let mut ws = Workspace::new(relax.cells());
     for _ in 0..250 {
-        relax
-            .step(&mut ws, &StepParams { dt: 0.2, npc: 1 })
-            .unwrap();
+        relax.step(&mut ws, &StepParams::new(0.2, 1)).unwrap();
     }
     relax
 }

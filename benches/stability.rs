@@ -21,8 +21,8 @@ const T_RUN: f64 = 200.0;
 
 fn stable(start: &Cells, params: ModelParams, dt: f64, npc: usize) -> bool {
     let mut t = Tissue::new(start.clone(), params);
-    let mut ws = Workspace::new(&t.cells);
-    let sp = StepParams { dt, npc };
+    let mut ws = Workspace::new(t.cells());
+    let sp = StepParams::new(dt, npc);
     let steps = (T_RUN / dt).ceil() as usize;
     (0..steps).all(|_| t.step(&mut ws, &sp).is_ok())
 }
@@ -50,7 +50,7 @@ fn main() {
 
 fn study() {
     let relax = monolayer_benches::relaxed_paper_state(16);
-    let start = relax.cells;
+    let start = relax.cells().clone();
 
     let mut cases: Vec<(String, ModelParams)> = Vec::new();
     let base = ModelParams::paper(0.005);

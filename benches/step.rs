@@ -10,8 +10,8 @@ use criterion::measurement::WallTime;
 use criterion::{criterion_main, BenchmarkGroup, BenchmarkId, Criterion, Throughput};
 use mechanics::{Tissue, Workspace};
 use monolayer_benches::{pool, relaxed_scene, scaling_overrides};
-use monolayer_cli::scene::Scene;
 use phasefield::Real;
+use scene::Scene;
 
 /// Relaxation before timing, in steps (20 TU): the initial discs have grown to confluence.
 const RELAX_STEPS: usize = 100;
@@ -36,7 +36,7 @@ fn bench_scene<T: Real>(
     let (mut t, mut ws, s) = pool(2).install(|| relaxed::<T>(scene, margin));
     let sp = s.step_params();
     g.throughput(Throughput::Elements(
-        (t.cells.n_cells() * t.cells.patch_len()) as u64,
+        (t.cells().n_cells() * t.cells().patch_len()) as u64,
     ));
     for threads in [1, 2] {
         let pool = pool(threads);

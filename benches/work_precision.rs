@@ -37,15 +37,12 @@ fn run<T: Real>(start: &Cells, centres: &[[f64; 2]], c: &Config) -> (Tissue<T>, 
         .resampled(PatchShape::new(lattice, c.margin).unwrap(), centres)
         .to_precision::<T>();
     let steps = (T_ACTIVE / c.dt).round() as usize;
-    let sp = StepParams {
-        dt: c.dt,
-        npc: c.npc,
-    };
+    let sp = StepParams::new(c.dt, c.npc);
     let mut best = f64::INFINITY;
     let mut last = None;
     for rep in 0..3 {
         let mut t = Tissue::new(cells.clone(), ModelParams::paper(ZETA));
-        let mut ws = Workspace::new(&t.cells);
+        let mut ws = Workspace::new(t.cells());
         let t0 = Instant::now();
         for _ in 0..steps {
             t.step(&mut ws, &sp).expect("stable");
@@ -64,12 +61,12 @@ fn errors<T: Real>(reference: &Tissue, t: &Tissue<T>) -> (f64, f64) {
     let lattice = reference.lattice();
     let mut e_c: f64 = 0.0;
     let mut e_phi: f64 = 0.0;
-    for i in 0..t.cells.n_cells() {
-        e_c = e_c.max(lattice.distance(reference.centre[i], t.centre[i]));
+    for i in 0..t.cells().n_cells() {
+        e_c = e_c.max(lattice.distance(reference.centres()[i], t.centres()[i]));
         for x in 0..lattice.lx {
             for y in 0..lattice.ly {
                 e_phi = e_phi
-                    .max((reference.cells.value_at(i, x, y) - t.cells.value_at(i, x, y)).abs());
+                    .max((reference.cells().value_at(i, x, y) - t.cells().value_at(i, x, y)).abs());
             }
         }
     }
@@ -84,8 +81,8 @@ fn main() {
 
 fn study() {
     let relax = monolayer_benches::relaxed_paper_state(25);
-    let start = relax.cells.clone();
-    let centres = relax.centre.clone();
+    let start = relax.cells().clone();
+    let centres = relax.centres().to_vec();
 
     let reference_cfg = Config {
         name: "reference: full, Heun, dt 0.01".into(),

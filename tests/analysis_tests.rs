@@ -202,7 +202,6 @@ fn net_charge_is_zero_for_any_field() {
                 let qxy = box_smooth(lattice, &v[n..], 2 * side - 1).unwrap();
                 let found = detect(lattice, &qxx, &qxy);
                 prop_assert_eq!(net_charge(&found), 0.0);
-                prop_assert!(found.iter().all(|d| (2.0 * d.charge).fract() == 0.0));
                 Ok(())
             },
         )

@@ -1,9 +1,9 @@
 //! One integration-test binary for the whole workspace, with topical modules.
 
 mod analysis_tests;
-mod cli;
 mod mechanics_tests;
 mod patch_tests;
 mod phasefield_tests;
 mod regression;
+mod simulation_tests;
 mod strategies;

@@ -1,9 +1,9 @@
 //! Forces, symmetries and the stepper.
 
-use mechanics::{PressureKind, Tissue, Workspace};
+use mechanics::{PressureKind, SumField, Tissue, Workspace};
 use phasefield::Lattice;
 
-use crate::strategies::{advance, confluent, discs, max_diff, tissue, HEUN, ZETAS};
+use crate::strategies::{advance, confluent, discs, tissue, HEUN, ZETAS};
 
 const PRESSURES: [PressureKind; 2] = [PressureKind::Paper, PressureKind::Interaction];
 
@@ -31,13 +31,14 @@ fn check_symmetry(
         for x in 0..l {
             for y in 0..l {
                 let (xx, yy) = node_map(x, y);
-                e_phi = e_phi.max((a.cells.value_at(i, x, y) - b.cells.value_at(i, xx, yy)).abs());
+                e_phi =
+                    e_phi.max((a.cells().value_at(i, x, y) - b.cells().value_at(i, xx, yy)).abs());
             }
         }
-        let ca = point_map(a.centre[i]);
-        e_c = e_c.max(lat.distance(ca, b.centre[i]));
-        let va = vec_map(wa.cell_state[i].velocity);
-        let vb = wb.cell_state[i].velocity;
+        let ca = point_map(a.centres()[i]);
+        e_c = e_c.max(lat.distance(ca, b.centres()[i]));
+        let va = vec_map(wa.cell(i).velocity.into());
+        let vb: [f64; 2] = wb.cell(i).velocity.into();
         e_v = e_v.max((va[0] - vb[0]).abs().max((va[1] - vb[1]).abs()));
     }
     (e_phi, e_c, e_v)
@@ -113,17 +114,17 @@ fn an_isolated_cell_stays_at_rest_and_round() {
         for pressure in PRESSURES {
             let (mut t, mut ws) = tissue(discs(L, 12, &[[20.3, 40.7]], 8.0), zeta, pressure);
             advance(&mut t, &mut ws, 100, &HEUN);
-            let c0 = t.centre[0];
+            let c0 = t.centres()[0];
             let mut vmax: f64 = 0.0;
             for _ in 0..500 {
                 t.step(&mut ws, &HEUN).unwrap();
-                let v = ws.cell_state[0].velocity;
+                let v = ws.cell(0).velocity;
                 vmax = vmax.max(v[0].hypot(v[1]));
             }
-            let drift = Lattice::new(L, L).distance(c0, t.centre[0]);
+            let drift = Lattice::new(L, L).distance(c0, t.centres()[0]);
             let o = t.observe(&mut ws);
             // Roundness: |S| against the trace of the structure tensor, Σ|∇φ|²/2.
-            let cells = &t.cells;
+            let cells = t.cells();
             let mut trace = 0.0;
             phasefield::for_each_stencil(cells.cell_phi(0), cells.shape(), |_, s| {
                 trace += 0.5 * (s.dx() * s.dx() + s.dy() * s.dy());
@@ -148,20 +149,20 @@ fn two_overlapping_cells_move_apart_with_equal_and_opposite_velocities() {
                 pressure,
             );
             t.refresh(&mut ws);
-            let (v0, v1) = (ws.cell_state[0].velocity, ws.cell_state[1].velocity);
+            let (v0, v1) = (ws.cell(0).velocity, ws.cell(1).velocity);
             assert!(v0[0] < 0.0 && v1[0] > 0.0, "they must repel: {v0:?} {v1:?}");
             assert!((v0[0] + v1[0]).abs() < 1e-14 && v0[1].abs() < 1e-14 && v1[1].abs() < 1e-14);
-            let d0 = t.centre[1][0] - t.centre[0][0];
+            let d0 = t.centres()[1][0] - t.centres()[0][0];
             advance(&mut t, &mut ws, 50, &HEUN);
-            assert!(t.centre[1][0] - t.centre[0][0] > d0);
+            assert!(t.centres()[1][0] - t.centres()[0][0] > d0);
             // A generic pair, on no symmetry axis: equal and opposite to the net-force bound.
-            let (mut t2, mut ws2) = tissue(
+            let (t2, mut ws2) = tissue(
                 discs(100, 12, &[[40.3, 47.1], [51.2, 53.9]], 8.0),
                 zeta,
                 pressure,
             );
             t2.refresh(&mut ws2);
-            let (f0, f1) = (ws2.cell_state[0].force, ws2.cell_state[1].force);
+            let (f0, f1) = (ws2.cell(0).force, ws2.cell(1).force);
             let rel =
                 (f0[0] + f1[0]).hypot(f0[1] + f1[1]) / (f0[0].hypot(f0[1]) + f1[0].hypot(f1[1]));
             eprintln!("pair zeta={zeta} {pressure:?}: |F0+F1|/(|F0|+|F1|) = {rel:.2e}");
@@ -172,7 +173,7 @@ fn two_overlapping_cells_move_apart_with_equal_and_opposite_velocities() {
 
 fn net_force_ratio(ws: &Workspace) -> f64 {
     let (mut sx, mut sy, mut sabs) = (0.0, 0.0, 0.0);
-    for c in &ws.cell_state {
+    for c in ws.cells() {
         sx += c.force[0];
         sy += c.force[1];
         sabs += c.force[0].hypot(c.force[1]);
@@ -192,7 +193,7 @@ fn net_force_vanishes_on_mirror_symmetric_clusters() {
                 [52.0, 52.0],
                 [46.0, 46.0],
             ];
-            let (mut t, mut ws) = tissue(discs(100, 12, &c, 7.0), zeta, pressure);
+            let (t, mut ws) = tissue(discs(100, 12, &c, 7.0), zeta, pressure);
             t.refresh(&mut ws);
             let r = net_force_ratio(&ws);
             assert!(r < 1e-13, "zeta={zeta} {pressure:?}: {r}");
@@ -200,26 +201,22 @@ fn net_force_vanishes_on_mirror_symmetric_clusters() {
     }
 }
 
-/// What the discretisation guarantees: summing `F_i` over cells gives
-/// `Σ_i F_i = Σ_x [P ∇s1 + ζ Q·∇s1] − Σ_i Σ_x P_i^self ∇φ_i` (central differences are linear;
-/// in full-domain storage `Σ_i ∇φ_i = ∇s1` exactly). No term is a discrete gradient, so the
-/// sum vanishes exactly only by symmetry (previous test); in a confluent tissue it is set by
-/// how far `s1 = Σ φ_i` is from uniform (the dips at junctions) and it is not small compared
-/// with single forces, which nearly balance. Measured over 80 random cases (seeds, ζ in
-/// [−0.01, 0.01], both pressures, 30 TU of relaxation): median 0.006, largest 0.12
-/// (interaction pressure, ζ = 0.0066). The bound is 2× the largest.
-pub const NET_FORCE_BOUND: f64 = 0.25;
-
+/// What the discretisation guarantees, at round-off: summing `F_i` over cells gives
+/// `Σ_i F_i = Σ_x [P ∇s1 + ζ Q·∇s1] − Σ_i Σ_x P_i^self ∇φ_i`, since central differences are
+/// linear and in full-domain storage `Σ_i ∇φ_i = ∇s1` exactly. Checked on random confluent
+/// states (seeds, ζ in [−0.01, 0.01], both pressures), with the right-hand side built here from
+/// the lattice fields and the node-by-node stencil, independently of the kernels. No term is a
+/// discrete gradient, so the sum itself is not zero (it is set by how far `s1` is from
+/// uniform); only the identity is exact. Tolerance: `8 n ε` times the sum of the magnitudes of
+/// the terms, `n` the number of terms (faer's convention for sums).
 #[test]
-fn net_force_is_small_on_random_confluent_states() {
+fn net_force_is_the_lattice_sum_it_reduces_to() {
+    use mechanics::equations::{force_density, pressure_self_part};
+    use phasefield::{for_each_stencil, init, Cells, PatchShape};
     use proptest::prelude::*;
     use proptest::test_runner::{Config, TestRng, TestRunner};
-    let cases = std::env::var("MONOLAYER_NET_FORCE_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(6);
     let config = Config {
-        cases,
+        cases: 6,
         ..Config::default()
     };
     let rng = TestRng::deterministic_rng(config.rng_algorithm);
@@ -229,14 +226,54 @@ fn net_force_is_small_on_random_confluent_states() {
         -0.01f64..0.01,
         prop_oneof![Just(PressureKind::Paper), Just(PressureKind::Interaction)],
     );
+    const L: usize = 48;
     runner
         .run(&strategy, |(seed, zeta, pressure)| {
-            let (mut t, mut ws) = confluent(100, seed, 150, pressure);
-            t.params.zeta = zeta;
-            t.refresh(&mut ws);
-            let r = net_force_ratio(&ws);
-            eprintln!("net force seed={seed} {pressure:?} zeta={zeta:.4}: {r:.3e}");
-            prop_assert!(r < NET_FORCE_BOUND, "{}", r);
+            let lattice = Lattice::new(L, L);
+            let n = ((L * L) as f64 * 15.0 / 2500.0).round() as usize;
+            let centres =
+                init::positions(lattice, n, 4.0, &init::Layout::Random { seed }).unwrap();
+            let full = PatchShape::new(lattice, 0).unwrap();
+            let cells: Cells = init::discs(lattice, full, &centres, 4.0, 2.5);
+            let (mut t, mut ws) = tissue(cells, 0.0, pressure);
+            advance(&mut t, &mut ws, 60, &HEUN);
+            t.params_mut().zeta = zeta;
+            let f = t.fields(&mut ws);
+            let coef = t.params().energy.coefficients();
+            let mut s1 = vec![0.0; lattice.len()];
+            for i in 0..t.n_cells() {
+                t.cells().add_to_lattice(i, &mut s1);
+            }
+            let (mut rhs, mut scale, mut terms) = ([0.0f64; 2], 0.0f64, 0usize);
+            for x in 0..L {
+                for y in 0..L {
+                    let k = lattice.index(x, y);
+                    let at = |dx: usize, dy: usize| s1[lattice.index((x + dx) % L, (y + dy) % L)];
+                    let grad = [
+                        0.5 * (at(1, 0) - at(L - 1, 0)),
+                        0.5 * (at(0, 1) - at(0, L - 1)),
+                    ];
+                    let d = force_density(f.pressure[k], zeta, [f.qxx[k], f.qxy[k]], grad);
+                    rhs = [rhs[0] + d[0], rhs[1] + d[1]];
+                    scale += d[0].abs() + d[1].abs();
+                    terms += 1;
+                }
+            }
+            for i in 0..t.n_cells() {
+                for_each_stencil(t.cells().cell_phi(i), t.cells().shape(), |_, s| {
+                    let p = pressure_self_part(pressure, &coef, s.c);
+                    let d = [p * s.dx(), p * s.dy()];
+                    rhs = [rhs[0] - d[0], rhs[1] - d[1]];
+                    scale += d[0].abs() + d[1].abs();
+                    terms += 1;
+                });
+            }
+            let sum = ws.cells().iter().fold([0.0, 0.0], |a, c| [a[0] + c.force.x, a[1] + c.force.y]);
+            let err = (sum[0] - rhs[0]).hypot(sum[1] - rhs[1]);
+            let tol = 8.0 * terms as f64 * f64::EPSILON * scale;
+            eprintln!("net force seed={seed} {pressure:?} zeta={zeta:.4}: |ΣF| {:.3e}, identity error {err:.1e} (tolerance {tol:.1e})", sum[0].hypot(sum[1]));
+            prop_assert!(sum[0].hypot(sum[1]) > 1e3 * tol, "the test must not be vacuous");
+            prop_assert!(err <= tol, "{} > {}", err, tol);
             Ok(())
         })
         .unwrap();
@@ -251,15 +288,18 @@ fn results_do_not_depend_on_the_thread_count() {
             .unwrap();
         pool.install(|| {
             let (mut t, mut ws) = confluent(100, 4, 20, PressureKind::Paper);
-            t.params.zeta = 0.01;
+            t.params_mut().zeta = 0.01;
             advance(&mut t, &mut ws, 20, &HEUN);
             t
         })
     };
     let (a, b) = (run(1), run(2));
-    assert_eq!(a.cells.phi(), b.cells.phi(), "bit-for-bit identical fields");
-    assert_eq!(a.centre, b.centre);
-    assert_eq!(max_diff(a.cells.phi(), b.cells.phi()), 0.0);
+    assert_eq!(
+        a.cells().phi(),
+        b.cells().phi(),
+        "bit-for-bit identical fields"
+    );
+    assert_eq!(a.centres(), b.centres());
     // And with single-precision storage.
     let run32 = |threads: usize| -> Tissue<f32> {
         let pool = rayon::ThreadPoolBuilder::new()
@@ -268,20 +308,20 @@ fn results_do_not_depend_on_the_thread_count() {
             .unwrap();
         pool.install(|| {
             let (t, _) = confluent(100, 4, 20, PressureKind::Paper);
-            let mut t = Tissue::new(t.cells.to_precision::<f32>(), t.params);
-            let mut ws = Workspace::new(&t.cells);
-            t.params.zeta = 0.01;
+            let mut t = Tissue::new(t.cells().to_precision::<f32>(), *t.params());
+            let mut ws = Workspace::new(t.cells());
+            t.params_mut().zeta = 0.01;
             advance(&mut t, &mut ws, 20, &HEUN);
             t
         })
     };
     let (a, b) = (run32(1), run32(2));
     assert_eq!(
-        a.cells.phi(),
-        b.cells.phi(),
+        a.cells().phi(),
+        b.cells().phi(),
         "bit-for-bit identical f32 fields"
     );
-    assert_eq!(a.centre, b.centre);
+    assert_eq!(a.centres(), b.centres());
 }
 
 /// Single-precision storage rounds every stored value to 2⁻²⁴ ≈ 6e-8 relative; over 100
@@ -292,21 +332,21 @@ fn results_do_not_depend_on_the_thread_count() {
 fn single_precision_storage_tracks_double_precision() {
     for pressure in PRESSURES {
         let (mut a, mut wa) = confluent(100, 7, 20, pressure);
-        let mut b = Tissue::new(a.cells.to_precision::<f32>(), a.params);
-        let mut wb = Workspace::new(&b.cells);
-        a.params.zeta = 0.01;
-        b.params.zeta = 0.01;
+        let mut b = Tissue::new(a.cells().to_precision::<f32>(), *a.params());
+        let mut wb = Workspace::new(b.cells());
+        a.params_mut().zeta = 0.01;
+        b.params_mut().zeta = 0.01;
         advance(&mut a, &mut wa, 100, &HEUN);
         advance(&mut b, &mut wb, 100, &HEUN);
         let lat = a.lattice();
         let mut e_phi: f64 = 0.0;
         let mut e_c: f64 = 0.0;
-        for i in 0..a.cells.n_cells() {
-            e_c = e_c.max(lat.distance(a.centre[i], b.centre[i]));
+        for i in 0..a.cells().n_cells() {
+            e_c = e_c.max(lat.distance(a.centres()[i], b.centres()[i]));
             for x in 0..lat.lx {
                 for y in 0..lat.ly {
-                    e_phi =
-                        e_phi.max((a.cells.value_at(i, x, y) - b.cells.value_at(i, x, y)).abs());
+                    e_phi = e_phi
+                        .max((a.cells().value_at(i, x, y) - b.cells().value_at(i, x, y)).abs());
                 }
             }
         }
@@ -322,14 +362,14 @@ fn single_precision_storage_tracks_double_precision() {
 fn lattice_fields_are_consistent_with_the_cells() {
     for pressure in PRESSURES {
         let (mut t, mut ws) = confluent(100, 5, 100, pressure);
-        t.params.zeta = 0.007;
+        t.params_mut().zeta = 0.007;
         let f = t.fields(&mut ws);
         let (mut qx, mut qy, mut vx, mut vy) = (0.0, 0.0, 0.0, 0.0);
-        for i in 0..t.cells.n_cells() {
-            let mass: f64 = t.cells.cell_phi(i).iter().sum();
-            let c = ws.cell_state[i];
-            qx += c.shape[0] * mass;
-            qy += c.shape[1] * mass;
+        for i in 0..t.cells().n_cells() {
+            let mass: f64 = t.cells().cell_phi(i).iter().sum();
+            let c = ws.cell(i);
+            qx += c.shape.xx * mass;
+            qy += c.shape.xy * mass;
             vx += c.velocity[0] * mass;
             vy += c.velocity[1] * mass;
         }
@@ -352,29 +392,29 @@ fn lattice_fields_are_consistent_with_the_cells() {
 fn sorting_the_cells_changes_storage_not_physics() {
     let (mut a, mut wa) = confluent(100, 6, 20, PressureKind::Paper);
     let mut b = a.clone();
-    let mut wb = Workspace::new(&b.cells);
+    let mut wb = Workspace::new(b.cells());
     let mut scratch = Vec::new();
     b.sort_cells(&mut scratch);
     assert!(
-        b.cell_id.iter().enumerate().any(|(j, &id)| j != id),
+        b.cell_ids().iter().enumerate().any(|(j, &id)| j != id),
         "random cells get reordered"
     );
-    a.params.zeta = 0.01;
-    b.params.zeta = 0.01;
+    a.params_mut().zeta = 0.01;
+    b.params_mut().zeta = 0.01;
     advance(&mut a, &mut wa, 30, &HEUN);
     advance(&mut b, &mut wb, 30, &HEUN);
     a.refresh(&mut wa);
     b.refresh(&mut wb);
     let slots = b.slots();
     let lat = a.lattice();
-    for id in 0..a.cells.n_cells() {
+    for id in 0..a.cells().n_cells() {
         let s = slots[id];
-        assert!(lat.distance(a.centre[id], b.centre[s]) < 1e-10);
-        let (va, vb) = (wa.cell_state[id].velocity, wb.cell_state[s].velocity);
+        assert!(lat.distance(a.centres()[id], b.centres()[s]) < 1e-10);
+        let (va, vb) = (wa.cell(id).velocity, wb.cell(s).velocity);
         assert!((va[0] - vb[0]).abs() < 1e-12 && (va[1] - vb[1]).abs() < 1e-12);
         for x in (0..lat.lx).step_by(3) {
             for y in 0..lat.ly {
-                assert!((a.cells.value_at(id, x, y) - b.cells.value_at(s, x, y)).abs() < 1e-10);
+                assert!((a.cells().value_at(id, x, y) - b.cells().value_at(s, x, y)).abs() < 1e-10);
             }
         }
     }
@@ -414,9 +454,9 @@ fn no_step_fails_inside_the_stable_region() {
                 p.energy.kappa = kappa;
                 p.energy.lambda = lambda;
                 let dt = dt_frac * p.max_stable_dt();
-                let mut t = Tissue::new(t0.cells.clone(), p);
-                let mut ws = Workspace::new(&t.cells);
-                let sp = StepParams { dt, npc };
+                let mut t = Tissue::new(t0.cells().clone(), p);
+                let mut ws = Workspace::new(t.cells());
+                let sp = StepParams::new(dt, npc);
                 for _ in 0..(40.0 / dt).ceil() as usize {
                     prop_assert!(
                         t.step(&mut ws, &sp).is_ok(),
@@ -446,19 +486,24 @@ const PHI: f64 = mechanics::PHI_BOUND;
 fn a_reused_workspace_has_the_sums_of_a_fresh_one_after_cells_move() {
     let here = discs(160, 12, &[[20.0, 30.0], [34.0, 30.0]], 7.0);
     let there = discs(160, 12, &[[110.0, 150.0], [158.0, 10.0]], 7.0);
-    let (mut a, mut ws) = tissue(here, 0.01, PressureKind::Paper);
+    let (a, mut ws) = tissue(here, 0.01, PressureKind::Paper);
     a.refresh(&mut ws);
     a.observe(&mut ws);
-    let (mut b, mut fresh) = tissue(there, 0.01, PressureKind::Paper);
+    let (b, mut fresh) = tissue(there, 0.01, PressureKind::Paper);
     b.refresh(&mut fresh);
     b.observe(&mut fresh);
     // The same workspace, now for the moved cells.
     let _ = b.observe(&mut ws);
-    assert!(ws.global.values().iter().any(|&v| v != 0.0));
-    assert_eq!(ws.global.values(), fresh.global.values(), "global sums");
-    assert_eq!(ws.field2.values(), fresh.field2.values(), "velocity field");
+    let sums = |w: &Workspace| SumField::ALL.map(|f| w.sum_field(f));
+    assert!(sums(&ws).iter().flatten().any(|&v| v != 0.0));
+    assert_eq!(sums(&ws), sums(&fresh), "lattice sums");
+    assert_eq!(
+        ws.velocity_field(),
+        fresh.velocity_field(),
+        "velocity field"
+    );
     // Nodes far from every patch hold zeros.
     let lattice = b.lattice();
     let far = lattice.index(40, 80);
-    assert!((0..mechanics::N_GLOBAL).all(|c| ws.global.get(c, far) == 0.0));
+    assert!(SumField::ALL.iter().all(|&f| ws.sum(f, far) == 0.0));
 }

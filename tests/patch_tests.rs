@@ -25,11 +25,11 @@ pub fn patch_error(m: usize, zeta: f64) -> (f64, f64, usize) {
     let (mut sub, mut ws) = tissue(discs(L, m, &PAIR, 7.0), zeta, PressureKind::Paper);
     let (mut e_c, mut e_phi): (f64, f64) = (0.0, 0.0);
     let mut crossings = 0;
-    let mut last = sub.centre[0];
+    let mut last = sub.centres()[0];
     for _ in 0..STEPS / 20 {
         advance(&mut full, &mut wf, 20, &HEUN);
         advance(&mut sub, &mut ws, 20, &HEUN);
-        let c = sub.centre[0];
+        let c = sub.centres()[0];
         for s in 0..2 {
             if (c[s] - last[s]).abs() > L as f64 / 2.0 {
                 crossings += 1;
@@ -37,11 +37,12 @@ pub fn patch_error(m: usize, zeta: f64) -> (f64, f64, usize) {
         }
         last = c;
         for i in 0..2 {
-            e_c = e_c.max(lat.distance(full.centre[i], sub.centre[i]));
+            e_c = e_c.max(lat.distance(full.centres()[i], sub.centres()[i]));
             for x in 0..L {
                 for y in 0..L {
-                    e_phi = e_phi
-                        .max((full.cells.value_at(i, x, y) - sub.cells.value_at(i, x, y)).abs());
+                    e_phi = e_phi.max(
+                        (full.cells().value_at(i, x, y) - sub.cells().value_at(i, x, y)).abs(),
+                    );
                 }
             }
         }

@@ -65,48 +65,31 @@ fn check_derivative(e: EnergyParams) {
         .unwrap();
 }
 
+/// Free-energy parameters with the given γ, μ, λ, κ and R.
+fn energy(gamma: f64, mu: f64, lambda: f64, kappa: f64, radius: f64) -> EnergyParams {
+    let mut e = EnergyParams::paper();
+    (e.gamma, e.mu, e.lambda, e.kappa, e.radius) = (gamma, mu, lambda, kappa, radius);
+    e
+}
+
 #[test]
 fn cahn_hilliard_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams {
-        gamma: 0.7,
-        mu: 0.0,
-        lambda: 2.5,
-        kappa: 0.0,
-        radius: 3.0,
-    });
+    check_derivative(energy(0.7, 0.0, 2.5, 0.0, 3.0));
 }
 
 #[test]
 fn area_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams {
-        gamma: 0.0,
-        mu: 3.0,
-        lambda: 2.5,
-        kappa: 0.0,
-        radius: 3.0,
-    });
+    check_derivative(energy(0.0, 3.0, 2.5, 0.0, 3.0));
 }
 
 #[test]
 fn repulsion_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams {
-        gamma: 0.0,
-        mu: 0.0,
-        lambda: 2.5,
-        kappa: 0.4,
-        radius: 3.0,
-    });
+    check_derivative(energy(0.0, 0.0, 2.5, 0.4, 3.0));
 }
 
 #[test]
 fn full_derivative_is_the_gradient_of_the_discrete_energy() {
-    check_derivative(EnergyParams {
-        gamma: 0.3,
-        mu: 3.0,
-        lambda: 1.7,
-        kappa: 0.4,
-        radius: 3.0,
-    });
+    check_derivative(energy(0.3, 3.0, 1.7, 0.4, 3.0));
 }
 
 /// Exact (to round-off) on a disc symmetric about its storage, anywhere, including across

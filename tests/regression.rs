@@ -1,51 +1,36 @@
 //! Whole runs of the shipped paper scene against measured and published behaviour.
 
-use mechanics::{Observables, Observer, StepError, Tissue, Workspace};
-use monolayer_cli::scene::Scene;
-use phasefield::Real;
+use std::sync::{Arc, Mutex};
+
+use mechanics::{Observables, Observation, Schedule};
+use scene::Scene;
 
 fn paper_scene(overrides: &[&str]) -> Scene {
     let text =
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/paper.toml"))
             .unwrap();
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let scene = Scene::parse(&text, &o).unwrap();
-    scene.validate().unwrap();
-    scene
+    Scene::parse(&text, &o).unwrap()
 }
 
-/// Collects `(time, observables)` every `every` steps.
-struct Sampler {
-    every: u64,
-    samples: Vec<(f64, Observables)>,
-}
-
-impl Observer for Sampler {
-    type Error = StepError;
-    fn wants(&self, step: u64, _total: u64) -> bool {
-        step.is_multiple_of(self.every)
-    }
-    fn observe<T: Real>(
-        &mut self,
-        t: &Tissue<T>,
-        _: &Workspace<T>,
-        o: &Observables,
-    ) -> Result<(), StepError> {
-        self.samples.push((t.time, *o));
-        Ok(())
-    }
-}
-
-/// Runs `scene` (relaxation, then activity) and returns `(time, observables)` every `every` steps.
+/// Runs `scene` (relaxation, then activity) in f64 and returns `(time, observables)` every
+/// `every` steps.
 fn run(scene: &Scene, every: u64) -> Vec<(f64, Observables)> {
-    let mut t = scene.build().unwrap();
-    let mut ws = Workspace::new(&t.cells);
-    let mut sampler = Sampler {
-        every,
-        samples: Vec::new(),
-    };
-    mechanics::run(&mut t, &mut ws, &scene.protocol(), &mut sampler).unwrap();
-    sampler.samples
+    let mut sim = scene.simulation::<f64>();
+    let samples = Arc::new(Mutex::new(Vec::new()));
+    let sink = samples.clone();
+    sim.add_callback(
+        "sampler",
+        Schedule::IterationInterval(every),
+        move |o: &mut Observation<f64>| {
+            let obs = o.observables();
+            sink.lock().unwrap().push((o.time(), obs));
+            Ok(())
+        },
+    );
+    sim.run().unwrap();
+    let out = samples.lock().unwrap().clone();
+    out
 }
 
 /// Sixty cells at the paper's density relax at ζ = 0 (paper pressure, seed 1).

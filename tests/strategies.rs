@@ -7,7 +7,7 @@ use proptest::prelude::*;
 /// The paper's time step.
 pub const DT: f64 = 0.2;
 /// Heun with one corrector pass.
-pub const HEUN: StepParams = StepParams { dt: DT, npc: 1 };
+pub const HEUN: StepParams = StepParams::new(DT, 1);
 /// Activities swept by the tests: contractile, passive, and the paper's extensile range.
 pub const ZETAS: [f64; 4] = [-0.0018, 0.0, 0.005, 0.01];
 
@@ -28,7 +28,7 @@ pub fn tissue(cells: Cells, zeta: f64, pressure: PressureKind) -> (Tissue, Works
     let mut p = ModelParams::paper(zeta);
     p.pressure = pressure;
     let t = Tissue::new(cells, p);
-    let ws = Workspace::new(&t.cells);
+    let ws = Workspace::new(t.cells());
     (t, ws)
 }
 
@@ -66,12 +66,4 @@ pub fn confluent(l: usize, seed: u64, steps: usize, pressure: PressureKind) -> (
 pub fn node_or_half(l: usize) -> impl Strategy<Value = [f64; 2]> {
     (0..l, 0..l, 0..2u8, 0..2u8)
         .prop_map(|(x, y, hx, hy)| [x as f64 + 0.5 * hx as f64, y as f64 + 0.5 * hy as f64])
-}
-
-/// Maximum absolute difference of two slices.
-pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }

@@ -187,7 +187,13 @@ fn load_frame(
         .chunks_exact(2)
         .map(|s| [s[0], s[1]])
         .collect();
-    let tissue = Tissue::from_state(cells, scene.model_params(zeta), time, step, (0..n).collect());
+    let tissue = Tissue::from_state(
+        cells,
+        scene.model_params(zeta),
+        time,
+        step,
+        (0..n).collect(),
+    );
     Ok((tissue, shapes, step))
 }
 

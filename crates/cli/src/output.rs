@@ -121,9 +121,15 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
         ("centre", npy(&[n64, 2], centre.iter().flatten().copied())?),
         (
             "velocity",
-            npy(&[n64, 2], cs.iter().flat_map(|c| [c.velocity.x, c.velocity.y]))?,
+            npy(
+                &[n64, 2],
+                cs.iter().flat_map(|c| [c.velocity.x, c.velocity.y]),
+            )?,
         ),
-        ("force", npy(&[n64, 2], cs.iter().flat_map(|c| [c.force.x, c.force.y]))?),
+        (
+            "force",
+            npy(&[n64, 2], cs.iter().flat_map(|c| [c.force.x, c.force.y]))?,
+        ),
         ("area", npy(&[n64], cs.iter().map(|c| c.area))?),
         (
             "shape_tensor",

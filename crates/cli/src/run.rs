@@ -1,4 +1,4 @@
-//! `monolayer run`: builds the scene's [`Simulation`] and adds the output writers of a run
+//! `monolayer run`: builds the scene's [`mechanics::Simulation`] and adds the output writers of a run
 //! directory (series rows, frames) and a progress report, each on its schedule.
 
 use std::cell::Cell;

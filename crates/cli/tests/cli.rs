@@ -58,9 +58,9 @@ fn a_run_writes_scene_series_and_frames() {
     assert_eq!(frames.len(), 6, "frames at t = 0, 2, ..., 10");
     // The resolved scene parses back and has every default filled in.
     let resolved = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
-    let scene = monolayer_cli::scene::Scene::parse(&resolved, &[]).unwrap();
-    assert_eq!(scene.run.time, 6.0);
-    assert_eq!(scene.integrator.margin, 12);
+    let scene = scene::Scene::parse(&resolved, &[]).unwrap();
+    assert_eq!(scene.file().run.time, 6.0);
+    assert_eq!(scene.file().integrator.margin, 12);
 }
 
 /// The README's three-line snippet, run by NumPy itself. CI installs NumPy; elsewhere the test
@@ -331,8 +331,7 @@ fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
 fn shipped_scenes_are_valid_and_the_single_cell_rests() {
     for name in ["paper.toml", "single.toml", "large.toml"] {
         let text = std::fs::read_to_string(scene_path(name)).unwrap();
-        let scene = monolayer_cli::scene::Scene::parse(&text, &[]).unwrap();
-        scene.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+        scene::Scene::parse(&text, &[]).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
     let dir = tempfile::tempdir().unwrap();
     let o = run(&scene_path("single.toml"), dir.path(), &[]);

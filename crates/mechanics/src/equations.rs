@@ -157,12 +157,16 @@ mod tests {
             let (lap, a) = (0.07, -0.01);
             let u = pressure_cell_part(PressureKind::Paper, &coef, phi, lap, a);
             let p = pressure(PressureKind::Paper, &coef, phi, phi * phi, u);
-            let expected = coef.gradient * lap - a * phi
+            let expected = coef.gradient * lap
+                - a * phi
                 - coef.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi);
             assert!((p - expected).abs() <= 1e-15, "{p} {expected}");
             let u = pressure_cell_part(PressureKind::Interaction, &coef, phi, lap, a);
             let p = pressure(PressureKind::Interaction, &coef, phi, phi * phi, u);
-            assert!(p.abs() <= 1e-16, "one cell has no interaction pressure: {p}");
+            assert!(
+                p.abs() <= 1e-16,
+                "one cell has no interaction pressure: {p}"
+            );
         }
     }
 

@@ -41,20 +41,25 @@ impl<T: Real> Tissue<T> {
             ..
         } = ws;
         let cs: &[_] = cell_state;
-        scatter::<2, T, _>(&self.cells, self.cells.phi(), velocity_field, |i, run, sums| {
-            let [ux, uy] = [cs[i].velocity.x, cs[i].velocity.y];
-            let [vx, vy] = sums;
-            let n = run.c.len();
-            let (vx, vy) = (&mut vx[..n], &mut vy[..n]);
-            run.map(
-                [],
-                |s, []| [s.c * ux, s.c * uy],
-                |j, [x, y]| {
-                    vx[j] += x;
-                    vy[j] += y;
-                },
-            );
-        });
+        scatter::<2, T, _>(
+            &self.cells,
+            self.cells.phi(),
+            velocity_field,
+            |i, run, sums| {
+                let [ux, uy] = [cs[i].velocity.x, cs[i].velocity.y];
+                let [vx, vy] = sums;
+                let n = run.c.len();
+                let (vx, vy) = (&mut vx[..n], &mut vy[..n]);
+                run.map(
+                    [],
+                    |s, []| [s.c * ux, s.c * uy],
+                    |j, [x, y]| {
+                        vx[j] += x;
+                        vy[j] += y;
+                    },
+                );
+            },
+        );
     }
 
     /// Evaluates the state and returns its lattice fields. Allocates the result; meant for

@@ -79,7 +79,13 @@ mod tests {
     /// `½ atan2(xy, xx)`, to round-off, and `T a = |T| a`.
     #[test]
     fn the_axis_is_the_closed_form_eigenvector() {
-        for &(xx, xy) in &[(1.0, 0.0), (-1.0, 0.0), (0.3, 0.4), (-0.2, -0.9), (0.0, 2.0)] {
+        for &(xx, xy) in &[
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.3, 0.4),
+            (-0.2, -0.9),
+            (0.0, 2.0),
+        ] {
             let t = TracelessTensor::new(xx, xy);
             let (lambda, a) = t.axis();
             assert!((lambda - t.magnitude()).abs() < 1e-14 * t.magnitude().max(1.0));
@@ -87,7 +93,10 @@ mod tests {
             assert!(r.norm() < 1e-14, "{r:?}");
             let theta = t.angle();
             let closed = Vector2::new(theta.cos(), theta.sin());
-            assert!((a.dot(&closed).abs() - 1.0).abs() < 1e-14, "{a:?} {closed:?}");
+            assert!(
+                (a.dot(&closed).abs() - 1.0).abs() < 1e-14,
+                "{a:?} {closed:?}"
+            );
         }
     }
 }

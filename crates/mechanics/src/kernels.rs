@@ -191,8 +191,8 @@ fn evaluate_in<T: Real, const PAPER: bool>(
                         &cols[i_qxy][y],
                     ];
                     let value = |s: Stencil, [s1, s2, u, qxx, qxy]: [f64; 5]| {
-                        let p_cell = pressure(kind, &coef, s1, s2, u)
-                            - pressure_self_part(kind, &coef, s.c);
+                        let p_cell =
+                            pressure(kind, &coef, s1, s2, u) - pressure_self_part(kind, &coef, s.c);
                         force_density(p_cell, zeta, [qxx, qxy], [s.dx(), s.dy()])
                     };
                     run.sum_into(fields, value, &mut acc);

@@ -152,7 +152,7 @@ impl Default for StepParams {
 
 impl StepParams {
     /// Time step `dt` with `npc` corrector passes.
-    pub fn new(dt: f64, npc: usize) -> Self {
+    pub const fn new(dt: f64, npc: usize) -> Self {
         Self { dt, npc }
     }
 

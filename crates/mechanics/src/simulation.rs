@@ -123,7 +123,9 @@ pub enum SimulationError {
         source: CallbackError,
     },
     /// Nothing would stop the run.
-    #[error("the simulation has no stop criterion: set stop_iteration, stop_time or wall_time_limit")]
+    #[error(
+        "the simulation has no stop criterion: set stop_iteration, stop_time or wall_time_limit"
+    )]
     NoStop,
 }
 
@@ -262,7 +264,6 @@ pub struct RunInfo {
 /// let shape = PatchShape::new(lattice, 12).unwrap();
 /// let cells = init::discs(lattice, shape, &[[16.0, 24.0], [30.0, 24.0]], 7.0, 2.5);
 /// let tissue = Tissue::new(cells, ModelParams::paper(0.0));
-/// let mut v_rms = Vec::new();
 /// let mut sim = Simulation::new(tissue, StepParams::paper()).stop_iteration(20);
 /// sim.add_callback("v_rms", Schedule::IterationInterval(10), move |o: &mut Observation<f64>| {
 ///     assert!(o.observables().v_rms.is_finite());
@@ -469,7 +470,9 @@ impl<T: Real> Simulation<T> {
     /// then holds the last good state) or callback error. The finalizers run in every case
     /// but the first.
     pub fn run(&mut self) -> Result<RunInfo, SimulationError> {
-        if self.stop_iteration.is_none() && self.stop_time.is_none() && self.wall_time_limit.is_none()
+        if self.stop_iteration.is_none()
+            && self.stop_time.is_none()
+            && self.wall_time_limit.is_none()
         {
             return Err(SimulationError::NoStop);
         }
@@ -502,8 +505,11 @@ impl<T: Real> Simulation<T> {
             let (timer, check) = &mut self.check;
             let checked = timer.fires(it, self.tissue.time(), false);
             let check: &mut dyn StepCheck = if checked { check.as_mut() } else { &mut none };
-            self.tissue
-                .step_checked(&mut self.workspace, &self.step_params, &mut DynCheck(check))?;
+            self.tissue.step_checked(
+                &mut self.workspace,
+                &self.step_params,
+                &mut DynCheck(check),
+            )?;
             self.apply_activity();
             self.fire(start, Hook::Call, stop)?;
         }

@@ -58,7 +58,10 @@ impl<T: Real> Tissue<T> {
         let n = cells.n_cells();
         let mut seen = vec![false; n];
         assert!(
-            cell_id.len() == n && cell_id.iter().all(|&i| i < n && !std::mem::replace(&mut seen[i], true)),
+            cell_id.len() == n
+                && cell_id
+                    .iter()
+                    .all(|&i| i < n && !std::mem::replace(&mut seen[i], true)),
             "cell_id must be a permutation of 0..{n}"
         );
         let mut t = Self {

@@ -56,15 +56,9 @@ fn check_steps() {
             4.0,
             2.5,
         );
-        let mut t = Tissue::new(
-            cells,
-            ModelParams {
-                pressure,
-                ..ModelParams::paper(0.01)
-            },
-        );
-        let mut ws = Workspace::new(&t.cells);
-        let sp = StepParams { dt: 0.2, npc: 2 };
+        let mut t = Tissue::new(cells, ModelParams::paper(0.01).with_pressure(pressure));
+        let mut ws = Workspace::new(t.cells());
+        let sp = StepParams::new(0.2, 2);
         // Warm-up: starts rayon's pool and its thread-local state.
         for _ in 0..3 {
             t.step(&mut ws, &sp).unwrap();

@@ -232,22 +232,22 @@ impl SceneFile {
         let centres = match init::positions(lattice, c.count, r0, &layout) {
             Ok(centres) => centres,
             Err(e) => {
-            let key = if c.init == InitKind::Positions {
-                "positions"
-            } else {
-                "count"
-            };
-            return Err(invalid(
-                "cells",
-                key,
-                if key == "count" {
-                    c.count.to_string()
+                let key = if c.init == InitKind::Positions {
+                    "positions"
                 } else {
-                    "[...]".into()
-                },
-                e.to_string(),
-                "use fewer cells, smaller init_radius or a larger [domain]",
-            ));
+                    "count"
+                };
+                return Err(invalid(
+                    "cells",
+                    key,
+                    if key == "count" {
+                        c.count.to_string()
+                    } else {
+                        "[...]".into()
+                    },
+                    e.to_string(),
+                    "use fewer cells, smaller init_radius or a larger [domain]",
+                ));
             }
         };
         Ok(Scene {
@@ -274,6 +274,4 @@ impl SceneFile {
         let dt_max = self.model_params(self.model.zeta).max_stable_dt();
         (self.integrator.dt > dt_max).then_some(dt_max)
     }
-
-
 }

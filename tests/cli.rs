@@ -1,1 +1,0 @@
-//! The `monolayer` binary end to end.

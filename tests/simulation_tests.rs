@@ -1,0 +1,172 @@
+//! The driver (`mechanics::Simulation`): schedules, observation that never changes the
+//! dynamics, and the convergence order of the integrator.
+
+use std::sync::{Arc, Mutex};
+
+use mechanics::{Observation, Schedule, Simulation, StepParams, Tissue};
+use phasefield::Lattice;
+use scene::Scene;
+
+use crate::strategies::discs;
+
+/// A state recorded by a callback: iteration, fields, centres and the written observables.
+type Record = (u64, Vec<f32>, Vec<[f64; 2]>, [f64; 2]);
+
+/// Runs the shipped paper scene (60 cells, 100², default integrator, f32) for 600 TU of
+/// relaxation and 100 TU at ζ = 0.005 (1400 steps: 6 memory re-sorts, every 250 steps),
+/// recording the state every `every` TU.
+fn observed_run(every: f64) -> Vec<Record> {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/paper.toml"))
+            .unwrap();
+    let overrides = [
+        "run.relax_time=600",
+        "run.time=100",
+        "integrator.dt=0.5",
+        "integrator.margin=16",
+    ]
+    .map(String::from);
+    let scene = Scene::parse(&text, &overrides).unwrap();
+    let mut sim = scene.simulation::<f32>();
+    let out = Arc::new(Mutex::new(Vec::new()));
+    let sink = out.clone();
+    sim.add_output_writer(
+        "recorder",
+        Schedule::TimeInterval(every),
+        move |o: &mut Observation<f32>| {
+            let obs = o.observables();
+            let t = o.tissue();
+            sink.lock().unwrap().push((
+                t.iteration(),
+                t.cells().phi().to_vec(),
+                o.workspace().centres().to_vec(),
+                [obs.v_rms, obs.s_rms],
+            ));
+            Ok(())
+        },
+    );
+    sim.run().unwrap();
+    let v = out.lock().unwrap().clone();
+    v
+}
+
+/// Observation never changes what the dynamics use: frames every 10 TU and every 50 TU give
+/// bit-identical states, centres and observables at the times both write, across six memory
+/// re-sorts and the switch of activity.
+#[test]
+fn output_is_bit_identical_whatever_the_output_interval() {
+    let (often, rarely) = (observed_run(10.0), observed_run(50.0));
+    assert_eq!(often.len(), 71, "t = 0, 10, ..., 700");
+    assert_eq!(rarely.len(), 15, "t = 0, 50, ..., 700");
+    for r in &rarely {
+        let o = often
+            .iter()
+            .find(|o| o.0 == r.0)
+            .unwrap_or_else(|| panic!("no frame at step {} in the frequent run", r.0));
+        assert!(o.1 == r.1, "fields differ at step {}", r.0);
+        assert_eq!(o.2, r.2, "centres at step {}", r.0);
+        assert_eq!(o.3, r.3, "observables at step {}", r.0);
+    }
+}
+
+/// The schedules fire where documented: an iteration interval at its multiples (the start
+/// included), a time interval at the first step at or after each multiple, and the stop time
+/// is honoured.
+#[test]
+fn schedules_fire_where_documented() {
+    let tissue = Tissue::new(
+        discs(40, 12, &[[14.0, 20.0], [26.0, 20.0]], 7.0),
+        mechanics::ModelParams::paper(0.0),
+    );
+    let mut sim = Simulation::new(tissue, StepParams::new(0.3, 1)).stop_time(3.0);
+    let (iters, times) = (
+        Arc::new(Mutex::new(Vec::new())),
+        Arc::new(Mutex::new(Vec::new())),
+    );
+    let (a, b) = (iters.clone(), times.clone());
+    sim.add_callback(
+        "iterations",
+        Schedule::IterationInterval(4),
+        move |o: &mut Observation<f64>| {
+            a.lock().unwrap().push(o.iteration());
+            Ok(())
+        },
+    );
+    sim.add_callback(
+        "times",
+        Schedule::TimeInterval(1.0),
+        move |o: &mut Observation<f64>| {
+            b.lock().unwrap().push(o.iteration());
+            Ok(())
+        },
+    );
+    sim.run().unwrap();
+    assert_eq!(sim.tissue().iteration(), 10, "3.0 / 0.3 steps");
+    assert_eq!(*iters.lock().unwrap(), [0, 4, 8]);
+    // t = 0, then the first steps at or after 1.0 (step 4, t = 1.2), 2.0 (step 7, t = 2.1)
+    // and 3.0 (step 10, t = 3.0 to round-off).
+    assert_eq!(*times.lock().unwrap(), [0, 4, 7, 10]);
+}
+
+/// Without a stop criterion a run is refused rather than endless.
+#[test]
+fn a_simulation_without_a_stop_criterion_is_refused() {
+    let tissue = Tissue::new(
+        discs(40, 12, &[[20.0, 20.0]], 7.0),
+        mechanics::ModelParams::paper(0.0),
+    );
+    let mut sim = Simulation::new(tissue, StepParams::default());
+    assert!(matches!(sim.run(), Err(mechanics::SimulationError::NoStop)));
+}
+
+/// Max |Δφ| between two states of the same cells.
+fn field_error(a: &Tissue, b: &Tissue) -> f64 {
+    a.cells()
+        .phi()
+        .iter()
+        .zip(b.cells().phi())
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Two overlapping cells pushing apart at ζ = 0.01 for 4 TU, stored on the full 40² domain
+/// (no patch moves, whose discrete jumps would hide the order), with time step `dt`.
+fn pair_after(dt: f64, npc: usize) -> Tissue {
+    let lattice = Lattice::new(40, 40);
+    let mut t = Tissue::new(
+        discs(40, 0, &[[14.0, 20.0], [25.0, 21.5]], 7.0),
+        mechanics::ModelParams::paper(0.01),
+    );
+    assert_eq!(t.lattice(), lattice);
+    let mut ws = mechanics::Workspace::new(t.cells());
+    let steps = (4.0 / dt).round() as usize;
+    for _ in 0..steps {
+        t.step(&mut ws, &StepParams::new(dt, npc)).unwrap();
+    }
+    t
+}
+
+/// The observed order of the integrator in dt: Heun (one corrector) is second order and
+/// forward Euler first order. Errors are max |Δφ| after 4 TU against dt = 0.003125 (its own
+/// error is (0.003125/0.05)² ≈ 1/256 of the smallest Heun error measured, so it moves the
+/// last ratio by < 1 %). The order from successive halvings must lie within ±0.15 of the
+/// theory: the leading error term dominates once dt is well below the stability limit (≈ 4
+/// here), and measured orders are 2.01–2.02 (Heun) and 1.005–1.02 (Euler).
+#[test]
+fn heun_is_second_order_and_euler_first_order_in_dt() {
+    let reference = pair_after(0.003125, 1);
+    for (npc, order) in [(1usize, 2.0), (0, 1.0)] {
+        let errors: Vec<f64> = [0.4, 0.2, 0.1, 0.05]
+            .iter()
+            .map(|&dt| field_error(&pair_after(dt, npc), &reference))
+            .collect();
+        for w in errors.windows(2) {
+            let observed = (w[0] / w[1]).log2();
+            eprintln!("npc = {npc}: errors {errors:?}, observed order {observed:.3}");
+            assert!(
+                (observed - order).abs() < 0.15,
+                "npc = {npc}: order {observed} from errors {errors:?}"
+            );
+        }
+    }
+}
