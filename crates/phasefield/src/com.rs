@@ -5,7 +5,7 @@
 //! round-off, wherever the field sits on the torus.
 
 use crate::lattice::Lattice;
-use crate::patch::PatchShape;
+use crate::PatchShape;
 
 /// Precomputed `cos` and `sin` of `2π s / L_s` for every lattice coordinate.
 #[derive(Debug, Clone)]

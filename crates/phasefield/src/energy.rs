@@ -15,7 +15,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::lattice::Lattice;
-use crate::patch::Cells;
+use crate::Cells;
 
 /// The parameters of the free energy.
 ///

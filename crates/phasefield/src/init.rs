@@ -5,8 +5,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::lattice::Lattice;
-use crate::patch::{Cells, PatchShape};
 use crate::PhaseFieldError;
+use crate::{Cells, PatchShape};
 
 /// The largest fraction of the domain the initial discs may cover.
 ///

@@ -29,19 +29,23 @@
 //! ```
 #![deny(missing_docs)]
 
+mod cells;
 mod com;
 mod energy;
 pub mod init;
 mod lattice;
-mod patch;
 mod real;
 mod runs;
+mod shape;
+mod stencil;
 
+pub use cells::{Cells, PatchMap};
 pub use com::ComTable;
 pub use energy::{EnergyCoefficients, EnergyParams};
 pub use lattice::{min_image, wrap_real, Lattice};
-pub use patch::{for_each_stencil, for_each_stencil_at, Cells, PatchMap, PatchShape, Stencil};
 pub use real::Real;
+pub use shape::PatchShape;
+pub use stencil::{for_each_stencil, for_each_stencil_at, Stencil};
 
 /// The SIMD machinery of the step's kernels: runs of patch rows, their stencils and lane sums.
 ///
@@ -49,8 +53,8 @@ pub use real::Real;
 /// API and may change with any release. Use [`for_each_stencil`] (node by node) instead.
 #[doc(hidden)]
 pub mod kernel {
-    pub use crate::patch::for_each_stencil_in_column;
     pub use crate::runs::{add_lanes, for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
+    pub use crate::stencil::for_each_stencil_in_column;
 }
 
 /// Errors from building lattices, patches and initial states.
