@@ -87,13 +87,7 @@ fn bench_analysis(c: &mut Criterion) {
     g.bench_function("defects", |b| b.iter(|| detect(lattice, &sq.0, &sq.1)));
     let n_defects = detect(lattice, &sq.0, &sq.1).len();
     eprintln!("{n_defects} defects in the frame");
-    let mut tracker = Tracker::new(
-        lattice,
-        TrackParams {
-            max_link: 8.0,
-            max_pair: 16.0,
-        },
-    );
+    let mut tracker = Tracker::new(lattice, TrackParams::for_radius(8.0));
     let mut avg = DefectAverage::new(101);
     g.bench_function("whole-frame", |b| {
         b.iter(|| analyse(lattice, &f, &mut corr, &mut tracker, &mut avg))

@@ -173,7 +173,7 @@ fn two_overlapping_cells_move_apart_with_equal_and_opposite_velocities() {
 
 fn net_force_ratio(ws: &Workspace) -> f64 {
     let (mut sx, mut sy, mut sabs) = (0.0, 0.0, 0.0);
-    for c in ws.cells() {
+    for c in ws.cell_states() {
         sx += c.force[0];
         sy += c.force[1];
         sabs += c.force[0].hypot(c.force[1]);
@@ -268,7 +268,7 @@ fn net_force_is_the_lattice_sum_it_reduces_to() {
                     terms += 1;
                 });
             }
-            let sum = ws.cells().iter().fold([0.0, 0.0], |a, c| [a[0] + c.force.x, a[1] + c.force.y]);
+            let sum = ws.cell_states().iter().fold([0.0, 0.0], |a, c| [a[0] + c.force.x, a[1] + c.force.y]);
             let err = (sum[0] - rhs[0]).hypot(sum[1] - rhs[1]);
             let tol = 8.0 * terms as f64 * f64::EPSILON * scale;
             eprintln!("net force seed={seed} {pressure:?} zeta={zeta:.4}: |ΣF| {:.3e}, identity error {err:.1e} (tolerance {tol:.1e})", sum[0].hypot(sum[1]));

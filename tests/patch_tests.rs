@@ -56,7 +56,7 @@ pub fn patch_error(m: usize, zeta: f64) -> (f64, f64, usize) {
 /// 8.4e-4, 4.0e-5, 1.0e-6 (at most 0.85 × tail). Both are bounded by 2 × tail, and must
 /// decrease monotonically with m. The observed convergence rate, the least-squares slope of
 /// ln(error) against m, must be at least 0.8 times the tail's (2/λ = 0.8 per node far out;
-/// 0.79 over these m): measured 0.94 for the centres and 0.78 for the fields.
+/// 0.79 over these m): measured 0.93 for the centres and 0.78 for the fields.
 #[test]
 fn a_patch_crossing_the_periodic_edges_matches_the_full_domain() {
     let margins = [10usize, 12, 16, 20, 25];

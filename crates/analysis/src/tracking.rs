@@ -17,11 +17,27 @@ use crate::defects::Defect;
 
 /// Tracking distances.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct TrackParams {
-    /// Longest link of one defect between consecutive frames.
+    /// Longest link of one defect between consecutive frames (default R: a defect moves far
+    /// less than a cell radius between frames at the usual output intervals, and defects are
+    /// several radii apart). Larger values link defects that are not the same one.
     pub max_link: f64,
-    /// Largest separation of a created or annihilated pair.
+    /// Largest separation of a created or annihilated pair (default 2R). Larger values pair
+    /// births and deaths that are unrelated.
     pub max_pair: f64,
+}
+
+impl TrackParams {
+    /// The given distances.
+    pub const fn new(max_link: f64, max_pair: f64) -> Self {
+        Self { max_link, max_pair }
+    }
+
+    /// The defaults for cells of radius `radius`: links within R, pairs within 2R.
+    pub fn for_radius(radius: f64) -> Self {
+        Self::new(radius, 2.0 * radius)
+    }
 }
 
 /// What happened to defects between two frames.

@@ -242,10 +242,11 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         opts.crop_side % 2 == 1,
         "--crop must be odd (the defect sits on the centre node), e.g. 101"
     );
-    let params = TrackParams {
-        max_link: opts.max_link.unwrap_or(radius),
-        max_pair: opts.max_pair.unwrap_or(2.0 * radius),
-    };
+    let defaults = TrackParams::for_radius(radius);
+    let params = TrackParams::new(
+        opts.max_link.unwrap_or(defaults.max_link),
+        opts.max_pair.unwrap_or(defaults.max_pair),
+    );
 
     let selected: Vec<PathBuf> = frames
         .into_iter()

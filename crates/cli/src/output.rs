@@ -97,7 +97,7 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
     let n = tissue.n_cells();
     let shape = tissue.cells().shape();
     let (nx, ny) = (shape.nx, shape.ny);
-    let cs = ws.cells();
+    let cs = ws.cell_states();
     let lattice = tissue.lattice();
     // Cells are written in identity order, whatever their storage order.
     let slots = tissue.slots();

@@ -67,7 +67,7 @@ pub struct CellState {
 /// never serialised (after rapier's pipeline and faer's scratch memory).
 ///
 /// After an evaluation (a step, or [`crate::Tissue::refresh`] / [`crate::Tissue::observe`])
-/// it holds the per-cell quantities ([`Workspace::cells`]) and the lattice sums
+/// it holds the per-cell quantities ([`Workspace::cell_states`]) and the lattice sums
 /// ([`Workspace::sum_field`]) of the state evaluated last; after a step that is the state of
 /// its last corrector pass, not the new state: observe to evaluate the current one.
 #[derive(Debug, Clone)]
@@ -100,7 +100,7 @@ impl<T: Real> Workspace<T> {
     }
 
     /// The per-cell quantities of the last evaluation, by slot.
-    pub fn cells(&self) -> &[CellState] {
+    pub fn cell_states(&self) -> &[CellState] {
         &self.cell_state
     }
 
