@@ -75,8 +75,8 @@ fn output_is_bit_identical_whatever_the_output_interval() {
 /// after a patch moved): any path by which an observation reached the state, the workspace
 /// buffers the step reads, or the sort would show here. The guarantee itself is structural
 /// (callbacks hold `&Tissue`). Putting back the earlier driver's fault (observation wrote the
-/// sort key) does not fail this scene: the key is a block of 8 nodes, and no cell sat within
-/// 0.24 node of a block edge at a sort.
+/// sort key) does not fail this scene: the key is a block of 8 nodes, and the shifted
+/// centres never changed the order.
 #[test]
 fn observing_at_every_step_changes_nothing() {
     let every_step = observed_run(Schedule::IterationInterval(1), 9, 1);
