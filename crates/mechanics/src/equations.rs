@@ -90,10 +90,24 @@ pub fn pressure(kind: PressureKind, coef: &EnergyCoefficients, s1: f64, s2: f64,
 /// the patch Laplacian, and `φ_i ∂φ_i`) already sum to zero exactly on a periodic patch.
 #[inline(always)]
 pub fn pressure_self_part(kind: PressureKind, coef: &EnergyCoefficients, phi: f64) -> f64 {
+    pressure_self_part_with(pressure_self_coefficient(kind, coef), phi)
+}
+
+/// The coefficient `c` of [`pressure_self_part`] `= −c φ(1−φ)(1−2φ)`: `8γ/λ` (paper) or 0
+/// (interaction).
+#[inline(always)]
+pub fn pressure_self_coefficient(kind: PressureKind, coef: &EnergyCoefficients) -> f64 {
     match kind {
-        PressureKind::Paper => -coef.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi),
+        PressureKind::Paper => coef.double_well,
         PressureKind::Interaction => 0.0,
     }
+}
+
+/// [`pressure_self_part`] from its coefficient ([`pressure_self_coefficient`]), for loops that
+/// compute the coefficient once.
+#[inline(always)]
+pub fn pressure_self_part_with(c_self: f64, phi: f64) -> f64 {
+    -(c_self * phi * (1.0 - phi) * (1.0 - 2.0 * phi))
 }
 
 /// The integrand of the interface force on cell i (MODEL.md §3), the divergence of the
@@ -166,6 +180,27 @@ mod tests {
             assert!(
                 p.abs() <= 1e-16,
                 "one cell has no interaction pressure: {p}"
+            );
+        }
+    }
+
+    /// The identity the force kernel relies on to evaluate both forms without a branch: the
+    /// interaction pressure is the paper formula with `s2` in the place of `s1`, and its self
+    /// part is zero. Exact, bit for bit.
+    #[test]
+    fn the_interaction_form_is_the_paper_form_with_s2_for_s1() {
+        let coef = EnergyParams::paper().coefficients();
+        for &(s1, s2, u, phi) in &[
+            (1.2, 0.9, -0.3, 0.4),
+            (0.1, 0.01, 0.002, 0.97),
+            (2.0, 1.5, 0.7, 0.0),
+        ] {
+            let i = pressure(PressureKind::Interaction, &coef, s1, s2, u);
+            assert_eq!(i, pressure(PressureKind::Paper, &coef, s2, s2, u));
+            let self_i = pressure_self_part(PressureKind::Interaction, &coef, phi);
+            assert_eq!(
+                self_i,
+                0.0 * pressure_self_part(PressureKind::Paper, &coef, phi)
             );
         }
     }

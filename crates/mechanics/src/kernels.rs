@@ -16,13 +16,20 @@ use phasefield::{Cells, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
 use crate::equations::{
-    force_density, nematic_density, pressure, pressure_cell_part, pressure_self_part, rhs,
-    shape_tensor_density, velocity,
+    force_density, nematic_density, pressure, pressure_cell_part, pressure_self_coefficient,
+    pressure_self_part_with, rhs, shape_tensor_density, velocity,
 };
 use crate::geometry::TracelessTensor;
 use crate::params::{ModelParams, PressureKind};
 use crate::scatter::{scatter, LatticeSums};
 use crate::workspace::{CellState, SumField, N_SUMS};
+
+// Where each lattice sum is stored.
+const I_S1: usize = SumField::S1.index();
+const I_S2: usize = SumField::S2.index();
+const I_U: usize = SumField::U.index();
+const I_QXX: usize = SumField::Qxx.index();
+const I_QXY: usize = SumField::Qxy.index();
 
 /// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]
@@ -71,44 +78,28 @@ fn cell_sums<T: Real, const SHAPE: bool>(
 /// With `shapes` false the deformation tensors are not computed (left zero), and so neither is
 /// `Q`: the step passes `shapes = (ζ ≠ 0)`, since only the active force needs them, which saves
 /// 9 % of a passive step (960 cells, 1 thread: 16.2 → 14.7 ms). Observations always compute them.
+///
+/// The pressure form is dispatched outside the loops, and the force loop has no branch on it:
+/// the interaction form of [`pressure`] is the paper form with `s2` in the place of `s1`, so
+/// the loop reads `s2` into that slot, and the self term is weighted 1 (paper) or 0
+/// (interaction); both identities are tested in `equations`. (A version monomorphised on the
+/// form was 9 % slower on the paper scene, 1 thread, measured alternately; so were some
+/// rearrangements of this function that only renamed or regrouped its locals: its speed
+/// depends on how LLVM inlines the closures, so time it after any change, with the whole-run
+/// command in `docs/performance.md`.)
 pub(crate) fn evaluate<T: Real>(
     params: &ModelParams,
     cells: &Cells<T>,
     phi: &[T],
     shapes: bool,
     rhs_out: &mut [T],
-    sums: &mut LatticeSums<N_SUMS>,
+    global: &mut LatticeSums<N_SUMS>,
     cell_state: &mut [CellState],
 ) {
-    match params.pressure {
-        PressureKind::Paper => {
-            evaluate_in::<T, true>(params, cells, phi, shapes, rhs_out, sums, cell_state)
-        }
-        PressureKind::Interaction => {
-            evaluate_in::<T, false>(params, cells, phi, shapes, rhs_out, sums, cell_state)
-        }
-    }
-}
-
-/// [`evaluate`] for one pressure form (`PAPER`), so that the form is a constant in the loops.
-#[inline(always)]
-fn evaluate_in<T: Real, const PAPER: bool>(
-    params: &ModelParams,
-    cells: &Cells<T>,
-    phi: &[T],
-    shapes: bool,
-    rhs_out: &mut [T],
-    sums: &mut LatticeSums<N_SUMS>,
-    cell_state: &mut [CellState],
-) {
-    let kind = if PAPER {
-        PressureKind::Paper
-    } else {
-        PressureKind::Interaction
-    };
     let shape = cells.shape();
     let plen = shape.len();
     let ny = shape.ny;
+    let energy = params.energy;
     let zeta = params.zeta;
     let patch_runs = RowRuns::patch(ny);
 
@@ -125,51 +116,71 @@ fn evaluate_in<T: Real, const PAPER: bool>(
         });
 
     // 2. Lattice sums.
-    let coef = params.energy.coefficients();
+    let coef = energy.coefficients();
+    let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
-        scatter::<N_SUMS, T, _>(cells, phi, sums, |i, run, dst| {
+        scatter::<N_SUMS, T, _>(cells, phi, global, |i, run, sums| {
             let c = &cs[i];
             let n = run.c.len();
-            let [s1, s2, u, qxx, qxy] = dst;
+            let [s1, s2, u, qxx, qxy] = sums;
             let (s1, s2, u) = (&mut s1[..n], &mut s2[..n], &mut u[..n]);
             let (qxx, qxy) = (&mut qxx[..n], &mut qxy[..n]);
             let area_factor = coef.area_factor(c.area);
             let sh = c.shape.components();
-            run.map(
-                [],
-                |s, []| {
-                    let p = s.c;
-                    [
-                        p,
-                        p * p,
-                        pressure_cell_part(kind, &coef, p, s.laplacian(), area_factor),
-                    ]
-                },
-                |j, [p, p2, uj]| {
-                    let [q_xx, q_xy] = nematic_density(p, sh);
-                    s1[j] += p;
-                    s2[j] += p2;
-                    u[j] += uj;
-                    qxx[j] += q_xx;
-                    qxy[j] += q_xy;
-                },
-            );
+            let store = |j: usize, [p, p2, uj]: [f64; 3]| {
+                s1[j] += p;
+                s2[j] += p2;
+                u[j] += uj;
+                let [q_xx, q_xy] = nematic_density(p, sh);
+                qxx[j] += q_xx;
+                qxy[j] += q_xy;
+            };
+            match kind {
+                PressureKind::Paper => run.map(
+                    [],
+                    |s, []| {
+                        let p = s.c;
+                        [
+                            p,
+                            p * p,
+                            pressure_cell_part(
+                                PressureKind::Paper,
+                                &coef,
+                                p,
+                                s.laplacian(),
+                                area_factor,
+                            ),
+                        ]
+                    },
+                    store,
+                ),
+                PressureKind::Interaction => run.map(
+                    [],
+                    |s, []| {
+                        let p = s.c;
+                        [
+                            p,
+                            p * p,
+                            pressure_cell_part(PressureKind::Interaction, &coef, p, 0.0, 0.0),
+                        ]
+                    },
+                    store,
+                ),
+            }
         });
     }
 
     // 3. Forces, velocities and the right-hand side.
-    let g: &LatticeSums<N_SUMS> = sums;
+    let g: &LatticeSums<N_SUMS> = global;
     let map = cells.map();
     let xi = params.xi;
-    let (i_s1, i_s2, i_u) = (
-        SumField::S1.index(),
-        SumField::S2.index(),
-        SumField::U.index(),
-    );
-    let (i_qxx, i_qxy) = (SumField::Qxx.index(), SumField::Qxy.index());
-    // The interaction pressure needs no s1: read s2 in its place, so that no stream is wasted.
-    let i_first = if PAPER { i_s1 } else { i_s2 };
+    // The interaction form is the paper form with s2 in the place of s1 (see the doc above).
+    let first = match kind {
+        PressureKind::Paper => I_S1,
+        PressureKind::Interaction => I_S2,
+    };
+    let c_self = pressure_self_coefficient(kind, &coef);
     rhs_out
         .par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
@@ -184,16 +195,16 @@ fn evaluate_in<T: Real, const PAPER: bool>(
                 for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
                     let y = run.run.y0..run.run.y0 + run.run.len;
                     let fields = [
-                        &cols[i_first][y.clone()],
-                        &cols[i_s2][y.clone()],
-                        &cols[i_u][y.clone()],
-                        &cols[i_qxx][y.clone()],
-                        &cols[i_qxy][y],
+                        &cols[first][y.clone()],
+                        &cols[I_S2][y.clone()],
+                        &cols[I_U][y.clone()],
+                        &cols[I_QXX][y.clone()],
+                        &cols[I_QXY][y],
                     ];
-                    let value = |s: Stencil, [s1, s2, u, qxx, qxy]: [f64; 5]| {
-                        let p_cell =
-                            pressure(kind, &coef, s1, s2, u) - pressure_self_part(kind, &coef, s.c);
-                        force_density(p_cell, zeta, [qxx, qxy], [s.dx(), s.dy()])
+                    let value = |s: Stencil, [s_first, s2, u, qxx, qxy]: [f64; 5]| {
+                        let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
+                            - pressure_self_part_with(c_self, s.c);
+                        force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()])
                     };
                     run.sum_into(fields, value, &mut acc);
                 });
@@ -204,7 +215,7 @@ fn evaluate_in<T: Real, const PAPER: bool>(
             st.velocity = Vector2::from(v);
             let area_factor = coef.area_factor(st.area);
             for (a, &x) in xs.iter().enumerate() {
-                let s2_col = g.column(i_s2, x as usize);
+                let s2_col = g.column(I_S2, x as usize);
                 let out_col = &mut out[a * ny..(a + 1) * ny];
                 for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
                     let (y0, b0, n) = (run.run.y0, run.run.b0, run.run.len);
@@ -221,7 +232,7 @@ fn evaluate_in<T: Real, const PAPER: bool>(
                             );
                             [rhs(v, [s.dx(), s.dy()], dfdphi)]
                         },
-                        |j, [r]| o[j] = T::from_f64(r),
+                        |j, [v]| o[j] = T::from_f64(v),
                     );
                 });
             }
