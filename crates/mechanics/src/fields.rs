@@ -12,6 +12,7 @@ use crate::workspace::{SumField, Workspace};
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]
+#[non_exhaustive]
 pub struct TissueFields {
     /// `v_x = Σ_i φ_i v_i,x`.
     pub vx: Vec<f64>,

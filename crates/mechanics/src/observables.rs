@@ -7,6 +7,7 @@ use crate::workspace::Workspace;
 
 /// Scalar summary of one state, computed on output steps only.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct Observables {
     /// `sqrt(⟨|v|²⟩)` over the lattice of the tissue velocity `v = Σ_i φ_i v_i`.
     pub v_rms: f64,
