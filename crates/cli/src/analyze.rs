@@ -21,7 +21,7 @@ use anyhow::{bail, ensure, Context, Result};
 use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
-use crate::output::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
+use rundir::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
 use scene::{Scene, SceneFile};
 
 /// Options of `monolayer analyze`.
@@ -387,5 +387,5 @@ fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {
             ));
         }
     }
-    write_npz(path, arrays)
+    Ok(write_npz(path, arrays)?)
 }

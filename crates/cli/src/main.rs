@@ -93,7 +93,7 @@ fn real_main() -> Result<()> {
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
             let parsed = Scene::parse(&text, &set)
                 .with_context(|| format!("in scene {}", scene.display()))?;
-            run::prepare_output(&out, overwrite)?;
+            rundir::prepare(&out, overwrite)?;
             let pool = pool(threads)?;
             let info = pool.install(|| run::run(&parsed, &out, quiet))?;
             if !quiet {

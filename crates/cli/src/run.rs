@@ -1,10 +1,8 @@
-//! `monolayer run`: builds the scene's [`mechanics::Simulation`] and adds the output writers of a run
-//! directory (series rows, frames) and a progress report, each on its schedule.
+//! `monolayer run`: builds the scene's [`mechanics::Simulation`], adds the run directory's
+//! writers (`rundir::add_writers`) and a progress report, and runs it.
 
-use std::cell::Cell;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use std::rc::Rc;
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -12,7 +10,7 @@ use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
 use phasefield::Real;
 use scene::Scene;
 
-use crate::output::{write_frame, SeriesWriter};
+use rundir::FinalToo;
 
 /// What a finished run reports.
 #[derive(Debug, Clone, Copy)]
@@ -25,40 +23,13 @@ pub struct RunInfo {
     pub frames: usize,
 }
 
-/// Makes sure `out` holds no earlier run: with `overwrite`, removes its `series.csv`,
-/// `scene.toml` and `frames/`; without, refuses.
-///
-/// # Errors
-/// When `out` already holds a run and `overwrite` is false, or files cannot be removed.
-pub fn prepare_output(out: &Path, overwrite: bool) -> Result<()> {
-    let series = out.join("series.csv");
-    if !series.exists() {
-        return Ok(());
-    }
-    anyhow::ensure!(
-        overwrite,
-        "{} already holds a run (series.csv); choose another --out or pass --overwrite to replace it",
-        out.display()
-    );
-    std::fs::remove_file(&series)?;
-    let _ = std::fs::remove_file(out.join("scene.toml"));
-    let frames = out.join("frames");
-    if frames.exists() {
-        std::fs::remove_dir_all(&frames)
-            .with_context(|| format!("cannot remove {}", frames.display()))?;
-    }
-    Ok(())
-}
-
 /// Runs a valid scene, writing into `out`. On a step error the output written so far is
 /// kept and the error is returned.
 ///
 /// # Errors
 /// When the directory cannot be written or the run stops early.
 pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
-    std::fs::create_dir_all(out)
-        .with_context(|| format!("cannot create output directory {}", out.display()))?;
-    std::fs::write(out.join("scene.toml"), scene.to_toml())?;
+    rundir::write_scene(out, scene)?;
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
@@ -71,20 +42,7 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
 fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     let counts = scene.step_counts();
     let mut sim = scene.simulation::<T>();
-    let frames = Rc::new(Cell::new(0));
-    sim.add_output_writer(
-        "series.csv",
-        Schedule::IterationInterval(counts.series_every),
-        FinalToo::new(SeriesRows(SeriesWriter::create(out)?)),
-    );
-    sim.add_output_writer(
-        "frame writer",
-        Schedule::IterationInterval(counts.frame_every),
-        FinalToo::new(Frames {
-            out: out.to_path_buf(),
-            written: frames.clone(),
-        }),
-    );
+    let written = rundir::add_writers(&mut sim, out, &counts)?;
     sim.add_output_writer(
         "progress",
         Schedule::IterationInterval(counts.series_every.min(counts.frame_every)),
@@ -101,61 +59,8 @@ fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
     Ok(RunInfo {
         steps: info.iterations,
         wall_s: info.wall_time.as_secs_f64(),
-        frames: frames.get(),
+        frames: written.frames(),
     })
-}
-
-/// A writer that also writes the final state, unless its schedule just did.
-struct FinalToo<W> {
-    inner: W,
-    last: Option<u64>,
-}
-
-impl<W> FinalToo<W> {
-    fn new(inner: W) -> Self {
-        Self { inner, last: None }
-    }
-}
-
-impl<T: Real, W: Callback<T>> Callback<T> for FinalToo<W> {
-    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
-        self.last = Some(obs.iteration());
-        self.inner.call(obs)
-    }
-
-    fn finalize(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
-        if self.last != Some(obs.iteration()) {
-            self.call(obs)?;
-        }
-        self.inner.finalize(obs)
-    }
-}
-
-/// Rows of `series.csv`.
-struct SeriesRows(SeriesWriter);
-
-impl<T: Real> Callback<T> for SeriesRows {
-    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
-        let o = obs.observables();
-        self.0.row(obs.tissue(), &o)?;
-        Ok(())
-    }
-}
-
-/// Frames in `frames/`.
-struct Frames {
-    out: PathBuf,
-    written: Rc<Cell<usize>>,
-}
-
-impl<T: Real> Callback<T> for Frames {
-    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
-        let tissue = obs.tissue();
-        let ws = obs.workspace();
-        write_frame(&self.out, tissue, ws)?;
-        self.written.set(self.written.get() + 1);
-        Ok(())
-    }
 }
 
 /// A progress bar on a terminal, plain lines (about every 10 %) otherwise.

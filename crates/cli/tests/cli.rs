@@ -433,7 +433,7 @@ fn analyze_after_run_writes_consistent_files() {
     assert_eq!(corr[0], vec!["0", "1e0", "1e0", "1e0"]);
     let lengths = csv_rows(&an.join("lengths.csv"));
     assert_eq!(lengths.len(), 3);
-    let avg = monolayer_cli::output::read_npz(
+    let avg = rundir::read_npz(
         &an.join("defect_averages.npz"),
         &["n_plus", "n_minus", "plus_vx", "minus_qxx"],
     )
@@ -528,9 +528,7 @@ fn plus_half_defects_self_propel_along_their_axis() {
         .unwrap();
     assert!(a.status.success(), "{}", stderr(&a));
     let names = ["plus_vx", "plus_vy", "minus_vx", "minus_vy", "n_plus"];
-    let f =
-        monolayer_cli::output::read_npz(&dir.path().join("analysis/defect_averages.npz"), &names)
-            .unwrap();
+    let f = rundir::read_npz(&dir.path().join("analysis/defect_averages.npz"), &names).unwrap();
     assert!(
         f[4].data[0] > 100.0,
         "enough defects to average: {}",

@@ -1,4 +1,4 @@
-//! Output files of a run: the resolved scene, `series.csv` and `frames/frame_STEP.npz`.
+//! The frames of a run, `frames/frame_STEP.npz`, and reading `.npz` archives back.
 //!
 //! Frames are NumPy `.npz` archives (zip of `.npy` arrays, deflate-compressed), readable with
 //! `numpy.load` and no custom code. Arrays in a frame:
@@ -20,61 +20,20 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use mechanics::{Observables, Tissue, Workspace};
+use mechanics::{Tissue, Workspace};
+
+use crate::{Result, RunDirError};
 use npyz::WriterBuilder;
 use phasefield::Real;
 
 /// Version of the frame layout; `monolayer analyze` refuses frames of another version.
 pub const FRAME_FORMAT: i64 = 1;
 
-/// The header of `series.csv`.
-pub const SERIES_HEADER: &str =
-    "step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max,cell_speed_rms,phi_min,phi_max";
-
-/// Writes `series.csv` row by row, flushing each row so that a run that stops keeps them.
-pub struct SeriesWriter {
-    out: BufWriter<File>,
-}
-
-impl SeriesWriter {
-    /// Creates `dir/series.csv` with its header.
-    pub fn create(dir: &Path) -> Result<Self> {
-        let path = dir.join("series.csv");
-        let f = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
-        let mut out = BufWriter::new(f);
-        writeln!(out, "{SERIES_HEADER}")?;
-        out.flush()?;
-        Ok(Self { out })
-    }
-
-    /// Appends one row.
-    pub fn row<T: Real>(&mut self, tissue: &Tissue<T>, o: &Observables) -> Result<()> {
-        writeln!(
-            self.out,
-            "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}",
-            tissue.iteration(),
-            tissue.time(),
-            tissue.params().zeta,
-            o.v_rms,
-            o.s_rms,
-            o.area_mean,
-            o.area_min,
-            o.area_max,
-            o.cell_speed_rms,
-            o.phi_min,
-            o.phi_max
-        )?;
-        self.out.flush()?;
-        Ok(())
-    }
-}
-
 /// One `.npy` array in memory.
-pub(crate) fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
+pub fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
     shape: &[u64],
     data: impl IntoIterator<Item = T>,
-) -> Result<Vec<u8>> {
+) -> std::io::Result<Vec<u8>> {
     let mut buf = Vec::new();
     {
         let mut w = npyz::WriteOptions::new()
@@ -92,7 +51,7 @@ pub(crate) fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
 /// current state (call [`Tissue::observe`] or [`Tissue::refresh`] first).
 pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -> Result<PathBuf> {
     let frames = dir.join("frames");
-    std::fs::create_dir_all(&frames)?;
+    std::fs::create_dir_all(&frames).map_err(|e| RunDirError::io("create", &frames, e))?;
     let path = frames.join(format!("frame_{:08}.npz", tissue.iteration()));
     let n = tissue.n_cells();
     let shape = tissue.cells().shape();
@@ -109,67 +68,72 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
         tissue.cells().unrolled_into(slot, chunk);
     }
     let n64 = n as u64;
-    let arrays: Vec<(&str, Vec<u8>)> = vec![
-        ("format", npy(&[], [FRAME_FORMAT])?),
-        ("step", npy(&[], [tissue.iteration() as i64])?),
-        ("time", npy(&[], [tissue.time()])?),
-        ("zeta", npy(&[], [tissue.params().zeta])?),
-        (
-            "lattice",
-            npy(&[2], [lattice.lx as i64, lattice.ly as i64])?,
-        ),
-        ("centre", npy(&[n64, 2], centre.iter().flatten().copied())?),
-        (
-            "velocity",
-            npy(
-                &[n64, 2],
-                cs.iter().flat_map(|c| [c.velocity.x, c.velocity.y]),
-            )?,
-        ),
-        (
-            "force",
-            npy(&[n64, 2], cs.iter().flat_map(|c| [c.force.x, c.force.y]))?,
-        ),
-        ("area", npy(&[n64], cs.iter().map(|c| c.area))?),
-        (
-            "shape_tensor",
-            npy(&[n64, 2], cs.iter().flat_map(|c| c.shape.components()))?,
-        ),
-        (
-            "origin",
-            npy(
-                &[n64, 2],
-                slots
-                    .iter()
-                    .flat_map(|&s| [origin[s][0] as i64, origin[s][1] as i64]),
-            )?,
-        ),
-        (
-            "phi",
-            npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?,
-        ),
-    ];
+    let arrays = || -> std::io::Result<Vec<(&str, Vec<u8>)>> {
+        Ok(vec![
+            ("format", npy(&[], [FRAME_FORMAT])?),
+            ("step", npy(&[], [tissue.iteration() as i64])?),
+            ("time", npy(&[], [tissue.time()])?),
+            ("zeta", npy(&[], [tissue.params().zeta])?),
+            (
+                "lattice",
+                npy(&[2], [lattice.lx as i64, lattice.ly as i64])?,
+            ),
+            ("centre", npy(&[n64, 2], centre.iter().flatten().copied())?),
+            (
+                "velocity",
+                npy(
+                    &[n64, 2],
+                    cs.iter().flat_map(|c| [c.velocity.x, c.velocity.y]),
+                )?,
+            ),
+            (
+                "force",
+                npy(&[n64, 2], cs.iter().flat_map(|c| [c.force.x, c.force.y]))?,
+            ),
+            ("area", npy(&[n64], cs.iter().map(|c| c.area))?),
+            (
+                "shape_tensor",
+                npy(&[n64, 2], cs.iter().flat_map(|c| c.shape.components()))?,
+            ),
+            (
+                "origin",
+                npy(
+                    &[n64, 2],
+                    slots
+                        .iter()
+                        .flat_map(|&s| [origin[s][0] as i64, origin[s][1] as i64]),
+                )?,
+            ),
+            (
+                "phi",
+                npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?,
+            ),
+        ])
+    };
+    let arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
     write_npz(&path, arrays)?;
     Ok(path)
 }
 
 /// Writes named `.npy` arrays (from [`npy`]) as a deflated `.npz` archive, through a
 /// temporary name so that a reader never sees a half-written file.
-pub(crate) fn write_npz<S: AsRef<str>>(path: &Path, arrays: Vec<(S, Vec<u8>)>) -> Result<()> {
+pub fn write_npz<S: AsRef<str>>(path: &Path, arrays: Vec<(S, Vec<u8>)>) -> Result<()> {
     let tmp = path.with_extension("npz.partial");
-    {
-        let f = File::create(&tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
+    let write = || -> std::io::Result<()> {
+        let f = File::create(&tmp)?;
         let mut zip = zip::ZipWriter::new(BufWriter::new(f));
         let opts = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Deflated)
             .compression_level(Some(1));
         for (name, bytes) in arrays {
-            zip.start_file(format!("{}.npy", name.as_ref()), opts)?;
+            zip.start_file(format!("{}.npy", name.as_ref()), opts)
+                .map_err(std::io::Error::other)?;
             zip.write_all(&bytes)?;
         }
-        zip.finish()?.flush()?;
-    }
-    std::fs::rename(&tmp, path)?;
+        zip.finish().map_err(std::io::Error::other)?.flush()
+    };
+    write().map_err(|e| RunDirError::io("write", &tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| RunDirError::io("rename", &tmp, e))?;
     Ok(())
 }
 
@@ -188,30 +152,38 @@ pub struct Array {
 /// # Errors
 /// When the file is not a readable archive or lacks one of the arrays.
 pub fn read_npz(path: &Path, names: &[&str]) -> Result<Vec<Array>> {
-    let f = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let mut zip = zip::ZipArchive::new(BufReader::new(f)).with_context(|| {
-        format!(
-            "{} is not a readable .npz archive (truncated?)",
-            path.display()
-        )
+    let f = File::open(path).map_err(|e| RunDirError::io("open", path, e))?;
+    let mut zip = zip::ZipArchive::new(BufReader::new(f)).map_err(|e| RunDirError::Archive {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
     })?;
     let mut out = Vec::with_capacity(names.len());
     for name in names {
-        let mut entry = zip
-            .by_name(&format!("{name}.npy"))
-            .with_context(|| format!("{} has no array '{name}'", path.display()))?;
+        let bad = |reason: String| RunDirError::BadArray {
+            path: path.to_path_buf(),
+            name: name.to_string(),
+            reason,
+        };
+        let mut entry =
+            zip.by_name(&format!("{name}.npy"))
+                .map_err(|_| RunDirError::MissingArray {
+                    path: path.to_path_buf(),
+                    name: name.to_string(),
+                })?;
         let mut bytes = Vec::with_capacity(entry.size() as usize);
-        entry.read_to_end(&mut bytes)?;
-        let npy = npyz::NpyFile::new(&bytes[..])
-            .with_context(|| format!("bad array '{name}' in {}", path.display()))?;
+        entry
+            .read_to_end(&mut bytes)
+            .map_err(|e| bad(e.to_string()))?;
+        let npy = npyz::NpyFile::new(&bytes[..]).map_err(|e| bad(e.to_string()))?;
         let shape = npy.shape().to_vec();
         let data = match npy.dtype() {
             npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Int => npy
-                .into_vec::<i64>()?
+                .into_vec::<i64>()
+                .map_err(|e| bad(e.to_string()))?
                 .into_iter()
                 .map(|v| v as f64)
                 .collect(),
-            _ => npy.into_vec::<f64>()?,
+            _ => npy.into_vec::<f64>().map_err(|e| bad(e.to_string()))?,
         };
         out.push(Array { shape, data });
     }

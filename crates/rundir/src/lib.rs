@@ -1,0 +1,118 @@
+//! # rundir
+//!
+//! The files of a run directory and nothing else: it knows formats, not physics.
+//!
+//! | file | written by |
+//! |---|---|
+//! | `scene.toml` | [`prepare`] and [`write_scene`]: the resolved scene, every default filled in |
+//! | `series.csv` | [`SeriesWriter`], one row every `series_every` steps ([`SERIES_HEADER`]) |
+//! | `frames/frame_STEP.npz` | [`write_frame`], NumPy archives `numpy.load` reads as they are |
+//!
+//! [`add_writers`] adds the series and frame writers to a [`mechanics::Simulation`];
+//! [`read_npz`] reads frames back. Errors name the file ([`RunDirError`]).
+#![deny(missing_docs)]
+
+mod frame;
+mod series;
+mod writers;
+
+use std::path::{Path, PathBuf};
+
+pub use frame::{npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT};
+pub use series::{SeriesWriter, SERIES_HEADER};
+pub use writers::{add_writers, FinalToo, Written};
+
+/// A file of a run directory could not be read or written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunDirError {
+    /// An I/O operation on a file failed.
+    #[error("cannot {action} {}", path.display())]
+    Io {
+        /// What was being done (`create`, `write`, `open`, ...).
+        action: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// The error of the operating system.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file is not a zip archive.
+    #[error("{} is not a readable .npz archive (truncated?): {reason}", path.display())]
+    Archive {
+        /// The file.
+        path: PathBuf,
+        /// What the zip reader said.
+        reason: String,
+    },
+    /// An archive lacks an array.
+    #[error("{} has no array '{name}'", path.display())]
+    MissingArray {
+        /// The file.
+        path: PathBuf,
+        /// The array.
+        name: String,
+    },
+    /// An array cannot be decoded.
+    #[error("bad array '{name}' in {}: {reason}", path.display())]
+    BadArray {
+        /// The file.
+        path: PathBuf,
+        /// The array.
+        name: String,
+        /// What the decoder said.
+        reason: String,
+    },
+    /// The directory already holds a run.
+    #[error("{} already holds a run (series.csv); choose another --out or pass --overwrite to replace it", dir.display())]
+    Occupied {
+        /// The directory.
+        dir: PathBuf,
+    },
+}
+
+impl RunDirError {
+    pub(crate) fn io(action: &'static str, path: &Path, source: std::io::Error) -> Self {
+        Self::Io {
+            action,
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
+/// The result of this crate's operations.
+pub type Result<T> = std::result::Result<T, RunDirError>;
+
+/// Makes `dir` ready for a new run: creates it, and makes sure it holds no earlier run. With
+/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml` and `frames/`; without,
+/// refuses.
+///
+/// # Errors
+/// [`RunDirError::Occupied`] when `dir` holds a run and `overwrite` is false; I/O errors.
+pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
+    let series = dir.join("series.csv");
+    if series.exists() {
+        if !overwrite {
+            return Err(RunDirError::Occupied {
+                dir: dir.to_path_buf(),
+            });
+        }
+        std::fs::remove_file(&series).map_err(|e| RunDirError::io("remove", &series, e))?;
+        let _ = std::fs::remove_file(dir.join("scene.toml"));
+        let frames = dir.join("frames");
+        if frames.exists() {
+            std::fs::remove_dir_all(&frames).map_err(|e| RunDirError::io("remove", &frames, e))?;
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))
+}
+
+/// Writes the resolved scene as `dir/scene.toml`.
+///
+/// # Errors
+/// When the file cannot be written.
+pub fn write_scene(dir: &Path, scene: &scene::Scene) -> Result<()> {
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, scene.to_toml()).map_err(|e| RunDirError::io("write", &path, e))
+}
