@@ -39,6 +39,32 @@ enum Command {
         #[arg(long)]
         overwrite: bool,
     },
+    /// Run a scene over a grid of values and seeds: each point an ordinary run directory under
+    /// OUT/runs/, and OUT/summary.csv with one row per run. A second call with the same
+    /// arguments redoes only the runs that did not finish.
+    Sweep {
+        /// The scene file (TOML).
+        scene: PathBuf,
+        /// An axis of the grid, e.g. `--vary model.zeta=0.004,0.006` (repeatable; the last
+        /// varies fastest).
+        #[arg(long = "vary", value_name = "SECTION.KEY=V1,V2,...")]
+        vary: Vec<String>,
+        /// Seeds of each point, `A-B` or `A` (default: the scene's `[run] seed`).
+        #[arg(long)]
+        seeds: Option<String>,
+        /// Override a scene value for every point (repeatable).
+        #[arg(long = "set", value_name = "SECTION.KEY=VALUE")]
+        set: Vec<String>,
+        /// The sweep directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Runs at a time; each gets cores / jobs threads. Results do not depend on it.
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Analyse a run directory: observables, correlations, defects and defect-centred
     /// averages, written into RUN_DIR/analysis/.
     Analyze {
@@ -103,6 +129,39 @@ fn real_main() -> Result<()> {
                     info.wall_s,
                     info.frames,
                     out.display()
+                );
+            }
+            Ok(())
+        }
+        Command::Sweep {
+            scene,
+            vary,
+            seeds,
+            set,
+            out,
+            jobs,
+            quiet,
+        } => {
+            anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let args = monolayer_cli::sweep::SweepArgs {
+                scene: &scene,
+                vary: &vary,
+                seeds: seeds.as_deref(),
+                set: &set,
+                out: &out,
+                jobs,
+                threads: (cores / jobs).max(1),
+                quiet,
+            };
+            let (info, n) = monolayer_cli::sweep::sweep(&args)?;
+            if !quiet {
+                eprintln!(
+                    "done: {} of {n} runs taken ({} steps), {} already complete; summary in {}",
+                    info.ran,
+                    info.steps,
+                    info.skipped,
+                    out.join("summary.csv").display()
                 );
             }
             Ok(())

@@ -598,3 +598,61 @@ fn frames_are_identical_whatever_the_output_interval() {
         assert!(dense.lines().any(|r| r == row), "series row {row} differs");
     }
 }
+
+/// `monolayer sweep` end to end: a 2 × 2 grid of the paper scene runs, writes one row per run
+/// to summary.csv, and a second call takes no run; a bad axis stops before anything runs.
+#[test]
+fn a_sweep_runs_its_grid_once_and_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = || {
+        bin()
+            .args(["sweep"])
+            .arg(scene_path("paper.toml"))
+            .args(["--vary", "model.zeta=0,0.005", "--seeds", "1-2"])
+            .args([
+                "--set",
+                "run.relax_time=4",
+                "--set",
+                "run.time=4",
+                "--jobs",
+                "2",
+                "--out",
+            ])
+            .arg(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = sweep();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("4 of 4 runs taken"), "{}", stderr(&o));
+    let summary = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 5, "{summary}");
+    assert!(summary.starts_with("model.zeta,seed,window_start,"));
+    let o = sweep();
+    assert!(
+        o.status.success() && stderr(&o).contains("0 of 4 runs taken"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("summary.csv")).unwrap(),
+        summary
+    );
+    let bad = bin()
+        .args(["sweep"])
+        .arg(scene_path("paper.toml"))
+        .args(["--vary", "zeta=1", "--out"])
+        .arg(dir.path().join("bad"))
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(
+        stderr(&bad).contains("--vary zeta=1: the key needs a section"),
+        "{}",
+        stderr(&bad)
+    );
+    assert!(
+        !dir.path().join("bad").exists(),
+        "nothing is written before the plan is valid"
+    );
+}

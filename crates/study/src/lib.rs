@@ -1,0 +1,92 @@
+//! # study
+//!
+//! Workflows over many runs (the layout's floor 4). Today: parameter sweeps.
+//!
+//! A sweep is a scene, `--set` overrides, axes ([`Vary`], `section.key=V1,V2,...`) and
+//! [`Seeds`]. [`plan`] expands them into [`Point`]s, the last axis fastest and the seeds
+//! fastest of all, and validates every point's scene before anything runs. [`run_points`]
+//! runs them, `jobs` at a time, each in `DIR/runs/NAME/` as an ordinary run directory, and
+//! marks each finished run with a `complete` file holding its resolved scene. A second call
+//! with the same arguments skips the complete runs and starts the others again from their
+//! beginning. [`write_summary`] writes `DIR/summary.csv`: one row per run, with time averages
+//! of `v_rms`, `s_rms` and `area_mean` over the second half of the active phase, and the
+//! growth rate of `ln v_rms` there ([`summary`]).
+//!
+//! Results do not depend on `jobs` or threads: every run is bit-identical for any thread
+//! count.
+#![deny(missing_docs)]
+
+mod plan;
+pub mod summary;
+mod sweep;
+
+use std::path::PathBuf;
+
+pub use plan::{plan, Point, Seeds, Vary};
+pub use sweep::{
+    is_complete, pending, run_dir, run_points, write_summary, SweepInfo, SweepParams, COMPLETE,
+};
+
+/// What stops a sweep, naming the argument, the point or the file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SweepError {
+    /// A `--vary` argument is malformed.
+    #[error("--vary {arg}: {why}; write --vary section.key=V1,V2,..., e.g. --vary model.zeta=0.004,0.006")]
+    BadVary {
+        /// The argument.
+        arg: String,
+        /// What is wrong.
+        why: String,
+    },
+    /// A `--seeds` argument is malformed.
+    #[error("--seeds {arg}: write a range A-B with A ≤ B (at most 10000 seeds) or one seed, e.g. --seeds 1-5")]
+    BadSeeds {
+        /// The argument.
+        arg: String,
+    },
+    /// A point's scene is invalid.
+    #[error("sweep point {point}")]
+    Scene {
+        /// The point (or "the base scene").
+        point: String,
+        /// The scene's error.
+        #[source]
+        source: Box<scene::SceneError>,
+    },
+    /// A run directory could not be written.
+    #[error("sweep point {point}")]
+    RunDir {
+        /// The point.
+        point: String,
+        /// The error.
+        #[source]
+        source: rundir::RunDirError,
+    },
+    /// A run stopped early.
+    #[error("sweep point {point}: the run stopped")]
+    Run {
+        /// The point.
+        point: String,
+        /// The error.
+        #[source]
+        source: mechanics::SimulationError,
+    },
+    /// A series cannot be summarised.
+    #[error("{}: {why}", path.display())]
+    Series {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        why: String,
+    },
+    /// A point has no complete run.
+    #[error("sweep point {point} has no complete run: run the sweep (again) first")]
+    Incomplete {
+        /// The point.
+        point: String,
+    },
+    /// The thread pools could not be built.
+    #[error("cannot start the worker threads: {0}")]
+    Threads(String),
+}

@@ -1,0 +1,184 @@
+//! The summary of a run: time averages of its series over a stated window, and the late
+//! growth rate of `ln v_rms`.
+
+use std::path::Path;
+
+use crate::SweepError;
+
+/// The columns of a run's summary, after the varied keys and `seed`.
+pub const SUMMARY_COLUMNS: &str = "window_start,window_end,rows,v_rms,s_rms,area_mean,growth_rate";
+
+/// A run's summary over its window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunSummary {
+    /// Start of the averaging window (model time).
+    pub window_start: f64,
+    /// End of the window: the end of the run.
+    pub window_end: f64,
+    /// Rows of `series.csv` in the window.
+    pub rows: usize,
+    /// Mean `v_rms` over the window.
+    pub v_rms: f64,
+    /// Mean `s_rms` over the window.
+    pub s_rms: f64,
+    /// Mean `area_mean` over the window.
+    pub area_mean: f64,
+    /// Least-squares slope of `ln v_rms` against time over the window, per TU: positive where
+    /// the flow grows, negative where it decays.
+    pub growth_rate: f64,
+}
+
+impl RunSummary {
+    /// The row, in the order of [`SUMMARY_COLUMNS`].
+    pub fn csv(&self) -> String {
+        format!(
+            "{},{},{},{:e},{:e},{},{:e}",
+            self.window_start,
+            self.window_end,
+            self.rows,
+            self.v_rms,
+            self.s_rms,
+            self.area_mean,
+            self.growth_rate
+        )
+    }
+}
+
+/// The window of a run: the second half of its active phase,
+/// `[relax_time + time/2, relax_time + time]`, where a flow that is going to develop has had
+/// time to, and a passive one to settle.
+pub fn window(relax_time: f64, time: f64) -> (f64, f64) {
+    (relax_time + 0.5 * time, relax_time + time)
+}
+
+/// The least-squares slope of `y` against `t`; `NaN` for fewer than two distinct times.
+pub fn slope(t: &[f64], y: &[f64]) -> f64 {
+    let n = t.len() as f64;
+    if t.len() < 2 {
+        return f64::NAN;
+    }
+    let (mt, my) = (t.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let cov: f64 = t.iter().zip(y).map(|(a, b)| (a - mt) * (b - my)).sum();
+    let var: f64 = t.iter().map(|a| (a - mt) * (a - mt)).sum();
+    if var == 0.0 {
+        f64::NAN
+    } else {
+        cov / var
+    }
+}
+
+/// Summarises the `series.csv` of `run_dir` over `window` (to within 10⁻⁹ TU at its ends).
+///
+/// # Errors
+/// When the file is missing, malformed, or has no row in the window.
+pub fn summarise(run_dir: &Path, window: (f64, f64)) -> Result<RunSummary, SweepError> {
+    let path = run_dir.join("series.csv");
+    let bad = |why: String| SweepError::Series {
+        path: path.clone(),
+        why,
+    };
+    let text = std::fs::read_to_string(&path).map_err(|e| bad(e.to_string()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines
+        .next()
+        .ok_or_else(|| bad("empty".into()))?
+        .split(',')
+        .collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| bad(format!("no column {name}")))
+    };
+    let (ct, cv, cs, ca) = (
+        col("time")?,
+        col("v_rms")?,
+        col("s_rms")?,
+        col("area_mean")?,
+    );
+    let (mut t, mut ln_v) = (Vec::new(), Vec::new());
+    let (mut sv, mut ss, mut sa) = (0.0, 0.0, 0.0);
+    for (k, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let num = |c: usize| -> Result<f64, SweepError> {
+            f.get(c)
+                .and_then(|v| v.parse::<f64>().ok())
+                .ok_or_else(|| bad(format!("row {} is malformed", k + 2)))
+        };
+        let time = num(ct)?;
+        if time < window.0 - 1e-9 || time > window.1 + 1e-9 {
+            continue;
+        }
+        let (v, s, a) = (num(cv)?, num(cs)?, num(ca)?);
+        t.push(time);
+        ln_v.push(v.ln());
+        sv += v;
+        ss += s;
+        sa += a;
+    }
+    if t.is_empty() {
+        return Err(bad(format!(
+            "no row in the window [{}, {}]: the run is shorter than its scene",
+            window.0, window.1
+        )));
+    }
+    let n = t.len() as f64;
+    Ok(RunSummary {
+        window_start: window.0,
+        window_end: window.1,
+        rows: t.len(),
+        v_rms: sv / n,
+        s_rms: ss / n,
+        area_mean: sa / n,
+        growth_rate: slope(&t, &ln_v),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a synthetic exponential `v = v0 e^{r t}` the growth rate is `r` to round-off, the
+    /// averages are the exact means of the rows, and rows outside the window are left out.
+    #[test]
+    fn the_growth_rate_of_a_synthetic_exponential_is_its_rate() {
+        let dir = tempfile::tempdir().unwrap();
+        for &rate in &[-0.013, 0.0, 0.021] {
+            let mut text = String::from("step,time,zeta,v_rms,s_rms,area_mean\n");
+            let mut expected = 0.0;
+            for k in 0..=100 {
+                let t = k as f64;
+                let v = 1e-3 * (rate * t).exp();
+                if t >= 60.0 {
+                    expected += v;
+                }
+                text += &format!("{k},{t},0.005,{v:e},1.5,160\n");
+            }
+            std::fs::write(dir.path().join("series.csv"), text).unwrap();
+            let s = summarise(dir.path(), window(20.0, 80.0)).unwrap();
+            assert_eq!(s.rows, 41, "t = 60, ..., 100");
+            assert!(
+                (s.growth_rate - rate).abs() < 1e-12,
+                "{} {rate}",
+                s.growth_rate
+            );
+            assert!((s.v_rms - expected / 41.0).abs() < 1e-15 * expected);
+            assert_eq!((s.s_rms, s.area_mean), (1.5, 160.0));
+        }
+    }
+
+    #[test]
+    fn a_run_shorter_than_its_window_is_an_error_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("series.csv"),
+            "step,time,v_rms,s_rms,area_mean\n0,0,1,1,1\n",
+        )
+        .unwrap();
+        let e = summarise(dir.path(), (10.0, 20.0)).unwrap_err().to_string();
+        assert!(
+            e.contains("series.csv") && e.contains("no row in the window"),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,217 @@
+//! Running the points of a sweep, `--jobs` at a time, each in its own run directory under
+//! `runs/`, resumably; then `summary.csv`.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
+use phasefield::Real;
+use rayon::prelude::*;
+
+use crate::plan::Point;
+use crate::summary::{summarise, window, SUMMARY_COLUMNS};
+use crate::SweepError;
+
+/// The file that marks a finished run; it holds the run's resolved scene.
+pub const COMPLETE: &str = "complete";
+
+/// How a sweep shares the machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SweepParams {
+    /// Runs at a time.
+    pub jobs: usize,
+    /// Threads of each run; `jobs × threads` should be the cores. Results do not depend on
+    /// either.
+    pub threads: usize,
+}
+
+impl SweepParams {
+    /// `jobs` runs at a time with `threads` threads each (both at least 1).
+    pub fn new(jobs: usize, threads: usize) -> Self {
+        Self {
+            jobs: jobs.max(1),
+            threads: threads.max(1),
+        }
+    }
+}
+
+/// What a sweep did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct SweepInfo {
+    /// Runs taken in this call.
+    pub ran: usize,
+    /// Runs found complete and skipped.
+    pub skipped: usize,
+    /// Steps of the runs taken.
+    pub steps: u64,
+}
+
+/// The run directory of `point` in the sweep directory `dir`.
+pub fn run_dir(dir: &Path, point: &Point) -> PathBuf {
+    dir.join("runs").join(&point.name)
+}
+
+/// Whether `point` has a complete run in `dir` with the same resolved scene.
+pub fn is_complete(dir: &Path, point: &Point) -> bool {
+    std::fs::read_to_string(run_dir(dir, point).join(COMPLETE))
+        .is_ok_and(|scene| scene == point.scene.to_toml())
+}
+
+/// The points still to run, and the steps they take.
+pub fn pending<'a>(dir: &Path, points: &'a [Point]) -> (Vec<&'a Point>, u64) {
+    let todo: Vec<&Point> = points.iter().filter(|p| !is_complete(dir, p)).collect();
+    let steps = todo
+        .iter()
+        .map(|p| p.scene.step_counts().total_steps())
+        .sum();
+    (todo, steps)
+}
+
+/// Runs every point of `points` that has no complete run in `dir` yet, `params.jobs` at a
+/// time; a run that was interrupted is started again from its beginning. `progress` is told
+/// of the steps taken, every 10 steps of each run.
+///
+/// # Errors
+/// The first run that fails (its directory keeps what it wrote, and no `complete` mark);
+/// runs already started finish first.
+pub fn run_points(
+    points: &[Point],
+    dir: &Path,
+    params: SweepParams,
+    progress: Arc<dyn Fn(u64) + Send + Sync>,
+) -> Result<SweepInfo, SweepError> {
+    let (todo, steps) = pending(dir, points);
+    let outer = rayon::ThreadPoolBuilder::new()
+        .num_threads(params.jobs)
+        .build()
+        .map_err(|e| SweepError::Threads(e.to_string()))?;
+    outer.install(|| {
+        todo.par_iter()
+            .with_max_len(1)
+            .try_for_each(|p| run_point(p, dir, params.threads, progress.clone()))
+    })?;
+    Ok(SweepInfo {
+        ran: todo.len(),
+        skipped: points.len() - todo.len(),
+        steps,
+    })
+}
+
+fn run_point(
+    point: &Point,
+    dir: &Path,
+    threads: usize,
+    progress: Arc<dyn Fn(u64) + Send + Sync>,
+) -> Result<(), SweepError> {
+    let out = run_dir(dir, point);
+    let rd = |source| SweepError::RunDir {
+        point: point.name.clone(),
+        source,
+    };
+    let _ = std::fs::remove_file(out.join(COMPLETE));
+    rundir::prepare(&out, true).map_err(rd)?;
+    rundir::write_scene(&out, &point.scene).map_err(rd)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| SweepError::Threads(e.to_string()))?;
+    pool.install(|| match point.scene.precision() {
+        Precision::F64 => run_in::<f64>(point, &out, progress),
+        Precision::F32 => run_in::<f32>(point, &out, progress),
+    })?;
+    let mark = out.join(COMPLETE);
+    std::fs::write(&mark, point.scene.to_toml()).map_err(|source| {
+        rd(rundir::RunDirError::Io {
+            action: "write",
+            path: mark.clone(),
+            source,
+        })
+    })
+}
+
+fn run_in<T: Real>(
+    point: &Point,
+    out: &Path,
+    progress: Arc<dyn Fn(u64) + Send + Sync>,
+) -> Result<(), SweepError> {
+    let counts = point.scene.step_counts();
+    let mut sim = point.scene.simulation::<T>();
+    rundir::add_writers(&mut sim, out, &counts).map_err(|source| SweepError::RunDir {
+        point: point.name.clone(),
+        source,
+    })?;
+    sim.add_callback(
+        "progress",
+        Schedule::IterationInterval(10),
+        Steps {
+            progress,
+            reported: 0,
+        },
+    );
+    sim.run().map_err(|source| SweepError::Run {
+        point: point.name.clone(),
+        source,
+    })?;
+    Ok(())
+}
+
+/// Tells the sweep's progress of the steps taken.
+struct Steps {
+    progress: Arc<dyn Fn(u64) + Send + Sync>,
+    reported: u64,
+}
+
+impl<T: Real> Callback<T> for Steps {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        let it = obs.iteration();
+        (self.progress)(it - self.reported);
+        self.reported = it;
+        Ok(())
+    }
+
+    fn finalize(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
+        self.call(obs)
+    }
+}
+
+/// Writes `dir/summary.csv`: one row per point, in plan order, with the value on each axis
+/// (headed by its key, as given to `--vary`), `seed`, and the run's [`summarise`] over the
+/// second half of its active phase ([`window`]).
+///
+/// # Errors
+/// A point whose run is not complete, or whose series cannot be read.
+pub fn write_summary(dir: &Path, keys: &[String], points: &[Point]) -> Result<PathBuf, SweepError> {
+    let mut text = keys.iter().map(|k| format!("{k},")).collect::<String>();
+    text += "seed,";
+    text += SUMMARY_COLUMNS;
+    text += "\n";
+    for p in points {
+        if !is_complete(dir, p) {
+            return Err(SweepError::Incomplete {
+                point: p.name.clone(),
+            });
+        }
+        let r = &p.scene.file().run;
+        let s = summarise(&run_dir(dir, p), window(r.relax_time, r.time))?;
+        for v in &p.values {
+            text += v;
+            text += ",";
+        }
+        text += &format!("{},{}\n", p.seed, s.csv());
+    }
+    let path = dir.join("summary.csv");
+    let tmp = dir.join("summary.csv.partial");
+    let io = |source| SweepError::RunDir {
+        point: "summary.csv".into(),
+        source: rundir::RunDirError::Io {
+            action: "write",
+            path: path.clone(),
+            source,
+        },
+    };
+    std::fs::write(&tmp, text).map_err(io)?;
+    std::fs::rename(&tmp, &path).map_err(io)?;
+    Ok(path)
+}
