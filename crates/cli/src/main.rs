@@ -7,6 +7,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use monolayer_cli::analyze::{analyze, AnalyzeOptions};
 use monolayer_cli::run;
+use monolayer_cli::sweep::{SweepAction, SweepOutcome};
 use scene::Scene;
 
 /// Multi-phase-field simulations of cell monolayers (Mueller, Yeomans & Doostmohammadi, PRL 2019).
@@ -43,8 +44,10 @@ enum Command {
     /// OUT/runs/, and OUT/summary.csv with one row per run. A second call with the same
     /// arguments redoes only the runs that did not finish.
     Sweep {
-        /// The scene file (TOML).
-        scene: PathBuf,
+        /// The scene file (TOML); with `--collect` it may be left out, and the sweep recorded in
+        /// OUT is read.
+        #[arg(required_unless_present = "collect")]
+        scene: Option<PathBuf>,
         /// An axis of the grid, e.g. `--vary model.zeta=0.004,0.006` (repeatable; the last
         /// varies fastest).
         #[arg(long = "vary", value_name = "SECTION.KEY=V1,V2,...")]
@@ -64,6 +67,20 @@ enum Command {
         /// No progress output.
         #[arg(long, short)]
         quiet: bool,
+        /// Where the runs happen: `local` (here, the default) or `slurm` (writes
+        /// OUT/slurm/sweep.sbatch, a job array of one task per run that is not complete).
+        #[arg(long, default_value = "local", value_parser = ["local", "slurm"])]
+        backend: String,
+        /// With `--backend slurm`: submit the job array with `sbatch`.
+        #[arg(long)]
+        submit: bool,
+        /// Only build OUT/summary.csv from the finished runs (after a SLURM sweep).
+        #[arg(long, conflicts_with_all = ["submit", "jobs"])]
+        collect: bool,
+        /// Threads of each run (default: cores / jobs; with `--backend slurm`, the CPUs of each
+        /// task, default 1).
+        #[arg(long)]
+        threads: Option<usize>,
     },
     /// Analyse a run directory: observables, correlations, defects and defect-centred
     /// averages, written into RUN_DIR/analysis/.
@@ -141,28 +158,65 @@ fn real_main() -> Result<()> {
             out,
             jobs,
             quiet,
+            backend,
+            submit,
+            collect,
+            threads,
         } => {
             anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
+            anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
+            anyhow::ensure!(
+                !submit || backend == "slurm",
+                "--submit needs --backend slurm"
+            );
+            let action = if collect {
+                SweepAction::Collect
+            } else if backend == "slurm" {
+                SweepAction::Slurm { submit }
+            } else {
+                SweepAction::Local
+            };
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let default_threads = match action {
+                SweepAction::Slurm { .. } => 1,
+                _ => (cores / jobs).max(1),
+            };
             let args = monolayer_cli::sweep::SweepArgs {
-                scene: &scene,
+                scene: scene.as_deref(),
                 vary: &vary,
                 seeds: seeds.as_deref(),
                 set: &set,
                 out: &out,
                 jobs,
-                threads: (cores / jobs).max(1),
+                threads: threads.unwrap_or(default_threads),
                 quiet,
+                action,
             };
-            let (info, n) = monolayer_cli::sweep::sweep(&args)?;
-            if !quiet {
-                eprintln!(
+            match monolayer_cli::sweep::sweep(&args)? {
+                SweepOutcome::Ran(info, n) if !quiet => eprintln!(
                     "done: {} of {n} runs taken ({} steps), {} already complete; summary in {}",
                     info.ran,
                     info.steps,
                     info.skipped,
                     out.join("summary.csv").display()
-                );
+                ),
+                SweepOutcome::JobArray(job, submitted) if !quiet => match (job.tasks, submitted) {
+                    (0, _) => eprintln!("every run is complete; build the summary with --collect"),
+                    (n, Some(s)) => eprintln!(
+                        "{s}: {n} array tasks from {}; when they are done, run monolayer sweep --collect --out {}",
+                        job.script.display(),
+                        out.display()
+                    ),
+                    (n, None) => eprintln!(
+                        "wrote {} ({n} array tasks); submit it with sbatch, then run monolayer sweep --collect --out {}",
+                        job.script.display(),
+                        out.display()
+                    ),
+                },
+                SweepOutcome::Collected(n) if !quiet => {
+                    eprintln!("summary of {n} runs in {}", out.join("summary.csv").display())
+                }
+                _ => {}
             }
             Ok(())
         }

@@ -8,13 +8,13 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use study::{plan, run_points, write_summary, Seeds, SweepInfo, SweepParams, Vary};
+use study::{run_points, write_summary, Seeds, SweepInfo, SweepParams, SweepSpec, Vary};
 
 /// The arguments of `monolayer sweep`, as parsed.
 #[derive(Debug, Clone)]
 pub struct SweepArgs<'a> {
-    /// The scene file.
-    pub scene: &'a Path,
+    /// The scene file (none with `--collect`: the sweep directory's record is read).
+    pub scene: Option<&'a Path>,
     /// `--vary` arguments.
     pub vary: &'a [String],
     /// `--seeds`.
@@ -29,6 +29,33 @@ pub struct SweepArgs<'a> {
     pub threads: usize,
     /// `--quiet`.
     pub quiet: bool,
+    /// What to do.
+    pub action: SweepAction,
+}
+
+/// What `monolayer sweep` does with its plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SweepAction {
+    /// Run here (`--backend local`, the default), then write the summary.
+    Local,
+    /// Write a SLURM job array (`--backend slurm`), and submit it with `sbatch` if asked.
+    Slurm {
+        /// `--submit`.
+        submit: bool,
+    },
+    /// Only write the summary of the finished runs (`--collect`).
+    Collect,
+}
+
+/// What `monolayer sweep` did.
+#[derive(Debug, Clone)]
+pub enum SweepOutcome {
+    /// Ran here: what ran, and the number of points.
+    Ran(SweepInfo, usize),
+    /// Wrote a job array (and the output of `sbatch`, if submitted).
+    JobArray(study::JobArray, Option<String>),
+    /// Collected the summary of this many points.
+    Collected(usize),
 }
 
 /// Plans, runs (resumably) and summarises a sweep.
@@ -36,17 +63,58 @@ pub struct SweepArgs<'a> {
 /// # Errors
 /// A bad argument or scene (before anything runs), a failed run, or a file that cannot be
 /// written.
-pub fn sweep(a: &SweepArgs<'_>) -> Result<(SweepInfo, usize)> {
-    let text = std::fs::read_to_string(a.scene)
-        .with_context(|| format!("cannot read scene file {}", a.scene.display()))?;
-    let varies = a
-        .vary
-        .iter()
-        .map(|v| v.parse::<Vary>())
-        .collect::<Result<Vec<_>, _>>()?;
-    let seeds = a.seeds.map(|s| s.parse::<Seeds>()).transpose()?;
-    let points = plan(&text, a.set, &varies, seeds)
-        .with_context(|| format!("in scene {}", a.scene.display()))?;
+pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
+    let spec = match a.scene {
+        None => SweepSpec::load(a.out)?,
+        Some(path) => SweepSpec {
+            scene_text: std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read scene file {}", path.display()))?,
+            sets: a.set.to_vec(),
+            varies: a
+                .vary
+                .iter()
+                .map(|v| v.parse::<Vary>())
+                .collect::<Result<Vec<_>, _>>()?,
+            seeds: a.seeds.map(|s| s.parse::<Seeds>()).transpose()?,
+        },
+    };
+    let points = spec.plan().with_context(|| match a.scene {
+        Some(p) => format!("in scene {}", p.display()),
+        None => format!("in the sweep recorded in {}", a.out.display()),
+    })?;
+    if a.action != SweepAction::Collect {
+        std::fs::create_dir_all(a.out)
+            .with_context(|| format!("cannot create {}", a.out.display()))?;
+        spec.save(a.out)?;
+    }
+    let keys = spec.keys();
+    match a.action {
+        SweepAction::Local => {}
+        SweepAction::Collect => {
+            write_summary(a.out, &keys, &points)?;
+            return Ok(SweepOutcome::Collected(points.len()));
+        }
+        SweepAction::Slurm { submit } => {
+            let binary = std::env::current_exe().context("cannot find the monolayer binary")?;
+            let job = study::write_job_array(a.out, &points, &binary, a.threads)?;
+            let submitted = if submit && job.tasks > 0 {
+                let o = std::process::Command::new("sbatch")
+                    .arg(&job.script)
+                    .output()
+                    .context("cannot run sbatch: is SLURM installed and on the PATH? Without --submit the script is written for you to submit")?;
+                anyhow::ensure!(
+                    o.status.success(),
+                    "sbatch {} failed: {}",
+                    job.script.display(),
+                    String::from_utf8_lossy(&o.stderr).trim()
+                );
+                Some(String::from_utf8_lossy(&o.stdout).trim().to_string())
+            } else {
+                None
+            };
+            return Ok(SweepOutcome::JobArray(job, submitted));
+        }
+    }
     std::fs::create_dir_all(a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
     let (_, total) = study::pending(a.out, &points);
     let bar = (!a.quiet && std::io::stderr().is_terminal()).then(|| {
@@ -77,7 +145,6 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<(SweepInfo, usize)> {
     if let Some(b) = bar {
         b.finish();
     }
-    let keys: Vec<String> = varies.iter().map(|v| v.key.clone()).collect();
     write_summary(a.out, &keys, &points)?;
-    Ok((info, points.len()))
+    Ok(SweepOutcome::Ran(info, points.len()))
 }

@@ -656,3 +656,51 @@ fn a_sweep_runs_its_grid_once_and_resumes() {
         "nothing is written before the plan is valid"
     );
 }
+
+/// `--backend slurm` writes a job array of one task per run that is not complete, and
+/// `--collect` refuses to summarise before the runs are done; the real-SLURM round trip is
+/// `tests/slurm/check.sh` (run by `.ci/run`).
+#[test]
+fn the_slurm_backend_writes_one_array_task_per_pending_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bin()
+        .args(["sweep"])
+        .arg(scene_path("paper.toml"))
+        .args([
+            "--vary",
+            "model.zeta=0,0.005",
+            "--seeds",
+            "1-2",
+            "--backend",
+            "slurm",
+            "--threads",
+            "2",
+            "--out",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let script = std::fs::read_to_string(dir.path().join("slurm/sweep.sbatch")).unwrap();
+    assert!(
+        script.contains("#SBATCH --array=0-3") && script.contains("--cpus-per-task=2"),
+        "{script}"
+    );
+    assert!(
+        script.contains(" run \"$run/scene.toml\" --out \"$run\" --overwrite --threads 2"),
+        "{script}"
+    );
+    let points = std::fs::read_to_string(dir.path().join("slurm/points.txt")).unwrap();
+    assert_eq!(points.lines().count(), 4);
+    for run in points.lines() {
+        let scene = std::fs::read_to_string(Path::new(run).join("scene.toml")).unwrap();
+        assert!(scene::Scene::parse(&scene, &[]).is_ok(), "{run}");
+    }
+    let o = bin()
+        .args(["sweep", "--collect", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("has no complete run"), "{}", stderr(&o));
+}

@@ -12,17 +12,25 @@
 //! of `v_rms`, `s_rms` and `area_mean` over the second half of the active phase, and the
 //! growth rate of `ln v_rms` there ([`summary`]).
 //!
-//! Results do not depend on `jobs` or threads: every run is bit-identical for any thread
-//! count.
+//! Beyond one machine, [`write_job_array`] writes a SLURM job array with one task per pending
+//! point, each running `monolayer run` on the point's resolved scene and then marking it
+//! complete; [`write_summary`] then collects the finished runs.
+//!
+//! Results do not depend on `jobs`, threads or the backend: every run is bit-identical for any
+//! thread count.
 #![deny(missing_docs)]
 
 mod plan;
+mod slurm;
+mod spec;
 pub mod summary;
 mod sweep;
 
 use std::path::PathBuf;
 
 pub use plan::{plan, Point, Seeds, Vary};
+pub use slurm::{write_job_array, JobArray};
+pub use spec::SweepSpec;
 pub use sweep::{
     is_complete, pending, run_dir, run_points, write_summary, SweepInfo, SweepParams, COMPLETE,
 };
@@ -85,6 +93,12 @@ pub enum SweepError {
     Incomplete {
         /// The point.
         point: String,
+    },
+    /// A directory holds no record of a sweep.
+    #[error("{} holds no sweep (no sweep/scene.toml and sweep/args.txt): give the directory a sweep wrote with --out", dir.display())]
+    NoRecord {
+        /// The directory.
+        dir: PathBuf,
     },
     /// The thread pools could not be built.
     #[error("cannot start the worker threads: {0}")]

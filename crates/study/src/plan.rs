@@ -192,6 +192,17 @@ mod tests {
         assert_eq!(names.len(), 12, "every point has its own directory");
     }
 
+    /// The resolved scene of a point parses back to itself: a run of `runs/NAME/scene.toml`
+    /// (the SLURM backend's) is the run of the point, and its `complete` mark matches.
+    #[test]
+    fn a_points_resolved_scene_is_a_fixed_point() {
+        let v: Vec<Vary> = vec!["model.pressure=paper,interaction".parse().unwrap()];
+        for p in plan(SCENE, &["model.zeta=0.003".into()], &v, None).unwrap() {
+            let text = p.scene.to_toml();
+            assert_eq!(Scene::parse(&text, &[]).unwrap().to_toml(), text);
+        }
+    }
+
     #[test]
     fn bad_axes_and_seeds_are_refused_with_the_argument() {
         for bad in [
