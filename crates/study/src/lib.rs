@@ -18,6 +18,23 @@
 //!
 //! Results do not depend on `jobs`, threads or the backend: every run is bit-identical for any
 //! thread count.
+//!
+//! ```
+//! use study::{plan, Vary};
+//!
+//! let scene = "[domain]\nlx = 64\nly = 64\n[cells]\ncount = 2\n[run]\ntime = 1\n";
+//! let zeta: Vary = "model.zeta=0,0.005".parse()?;
+//! let points = plan(scene, &[], &[zeta], Some("1-2".parse()?))?;
+//! let names: Vec<&str> = points.iter().map(|p| p.name.as_str()).collect();
+//! assert_eq!(names, [
+//!     "model.zeta=0_seed=1",
+//!     "model.zeta=0_seed=2",
+//!     "model.zeta=0.005_seed=1",
+//!     "model.zeta=0.005_seed=2",
+//! ]);
+//! assert_eq!(points[3].scene.file().model.zeta, 0.005);
+//! # Ok::<(), study::SweepError>(())
+//! ```
 #![deny(missing_docs)]
 
 mod plan;
