@@ -75,12 +75,19 @@ enum Command {
         #[arg(long)]
         submit: bool,
         /// Only build OUT/summary.csv from the finished runs (after a SLURM sweep).
-        #[arg(long, conflicts_with_all = ["submit", "jobs"])]
+        #[arg(long, conflicts_with = "submit")]
         collect: bool,
         /// Threads of each run (default: cores / jobs; with `--backend slurm`, the CPUs of each
         /// task, default 1).
         #[arg(long)]
         threads: Option<usize>,
+        /// Analyse every run (as `monolayer analyze`) and add the three correlation lengths,
+        /// the defect density and the creation rate to the summary.
+        #[arg(long)]
+        analyze: bool,
+        /// With `--analyze`: the first time analysed (default: the end of relaxation).
+        #[arg(long, requires = "analyze")]
+        from: Option<f64>,
     },
     /// Analyse a run directory: observables, correlations, defects and defect-centred
     /// averages, written into RUN_DIR/analysis/.
@@ -162,7 +169,13 @@ fn real_main() -> Result<()> {
             submit,
             collect,
             threads,
+            analyze,
+            from,
         } => {
+            anyhow::ensure!(
+                !(analyze && backend == "slurm" && !collect),
+                "--analyze runs after the runs: give it with --collect once the SLURM tasks are done"
+            );
             anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
             anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
             anyhow::ensure!(
@@ -191,6 +204,10 @@ fn real_main() -> Result<()> {
                 threads: threads.unwrap_or(default_threads),
                 quiet,
                 action,
+                analyze: analyze.then(|| AnalyzeOptions {
+                    from,
+                    ..AnalyzeOptions::default()
+                }),
             };
             match monolayer_cli::sweep::sweep(&args)? {
                 SweepOutcome::Ran(info, n) if !quiet => eprintln!(

@@ -10,6 +10,8 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use study::{run_points, write_summary, Seeds, SweepInfo, SweepParams, SweepSpec, Vary};
 
+use crate::analyze::{analyze, AnalyzeOptions};
+
 /// The arguments of `monolayer sweep`, as parsed.
 #[derive(Debug, Clone)]
 pub struct SweepArgs<'a> {
@@ -31,6 +33,9 @@ pub struct SweepArgs<'a> {
     pub quiet: bool,
     /// What to do.
     pub action: SweepAction,
+    /// `--analyze`: analyse every run (as `monolayer analyze`, from `--from`) and add the
+    /// lengths and defect statistics to the summary.
+    pub analyze: Option<AnalyzeOptions>,
 }
 
 /// What `monolayer sweep` does with its plan.
@@ -91,7 +96,10 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
     match a.action {
         SweepAction::Local => {}
         SweepAction::Collect => {
-            write_summary(a.out, &keys, &points)?;
+            if let Some(opts) = &a.analyze {
+                analyze_points(&points, a.out, opts, a.jobs, a.threads)?;
+            }
+            write_summary(a.out, &keys, &points, a.analyze.is_some())?;
             return Ok(SweepOutcome::Collected(points.len()));
         }
         SweepAction::Slurm { submit } => {
@@ -145,6 +153,52 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
     if let Some(b) = bar {
         b.finish();
     }
-    write_summary(a.out, &keys, &points)?;
+    if let Some(opts) = &a.analyze {
+        analyze_points(&points, a.out, opts, a.jobs, a.threads)?;
+    }
+    write_summary(a.out, &keys, &points, a.analyze.is_some())?;
     Ok(SweepOutcome::Ran(info, points.len()))
+}
+
+/// The mark of an analysed run: `analysis/complete`, holding the options it was analysed with.
+fn analysis_mark(opts: &AnalyzeOptions) -> String {
+    format!("{opts:?}\n")
+}
+
+/// Analyses every complete run of `points` that has not been analysed with `opts`, `jobs` at a
+/// time.
+fn analyze_points(
+    points: &[study::Point],
+    dir: &Path,
+    opts: &AnalyzeOptions,
+    jobs: usize,
+    threads: usize,
+) -> Result<()> {
+    use rayon::prelude::*;
+    let mark = analysis_mark(opts);
+    let todo: Vec<std::path::PathBuf> = points
+        .iter()
+        .filter(|p| study::is_complete(dir, p))
+        .map(|p| study::run_dir(dir, p))
+        .filter(|r| {
+            std::fs::read_to_string(r.join("analysis/complete")).map_or(true, |m| m != mark)
+        })
+        .collect();
+    let outer = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
+    outer.install(|| {
+        todo.par_iter()
+            .with_max_len(1)
+            .try_for_each(|run| -> Result<()> {
+                let inner = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()?;
+                let _ = std::fs::remove_file(run.join("analysis/complete"));
+                inner
+                    .install(|| analyze(run, opts))
+                    .with_context(|| format!("analysing {}", run.display()))?;
+                std::fs::write(run.join("analysis/complete"), &mark)
+                    .with_context(|| format!("cannot mark {} analysed", run.display()))?;
+                Ok(())
+            })
+    })
 }

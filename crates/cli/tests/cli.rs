@@ -704,3 +704,54 @@ fn the_slurm_backend_writes_one_array_task_per_pending_run() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("has no complete run"), "{}", stderr(&o));
 }
+
+/// `monolayer sweep --analyze` analyses every run once and adds the lengths and defect
+/// statistics to the summary; a second call analyses nothing again.
+#[test]
+fn a_sweep_with_analyze_adds_the_analysis_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = || {
+        bin()
+            .args(["sweep"])
+            .arg(scene_path("paper.toml"))
+            .args([
+                "--vary",
+                "model.zeta=0,0.01",
+                "--set",
+                "run.relax_time=4",
+                "--set",
+                "run.time=8",
+            ])
+            .args([
+                "--set",
+                "run.output_every=2",
+                "--analyze",
+                "--quiet",
+                "--out",
+            ])
+            .arg(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = sweep();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
+    assert!(
+        summary.lines().next().unwrap().ends_with(
+            ",growth_rate,length_velocity,length_vorticity,length_q,defect_density,creation_rate"
+        ),
+        "{summary}"
+    );
+    assert_eq!(summary.lines().count(), 3);
+    let mark = dir
+        .path()
+        .join("runs/model.zeta=0.01_seed=1/analysis/complete");
+    let t0 = std::fs::metadata(&mark).unwrap().modified().unwrap();
+    let o = sweep();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::metadata(&mark).unwrap().modified().unwrap(), t0);
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("summary.csv")).unwrap(),
+        summary
+    );
+}

@@ -182,3 +182,65 @@ mod tests {
         );
     }
 }
+
+/// The columns an analysed run adds to its summary row.
+pub const ANALYSIS_COLUMNS: &str =
+    "length_velocity,length_vorticity,length_q,defect_density,creation_rate";
+
+/// A run's `monolayer analyze` results as summary columns: the three correlation lengths
+/// (`analysis/lengths.csv`) and the means over the analysed frames of the defect density and
+/// of the creation rate (`analysis/observables.csv`; frames where a rate is undefined, the
+/// first, are left out).
+///
+/// # Errors
+/// When the files are missing or malformed.
+pub fn analysis_columns(run_dir: &Path) -> Result<String, SweepError> {
+    let dir = run_dir.join("analysis");
+    let read = |name: &str| {
+        let path = dir.join(name);
+        std::fs::read_to_string(&path)
+            .map(|t| (path.clone(), t))
+            .map_err(|e| SweepError::Series {
+                path,
+                why: format!("{e}; analyse the run first (--analyze)"),
+            })
+    };
+    let (path, lengths) = read("lengths.csv")?;
+    let length = |field: &str| -> Result<String, SweepError> {
+        lengths
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("{field},")))
+            .map(str::to_string)
+            .ok_or_else(|| SweepError::Series {
+                path: path.clone(),
+                why: format!("no length of {field}"),
+            })
+    };
+    let (path, obs) = read("observables.csv")?;
+    let mut lines = obs.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let mean = |name: &str| -> Result<f64, SweepError> {
+        let c = header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| SweepError::Series {
+                path: path.clone(),
+                why: format!("no column {name}"),
+            })?;
+        let values: Vec<f64> = obs
+            .lines()
+            .skip(1)
+            .filter_map(|l| l.split(',').nth(c)?.parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .collect();
+        Ok(values.iter().sum::<f64>() / values.len() as f64)
+    };
+    Ok(format!(
+        "{},{},{},{:e},{:e}",
+        length("velocity")?,
+        length("vorticity")?,
+        length("q")?,
+        mean("defect_density")?,
+        mean("creation_rate")?
+    ))
+}

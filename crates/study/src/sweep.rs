@@ -9,7 +9,7 @@ use phasefield::Real;
 use rayon::prelude::*;
 
 use crate::plan::Point;
-use crate::summary::{summarise, window, SUMMARY_COLUMNS};
+use crate::summary::{analysis_columns, summarise, window, ANALYSIS_COLUMNS, SUMMARY_COLUMNS};
 use crate::SweepError;
 
 /// The file that marks a finished run; it holds the run's resolved scene.
@@ -178,14 +178,24 @@ impl<T: Real> Callback<T> for Steps {
 
 /// Writes `dir/summary.csv`: one row per point, in plan order, with the value on each axis
 /// (headed by its key, as given to `--vary`), `seed`, and the run's [`summarise`] over the
-/// second half of its active phase ([`window`]).
+/// second half of its active phase ([`window`]); with `analysed`, also its
+/// [`analysis_columns`].
 ///
 /// # Errors
-/// A point whose run is not complete, or whose series cannot be read.
-pub fn write_summary(dir: &Path, keys: &[String], points: &[Point]) -> Result<PathBuf, SweepError> {
+/// A point whose run is not complete (or not analysed), or whose files cannot be read.
+pub fn write_summary(
+    dir: &Path,
+    keys: &[String],
+    points: &[Point],
+    analysed: bool,
+) -> Result<PathBuf, SweepError> {
     let mut text = keys.iter().map(|k| format!("{k},")).collect::<String>();
     text += "seed,";
     text += SUMMARY_COLUMNS;
+    if analysed {
+        text += ",";
+        text += ANALYSIS_COLUMNS;
+    }
     text += "\n";
     for p in points {
         if !is_complete(dir, p) {
@@ -199,7 +209,12 @@ pub fn write_summary(dir: &Path, keys: &[String], points: &[Point]) -> Result<Pa
             text += v;
             text += ",";
         }
-        text += &format!("{},{}\n", p.seed, s.csv());
+        text += &format!("{},{}", p.seed, s.csv());
+        if analysed {
+            text += ",";
+            text += &analysis_columns(&run_dir(dir, p))?;
+        }
+        text += "\n";
     }
     let path = dir.join("summary.csv");
     let tmp = dir.join("summary.csv.partial");

@@ -50,7 +50,7 @@ fn sweep(dir: &std::path::Path, jobs: usize) -> (study::SweepInfo, String, u64) 
         }),
     )
     .unwrap();
-    let path = write_summary(dir, &keys, &points).unwrap();
+    let path = write_summary(dir, &keys, &points, false).unwrap();
     (
         info,
         std::fs::read_to_string(path).unwrap(),
