@@ -134,55 +134,6 @@ pub fn summarise(run_dir: &Path, window: (f64, f64)) -> Result<RunSummary, Sweep
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// On a synthetic exponential `v = v0 e^{r t}` the growth rate is `r` to round-off, the
-    /// averages are the exact means of the rows, and rows outside the window are left out.
-    #[test]
-    fn the_growth_rate_of_a_synthetic_exponential_is_its_rate() {
-        let dir = tempfile::tempdir().unwrap();
-        for &rate in &[-0.013, 0.0, 0.021] {
-            let mut text = String::from("step,time,zeta,v_rms,s_rms,area_mean\n");
-            let mut expected = 0.0;
-            for k in 0..=100 {
-                let t = k as f64;
-                let v = 1e-3 * (rate * t).exp();
-                if t >= 60.0 {
-                    expected += v;
-                }
-                text += &format!("{k},{t},0.005,{v:e},1.5,160\n");
-            }
-            std::fs::write(dir.path().join("series.csv"), text).unwrap();
-            let s = summarise(dir.path(), window(20.0, 80.0)).unwrap();
-            assert_eq!(s.rows, 41, "t = 60, ..., 100");
-            assert!(
-                (s.growth_rate - rate).abs() < 1e-12,
-                "{} {rate}",
-                s.growth_rate
-            );
-            assert!((s.v_rms - expected / 41.0).abs() < 1e-15 * expected);
-            assert_eq!((s.s_rms, s.area_mean), (1.5, 160.0));
-        }
-    }
-
-    #[test]
-    fn a_run_shorter_than_its_window_is_an_error_naming_the_file() {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::write(
-            dir.path().join("series.csv"),
-            "step,time,v_rms,s_rms,area_mean\n0,0,1,1,1\n",
-        )
-        .unwrap();
-        let e = summarise(dir.path(), (10.0, 20.0)).unwrap_err().to_string();
-        assert!(
-            e.contains("series.csv") && e.contains("no row in the window"),
-            "{e}"
-        );
-    }
-}
-
 /// The columns an analysed run adds to its summary row.
 pub const ANALYSIS_COLUMNS: &str =
     "length_velocity,length_vorticity,length_q,defect_density,creation_rate";
@@ -243,4 +194,53 @@ pub fn analysis_columns(run_dir: &Path) -> Result<String, SweepError> {
         mean("defect_density")?,
         mean("creation_rate")?
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a synthetic exponential `v = v0 e^{r t}` the growth rate is `r` to round-off, the
+    /// averages are the exact means of the rows, and rows outside the window are left out.
+    #[test]
+    fn the_growth_rate_of_a_synthetic_exponential_is_its_rate() {
+        let dir = tempfile::tempdir().unwrap();
+        for &rate in &[-0.013, 0.0, 0.021] {
+            let mut text = String::from("step,time,zeta,v_rms,s_rms,area_mean\n");
+            let mut expected = 0.0;
+            for k in 0..=100 {
+                let t = k as f64;
+                let v = 1e-3 * (rate * t).exp();
+                if t >= 60.0 {
+                    expected += v;
+                }
+                text += &format!("{k},{t},0.005,{v:e},1.5,160\n");
+            }
+            std::fs::write(dir.path().join("series.csv"), text).unwrap();
+            let s = summarise(dir.path(), window(20.0, 80.0)).unwrap();
+            assert_eq!(s.rows, 41, "t = 60, ..., 100");
+            assert!(
+                (s.growth_rate - rate).abs() < 1e-12,
+                "{} {rate}",
+                s.growth_rate
+            );
+            assert!((s.v_rms - expected / 41.0).abs() < 1e-15 * expected);
+            assert_eq!((s.s_rms, s.area_mean), (1.5, 160.0));
+        }
+    }
+
+    #[test]
+    fn a_run_shorter_than_its_window_is_an_error_naming_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(
+            dir.path().join("series.csv"),
+            "step,time,v_rms,s_rms,area_mean\n0,0,1,1,1\n",
+        )
+        .unwrap();
+        let e = summarise(dir.path(), (10.0, 20.0)).unwrap_err().to_string();
+        assert!(
+            e.contains("series.csv") && e.contains("no row in the window"),
+            "{e}"
+        );
+    }
 }
