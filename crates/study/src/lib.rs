@@ -16,6 +16,9 @@
 //! point, each running `monolayer run` on the point's resolved scene and then marking it
 //! complete; [`write_summary`] then collects the finished runs.
 //!
+//! [`threshold`] estimates the activity threshold from a sweep's growth rates (its protocol is
+//! in the module docs); it is not yet wired to a command.
+//!
 //! Results do not depend on `jobs`, threads or the backend: every run is bit-identical for any
 //! thread count.
 //!
@@ -42,6 +45,7 @@ mod slurm;
 mod spec;
 pub mod summary;
 mod sweep;
+pub mod threshold;
 
 use std::path::PathBuf;
 
