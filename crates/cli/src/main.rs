@@ -89,6 +89,16 @@ enum Command {
         #[arg(long, requires = "analyze")]
         from: Option<f64>,
     },
+    /// The activity threshold of a sweep: for every combination of its other axes, the
+    /// activity where the late growth rate of ln v_rms first exceeds that of zeta = 0 from the
+    /// same seeds (linear interpolation, with its bracket); writes DIR/threshold.csv.
+    Threshold {
+        /// A sweep directory (its summary.csv), whose axes include the activity with 0.
+        dir: PathBuf,
+        /// The activity's key as given to --vary.
+        #[arg(long, default_value = "model.zeta")]
+        key: String,
+    },
     /// Analyse a run directory: observables, correlations, defects and defect-centred
     /// averages, written into RUN_DIR/analysis/.
     Analyze {
@@ -235,6 +245,23 @@ fn real_main() -> Result<()> {
                 }
                 _ => {}
             }
+            Ok(())
+        }
+        Command::Threshold { dir, key } => {
+            let path = dir.join("summary.csv");
+            let summary = std::fs::read_to_string(&path).with_context(|| {
+                format!(
+                    "cannot read {}: run monolayer sweep --out {} first",
+                    path.display(),
+                    dir.display()
+                )
+            })?;
+            let table = study::threshold::threshold_table(&summary, &key)?;
+            let out = dir.join("threshold.csv");
+            std::fs::write(&out, &table)
+                .with_context(|| format!("cannot write {}", out.display()))?;
+            print!("{table}");
+            eprintln!("written to {}", out.display());
             Ok(())
         }
         Command::Analyze {

@@ -755,3 +755,35 @@ fn a_sweep_with_analyze_adds_the_analysis_columns() {
         summary
     );
 }
+
+/// `monolayer threshold` reads a sweep's summary.csv and writes threshold.csv; without a
+/// sweep it says what to run.
+#[test]
+fn the_threshold_command_tabulates_a_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bin().arg("threshold").arg(dir.path()).output().unwrap();
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("run monolayer sweep --out"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::write(
+        dir.path().join("summary.csv"),
+        "model.zeta,seed,growth_rate\n0,1,-0.004\n0.004,1,-0.005\n0.008,1,0.002\n",
+    )
+    .unwrap();
+    let o = bin().arg("threshold").arg(dir.path()).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = std::fs::read_to_string(dir.path().join("threshold.csv")).unwrap();
+    // The excess rate is −0.001 at ζ = 0.004 and +0.006 at 0.008: ζ_cr = 0.004 + 0.004/7.
+    let row: Vec<f64> = table
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!((row[0] - (0.004 + 0.004 / 7.0)).abs() < 1e-15, "{table}");
+    assert_eq!(&row[1..], &[0.004, 0.008, 1.0, 2.0]);
+}

@@ -17,7 +17,8 @@
 //! complete; [`write_summary`] then collects the finished runs.
 //!
 //! [`threshold`] estimates the activity threshold from a sweep's growth rates (its protocol is
-//! in the module docs); it is not yet wired to a command.
+//! in the module docs), and [`threshold::threshold_table`] does so for every combination of
+//! the other axes of a sweep's `summary.csv` (`monolayer threshold DIR`).
 //!
 //! Results do not depend on `jobs`, threads or the backend: every run is bit-identical for any
 //! thread count.
@@ -120,6 +121,12 @@ pub enum SweepError {
     NoRecord {
         /// The directory.
         dir: PathBuf,
+    },
+    /// A threshold cannot be estimated from a summary.
+    #[error("threshold: {why}")]
+    Threshold {
+        /// What is wrong.
+        why: String,
     },
     /// The thread pools could not be built.
     #[error("cannot start the worker threads: {0}")]

@@ -85,6 +85,92 @@ pub fn threshold(baseline: &[f64], points: &[RatePoint]) -> Threshold {
     }
 }
 
+/// The header of `threshold.csv` after the other varied keys.
+pub const THRESHOLD_COLUMNS: &str = "zeta_cr,zeta_cr_lo,zeta_cr_hi,seeds,activities";
+
+/// The threshold of every combination of the other axes of a sweep, from its `summary.csv`
+/// text: rows grouped by every varied key but `zeta_key`, the rows with ζ = 0 as the
+/// baseline, the others as the activities ([`threshold`]). Returns the text of
+/// `threshold.csv`: the other keys, then [`THRESHOLD_COLUMNS`]; an open bracket leaves
+/// `zeta_cr` empty, and `zeta_cr_lo` or `zeta_cr_hi` empty on its open side.
+///
+/// # Errors
+/// [`SweepError::Threshold`] when the summary has no `zeta_key` column, no growth rates, or a
+/// group without a ζ = 0 baseline.
+pub fn threshold_table(summary: &str, zeta_key: &str) -> Result<String, crate::SweepError> {
+    let bad = |why: String| crate::SweepError::Threshold { why };
+    let mut lines = summary.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| bad(format!("summary.csv has no column {name}")))
+    };
+    let (cz, cs, cr) = (col(zeta_key)?, col("seed")?, col("growth_rate")?);
+    let others: Vec<usize> = (0..cs).filter(|&c| c != cz).collect();
+    // Groups in order of first appearance: key values → (baseline rates, ζ → rates).
+    type Group = (Vec<String>, Vec<f64>, Vec<RatePoint>);
+    let mut groups: Vec<Group> = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let field = |c: usize| {
+            f.get(c)
+                .copied()
+                .ok_or_else(|| bad(format!("row {} of summary.csv is short", k + 2)))
+        };
+        let key: Vec<String> = others
+            .iter()
+            .map(|&c| field(c).map(str::to_string))
+            .collect::<Result<_, _>>()?;
+        let zeta: f64 = field(cz)?
+            .parse()
+            .map_err(|_| bad(format!("{zeta_key} = {} is not a number", f[cz])))?;
+        let rate: f64 = field(cr)?.parse().unwrap_or(f64::NAN);
+        let g = match groups.iter().position(|g| g.0 == key) {
+            Some(i) => &mut groups[i],
+            None => {
+                groups.push((key, Vec::new(), Vec::new()));
+                groups.last_mut().expect("just pushed")
+            }
+        };
+        if zeta == 0.0 {
+            g.1.push(rate);
+        } else if let Some(p) = g.2.iter_mut().find(|p| p.zeta == zeta) {
+            p.rates.push(rate);
+        } else {
+            g.2.push(RatePoint {
+                zeta,
+                rates: vec![rate],
+            });
+        }
+    }
+    let mut out: String = others.iter().map(|&c| format!("{},", header[c])).collect();
+    out += THRESHOLD_COLUMNS;
+    out += "\n";
+    for (key, baseline, points) in &groups {
+        if baseline.is_empty() {
+            return Err(bad(format!(
+                "no {zeta_key} = 0 run for {}: the threshold is measured against ζ = 0 from the same relaxed states; add 0 to --vary {zeta_key}",
+                if key.is_empty() { "the sweep".to_string() } else { key.join(",") }
+            )));
+        }
+        let (cr, lo, hi) = match threshold(baseline, points) {
+            Threshold::Bracketed { zeta_cr, lo, hi } => {
+                (zeta_cr.to_string(), lo.to_string(), hi.to_string())
+            }
+            Threshold::Below { hi } => (String::new(), String::new(), hi.to_string()),
+            Threshold::Above { lo } => (String::new(), lo.to_string(), String::new()),
+        };
+        for v in key {
+            out += v;
+            out += ",";
+        }
+        out += &format!("{cr},{lo},{hi},{},{}\n", baseline.len(), points.len());
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,5 +222,44 @@ mod tests {
         assert_eq!(threshold(&baseline, &above), Threshold::Below { hi: 0.007 });
         let below: Vec<RatePoint> = points.iter().filter(|p| p.zeta < 0.0063).cloned().collect();
         assert_eq!(threshold(&baseline, &below), Threshold::Above { lo: 0.006 });
+    }
+
+    /// The table groups a summary by the other axes, takes ζ = 0 as each group's baseline, and
+    /// refuses a group without one.
+    #[test]
+    fn the_threshold_table_groups_by_the_other_axes() {
+        // Two γ; rates r = c (ζ − ζ_cr(γ)) − 0.004, ζ_cr = 0.004 + 0.2 γ, two seeds each.
+        let mut summary = String::from("model.gamma,model.zeta,seed,growth_rate\n");
+        for gamma in [0.01f64, 0.02] {
+            for zeta in [0.0f64, 0.004, 0.006, 0.008, 0.01] {
+                for seed in [1, 2] {
+                    let rate = if zeta == 0.0 {
+                        -0.004
+                    } else {
+                        1.5 * (zeta - (0.004 + 0.2 * gamma)) - 0.004
+                    };
+                    summary += &format!("{gamma},{zeta},{seed},{rate}\n");
+                }
+            }
+        }
+        let table = threshold_table(&summary, "model.zeta").unwrap();
+        let lines: Vec<&str> = table.lines().collect();
+        assert_eq!(
+            lines[0],
+            "model.gamma,zeta_cr,zeta_cr_lo,zeta_cr_hi,seeds,activities"
+        );
+        for (line, (gamma, lo, hi)) in lines[1..]
+            .iter()
+            .zip([(0.01, 0.006, 0.008), (0.02, 0.008, 0.01)])
+        {
+            let f: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
+            assert_eq!((f[0], f[2], f[3], f[4], f[5]), (gamma, lo, hi, 2.0, 4.0));
+            assert!((f[1] - (0.004 + 0.2 * gamma)).abs() < 1e-12, "{line}");
+        }
+        let no_base = "model.zeta,seed,growth_rate\n0.005,1,0.1\n";
+        let e = threshold_table(no_base, "model.zeta")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("add 0 to --vary model.zeta"), "{e}");
     }
 }
