@@ -95,7 +95,7 @@ pub const THRESHOLD_COLUMNS: &str = "zeta_cr,zeta_cr_lo,zeta_cr_hi,seeds,activit
 /// `zeta_cr` empty, and `zeta_cr_lo` or `zeta_cr_hi` empty on its open side.
 ///
 /// # Errors
-/// [`SweepError::Threshold`] when the summary has no `zeta_key` column, no growth rates, or a
+/// [`crate::SweepError::Threshold`] when the summary has no `zeta_key` column, no growth rates, or a
 /// group without a ζ = 0 baseline.
 pub fn threshold_table(summary: &str, zeta_key: &str) -> Result<String, crate::SweepError> {
     let bad = |why: String| crate::SweepError::Threshold { why };
