@@ -174,7 +174,6 @@ fn analyze_points(
     jobs: usize,
     threads: usize,
 ) -> Result<()> {
-    use rayon::prelude::*;
     let mark = analysis_mark(opts);
     let todo: Vec<std::path::PathBuf> = points
         .iter()
@@ -184,21 +183,15 @@ fn analyze_points(
             std::fs::read_to_string(r.join("analysis/complete")).map_or(true, |m| m != mark)
         })
         .collect();
-    let outer = rayon::ThreadPoolBuilder::new().num_threads(jobs).build()?;
-    outer.install(|| {
-        todo.par_iter()
-            .with_max_len(1)
-            .try_for_each(|run| -> Result<()> {
-                let inner = rayon::ThreadPoolBuilder::new()
-                    .num_threads(threads)
-                    .build()?;
-                let _ = std::fs::remove_file(run.join("analysis/complete"));
-                inner
-                    .install(|| analyze(run, opts))
-                    .with_context(|| format!("analysing {}", run.display()))?;
-                std::fs::write(run.join("analysis/complete"), &mark)
-                    .with_context(|| format!("cannot mark {} analysed", run.display()))?;
-                Ok(())
-            })
-    })
+    study::in_jobs(
+        &todo,
+        SweepParams::new(jobs, threads),
+        |run| -> Result<()> {
+            let _ = std::fs::remove_file(run.join("analysis/complete"));
+            analyze(run, opts).with_context(|| format!("analysing {}", run.display()))?;
+            std::fs::write(run.join("analysis/complete"), &mark)
+                .with_context(|| format!("cannot mark {} analysed", run.display()))?;
+            Ok(())
+        },
+    )
 }

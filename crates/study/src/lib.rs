@@ -54,7 +54,8 @@ pub use plan::{plan, Point, Seeds, Vary};
 pub use slurm::{write_job_array, JobArray};
 pub use spec::SweepSpec;
 pub use sweep::{
-    is_complete, pending, run_dir, run_points, write_summary, SweepInfo, SweepParams, COMPLETE,
+    in_jobs, is_complete, pending, run_dir, run_points, write_summary, SweepInfo, SweepParams,
+    COMPLETE,
 };
 
 /// What stops a sweep, naming the argument, the point or the file.
@@ -131,4 +132,19 @@ pub enum SweepError {
     /// The thread pools could not be built.
     #[error("cannot start the worker threads: {0}")]
     Threads(String),
+}
+
+impl SweepError {
+    /// A file of the sweep (`what`: the point or the record it belongs to) could not be
+    /// written.
+    pub(crate) fn write(what: &str, path: &std::path::Path, source: std::io::Error) -> Self {
+        Self::RunDir {
+            point: what.to_string(),
+            source: rundir::RunDirError::Io {
+                action: "write",
+                path: path.to_path_buf(),
+                source,
+            },
+        }
+    }
 }

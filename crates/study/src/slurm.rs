@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::plan::Point;
-use crate::sweep::{pending, run_dir, COMPLETE};
+use crate::sweep::{pending, prepare_point, COMPLETE};
 use crate::SweepError;
 
 /// What [`write_job_array`] wrote.
@@ -36,28 +36,12 @@ pub fn write_job_array(
 ) -> Result<JobArray, SweepError> {
     let (todo, _) = pending(dir, points);
     let slurm = dir.join("slurm");
-    let io = |path: &Path, source| SweepError::RunDir {
-        point: "slurm".into(),
-        source: rundir::RunDirError::Io {
-            action: "write",
-            path: path.to_path_buf(),
-            source,
-        },
-    };
+    let io = |path: &Path, source| SweepError::write("slurm", path, source);
     std::fs::create_dir_all(&slurm).map_err(|e| io(&slurm, e))?;
     let script = slurm.join("sweep.sbatch");
     let mut list = String::new();
     for p in &todo {
-        let out = run_dir(dir, p);
-        let _ = std::fs::remove_file(out.join(COMPLETE));
-        rundir::prepare(&out, true).map_err(|source| SweepError::RunDir {
-            point: p.name.clone(),
-            source,
-        })?;
-        rundir::write_scene(&out, &p.scene).map_err(|source| SweepError::RunDir {
-            point: p.name.clone(),
-            source,
-        })?;
+        let out = prepare_point(dir, p)?;
         list += &absolute(&out).display().to_string();
         list += "\n";
     }

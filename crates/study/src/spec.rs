@@ -52,14 +52,7 @@ impl SweepSpec {
     /// When the files cannot be written.
     pub fn save(&self, dir: &Path) -> Result<(), SweepError> {
         let d = dir.join("sweep");
-        let io = |path: &Path, source| SweepError::RunDir {
-            point: "the sweep's record".into(),
-            source: rundir::RunDirError::Io {
-                action: "write",
-                path: path.to_path_buf(),
-                source,
-            },
-        };
+        let io = |path: &Path, source| SweepError::write("the sweep's record", path, source);
         std::fs::create_dir_all(&d).map_err(|e| io(&d, e))?;
         let mut args = String::new();
         for s in &self.sets {

@@ -83,15 +83,7 @@ pub fn run_points(
     progress: Arc<dyn Fn(u64) + Send + Sync>,
 ) -> Result<SweepInfo, SweepError> {
     let (todo, steps) = pending(dir, points);
-    let outer = rayon::ThreadPoolBuilder::new()
-        .num_threads(params.jobs)
-        .build()
-        .map_err(|e| SweepError::Threads(e.to_string()))?;
-    outer.install(|| {
-        todo.par_iter()
-            .with_max_len(1)
-            .try_for_each(|p| run_point(p, dir, params.threads, progress.clone()))
-    })?;
+    in_jobs(&todo, params, |p| run_point(p, dir, progress.clone()))?;
     Ok(SweepInfo {
         ran: todo.len(),
         skipped: points.len() - todo.len(),
@@ -99,12 +91,33 @@ pub fn run_points(
     })
 }
 
-fn run_point(
-    point: &Point,
-    dir: &Path,
-    threads: usize,
-    progress: Arc<dyn Fn(u64) + Send + Sync>,
-) -> Result<(), SweepError> {
+/// Calls `f` on every item, `params.jobs` at a time, each call inside its own rayon pool of
+/// `params.threads` threads; stops starting new calls after the first error.
+///
+/// # Errors
+/// The first error of `f`, or [`SweepError::Threads`] (converted) when a pool cannot start.
+pub fn in_jobs<I: Sync, E: From<SweepError> + Send>(
+    items: &[I],
+    params: SweepParams,
+    f: impl Fn(&I) -> Result<(), E> + Sync,
+) -> Result<(), E> {
+    let pool = |n: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|e| SweepError::Threads(e.to_string()))
+    };
+    pool(params.jobs)?.install(|| {
+        items.par_iter().with_max_len(1).try_for_each(|item| {
+            let inner = pool(params.threads)?;
+            inner.install(|| f(item))
+        })
+    })
+}
+
+/// Makes `point`'s run directory ready for a fresh run: no `complete` mark, no earlier
+/// output, its resolved `scene.toml` written. Returns the directory.
+pub(crate) fn prepare_point(dir: &Path, point: &Point) -> Result<PathBuf, SweepError> {
     let out = run_dir(dir, point);
     let rd = |source| SweepError::RunDir {
         point: point.name.clone(),
@@ -113,22 +126,22 @@ fn run_point(
     let _ = std::fs::remove_file(out.join(COMPLETE));
     rundir::prepare(&out, true).map_err(rd)?;
     rundir::write_scene(&out, &point.scene).map_err(rd)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| SweepError::Threads(e.to_string()))?;
-    pool.install(|| match point.scene.precision() {
+    Ok(out)
+}
+
+fn run_point(
+    point: &Point,
+    dir: &Path,
+    progress: Arc<dyn Fn(u64) + Send + Sync>,
+) -> Result<(), SweepError> {
+    let out = prepare_point(dir, point)?;
+    match point.scene.precision() {
         Precision::F64 => run_in::<f64>(point, &out, progress),
         Precision::F32 => run_in::<f32>(point, &out, progress),
-    })?;
+    }?;
     let mark = out.join(COMPLETE);
-    std::fs::write(&mark, point.scene.to_toml()).map_err(|source| {
-        rd(rundir::RunDirError::Io {
-            action: "write",
-            path: mark.clone(),
-            source,
-        })
-    })
+    std::fs::write(&mark, point.scene.to_toml())
+        .map_err(|source| SweepError::write(&point.name, &mark, source))
 }
 
 fn run_in<T: Real>(
@@ -218,14 +231,7 @@ pub fn write_summary(
     }
     let path = dir.join("summary.csv");
     let tmp = dir.join("summary.csv.partial");
-    let io = |source| SweepError::RunDir {
-        point: "summary.csv".into(),
-        source: rundir::RunDirError::Io {
-            action: "write",
-            path: path.clone(),
-            source,
-        },
-    };
+    let io = |source| SweepError::write("summary.csv", &path, source);
     std::fs::write(&tmp, text).map_err(io)?;
     std::fs::rename(&tmp, &path).map_err(io)?;
     Ok(path)
