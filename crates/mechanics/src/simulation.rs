@@ -4,16 +4,16 @@
 //!
 //! # The order of one iteration
 //!
-//! [`Simulation::run`] first calls every callback's and writer's
-//! [`Callback::initialize`], then fires the schedules at the starting state. Then, until a
-//! stop criterion holds:
+//! [`Simulation::run`] first sets ζ by the activity switch ([`Simulation::activity_from`]),
+//! calls every callback's and writer's [`Callback::initialize`], then fires the schedules at
+//! the starting state. Then, until a stop criterion holds:
 //!
-//! 1. the activity switch ([`Simulation::activity_from`]) sets ζ if its iteration is reached;
-//! 2. every `sort_every` iterations the cells are re-sorted in memory
+//! 1. every `sort_every` iterations the cells are re-sorted in memory
 //!    ([`Tissue::sort_cells`]);
-//! 3. the tissue takes one step; the state check ([`Simulation::set_check`], by default
+//! 2. the tissue takes one step; the state check ([`Simulation::set_check`], by default
 //!    [`StateCheck`] at every step) runs at the step's chokepoint, before anything is
 //!    overwritten;
+//! 3. the activity switch sets ζ if the new iteration reaches it;
 //! 4. the callbacks whose schedules fire run, in the order they were added, then the output
 //!    writers whose schedules fire, in the order they were added.
 //!
@@ -497,7 +497,6 @@ impl<T: Real> Simulation<T> {
         }
         let mut none = ();
         while !*stop && !self.done(start) {
-            self.apply_activity();
             let it = self.tissue.iteration();
             if self.sort_every.is_some_and(|k| it.is_multiple_of(k)) {
                 self.tissue.sort_cells(&mut self.sort_scratch);
@@ -505,27 +504,11 @@ impl<T: Real> Simulation<T> {
             let (timer, check) = &mut self.check;
             let checked = timer.fires(it, self.tissue.time(), false);
             let check: &mut dyn StepCheck = if checked { check.as_mut() } else { &mut none };
-            self.tissue.step_checked(
-                &mut self.workspace,
-                &self.step_params,
-                &mut DynCheck(check),
-            )?;
+            self.tissue
+                .step_checked(&mut self.workspace, &self.step_params, check)?;
             self.apply_activity();
             self.fire(start, Hook::Call, stop)?;
         }
         Ok(())
-    }
-}
-
-/// A `&mut dyn StepCheck` as a sized check.
-struct DynCheck<'a>(&'a mut dyn StepCheck);
-
-impl StepCheck for DynCheck<'_> {
-    fn check(
-        &mut self,
-        at: crate::step::CheckPoint,
-        cells: &[crate::workspace::CellState],
-    ) -> Result<(), StepError> {
-        self.0.check(at, cells)
     }
 }

@@ -119,7 +119,7 @@ impl<T: Real> Tissue<T> {
         &mut self,
         ws: &mut Workspace<T>,
         step_params: &StepParams,
-        check: &mut impl StepCheck,
+        check: &mut (impl StepCheck + ?Sized),
     ) -> Result<(), StepError> {
         let dt = step_params.dt;
         let shapes = self.params.zeta != 0.0;
