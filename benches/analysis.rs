@@ -6,7 +6,6 @@
 //! Run with `cargo bench -p monolayer-benches --bench analysis`.
 
 use analysis::correlation::Correlator;
-use analysis::crop::CropFields;
 use analysis::crop::DefectAverage;
 use analysis::defects::detect;
 use analysis::fields::vorticity;
@@ -16,6 +15,7 @@ use criterion::{criterion_main, Criterion};
 use mechanics::{TissueFields, Workspace};
 use phasefield::Lattice;
 use scene::Scene;
+use study::pipeline::crop_fields;
 
 fn frame() -> (Lattice, mechanics::Tissue, Workspace) {
     let path = format!("{}/../scenes/large.toml", env!("CARGO_MANIFEST_DIR"));
@@ -44,17 +44,7 @@ fn analyse(
     corr[2].add(&[&sqxx, &sqxy]);
     let found = detect(lattice, &sqxx, &sqxy);
     tracker.push(&found);
-    let cf = CropFields {
-        vx: &f.vx,
-        vy: &f.vy,
-        sigma_xx: &f.sigma_xx,
-        sigma_yy: &f.sigma_yy,
-        sigma_xy: &f.sigma_xy,
-        pressure: &f.pressure,
-        qxx: &f.qxx,
-        qxy: &f.qxy,
-    };
-    avg.add(lattice, &cf, &found);
+    avg.add(lattice, &crop_fields(f), &found);
     found.len()
 }
 

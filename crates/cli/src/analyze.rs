@@ -12,17 +12,18 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use analysis::correlation::{first_minimum, Correlator};
-use analysis::crop::{CropFields, DefectAverage, COMPONENTS};
+use analysis::crop::{DefectAverage, COMPONENTS};
 use analysis::defects::{detect, net_charge};
 use analysis::fields::{rms, s_rms, vorticity};
 use analysis::smooth::{box_smooth, paper_box_side};
 use analysis::tracking::{TrackParams, Tracker};
 use anyhow::{bail, ensure, Context, Result};
-use mechanics::{Tissue, TissueFields, Workspace};
+use mechanics::{Tissue, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
 use rundir::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
 use scene::{Scene, SceneFile};
+use study::pipeline::crop_fields;
 
 /// Options of `monolayer analyze`.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,20 +64,6 @@ pub struct AnalyzeInfo {
     pub defects: usize,
     /// Creation and annihilation events.
     pub events: usize,
-}
-
-/// The fields of a state that the defect-centred averages crop.
-pub fn crop_fields(f: &TissueFields) -> CropFields<'_> {
-    CropFields {
-        vx: &f.vx,
-        vy: &f.vy,
-        sigma_xx: &f.sigma_xx,
-        sigma_yy: &f.sigma_yy,
-        sigma_xy: &f.sigma_xy,
-        pressure: &f.pressure,
-        qxx: &f.qxx,
-        qxy: &f.qxy,
-    }
 }
 
 /// The frames of a run directory, in step order, and how many partial files were skipped.

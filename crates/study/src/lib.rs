@@ -41,6 +41,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod pipeline;
 mod plan;
 mod slurm;
 mod spec;
