@@ -15,7 +15,7 @@ use criterion::{criterion_main, Criterion};
 use mechanics::{TissueFields, Workspace};
 use phasefield::Lattice;
 use scene::Scene;
-use study::pipeline::crop_fields;
+use study::analyze::crop_fields;
 
 fn frame() -> (Lattice, mechanics::Tissue, Workspace) {
     let path = format!("{}/../scenes/large.toml", env!("CARGO_MANIFEST_DIR"));

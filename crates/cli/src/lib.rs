@@ -4,9 +4,8 @@
 //! validates scene files and builds the simulation, the `rundir` crate writes (and reads
 //! back) the files of a run directory; [`run`] runs a scene with a progress report,
 //! [`sweep`] runs a scene over a grid of values and seeds (the `study` crate), and
-//! [`analyze`] turns a run into the paper's quantities. Only this crate prints.
+//! `study::analyze` turns a run into the paper's quantities. Only this crate prints.
 #![deny(missing_docs)]
 
-pub mod analyze;
 pub mod run;
 pub mod sweep;

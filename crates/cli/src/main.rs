@@ -5,10 +5,10 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use monolayer_cli::analyze::{analyze, AnalyzeOptions};
 use monolayer_cli::run;
 use monolayer_cli::sweep::{SweepAction, SweepOutcome};
 use scene::Scene;
+use study::analyze::{analyze, AnalyzeOptions};
 
 /// Multi-phase-field simulations of cell monolayers (Mueller, Yeomans & Doostmohammadi, PRL 2019).
 #[derive(Parser)]
@@ -283,6 +283,9 @@ fn real_main() -> Result<()> {
                 s_rms_baseline,
             };
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
+            if info.partial > 0 {
+                eprintln!("note: skipped {} partially written frame(s)", info.partial);
+            }
             eprintln!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use study::{run_points, write_summary, Seeds, SweepInfo, SweepParams, SweepSpec, Vary};
 
-use crate::analyze::{analyze, AnalyzeOptions};
+use study::analyze::AnalyzeOptions;
 
 /// The arguments of `monolayer sweep`, as parsed.
 #[derive(Debug, Clone)]
@@ -97,7 +97,7 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
         SweepAction::Local => {}
         SweepAction::Collect => {
             if let Some(opts) = &a.analyze {
-                analyze_points(&points, a.out, opts, a.jobs, a.threads)?;
+                study::analyze_points(&points, a.out, opts, SweepParams::new(a.jobs, a.threads))?;
             }
             write_summary(a.out, &keys, &points, a.analyze.is_some())?;
             return Ok(SweepOutcome::Collected(points.len()));
@@ -154,44 +154,8 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
         b.finish();
     }
     if let Some(opts) = &a.analyze {
-        analyze_points(&points, a.out, opts, a.jobs, a.threads)?;
+        study::analyze_points(&points, a.out, opts, SweepParams::new(a.jobs, a.threads))?;
     }
     write_summary(a.out, &keys, &points, a.analyze.is_some())?;
     Ok(SweepOutcome::Ran(info, points.len()))
-}
-
-/// The mark of an analysed run: `analysis/complete`, holding the options it was analysed with.
-fn analysis_mark(opts: &AnalyzeOptions) -> String {
-    format!("{opts:?}\n")
-}
-
-/// Analyses every complete run of `points` that has not been analysed with `opts`, `jobs` at a
-/// time.
-fn analyze_points(
-    points: &[study::Point],
-    dir: &Path,
-    opts: &AnalyzeOptions,
-    jobs: usize,
-    threads: usize,
-) -> Result<()> {
-    let mark = analysis_mark(opts);
-    let todo: Vec<std::path::PathBuf> = points
-        .iter()
-        .filter(|p| study::is_complete(dir, p))
-        .map(|p| study::run_dir(dir, p))
-        .filter(|r| {
-            std::fs::read_to_string(r.join("analysis/complete")).map_or(true, |m| m != mark)
-        })
-        .collect();
-    study::in_jobs(
-        &todo,
-        SweepParams::new(jobs, threads),
-        |run| -> Result<()> {
-            let _ = std::fs::remove_file(run.join("analysis/complete"));
-            analyze(run, opts).with_context(|| format!("analysing {}", run.display()))?;
-            std::fs::write(run.join("analysis/complete"), &mark)
-                .with_context(|| format!("cannot mark {} analysed", run.display()))?;
-            Ok(())
-        },
-    )
 }

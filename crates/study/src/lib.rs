@@ -41,7 +41,7 @@
 //! ```
 #![deny(missing_docs)]
 
-pub mod pipeline;
+pub mod analyze;
 mod plan;
 mod slurm;
 mod spec;
@@ -55,8 +55,8 @@ pub use plan::{plan, Point, Seeds, Vary};
 pub use slurm::{write_job_array, JobArray};
 pub use spec::SweepSpec;
 pub use sweep::{
-    in_jobs, is_complete, pending, run_dir, run_points, write_summary, SweepInfo, SweepParams,
-    COMPLETE,
+    analyze_points, in_jobs, is_complete, pending, run_dir, run_points, write_summary, SweepInfo,
+    SweepParams, COMPLETE,
 };
 
 /// What stops a sweep, naming the argument, the point or the file.
@@ -129,6 +129,15 @@ pub enum SweepError {
     Threshold {
         /// What is wrong.
         why: String,
+    },
+    /// A run could not be analysed.
+    #[error("analysing {}", run.display())]
+    Analyze {
+        /// The run directory.
+        run: PathBuf,
+        /// The error.
+        #[source]
+        source: analyze::AnalyzeError,
     },
     /// The thread pools could not be built.
     #[error("cannot start the worker threads: {0}")]

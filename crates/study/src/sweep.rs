@@ -8,6 +8,7 @@ use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
 use phasefield::Real;
 use rayon::prelude::*;
 
+use crate::analyze::{analyze, AnalyzeOptions};
 use crate::plan::Point;
 use crate::summary::{analysis_columns, summarise, window, ANALYSIS_COLUMNS, SUMMARY_COLUMNS};
 use crate::SweepError;
@@ -235,4 +236,41 @@ pub fn write_summary(
     std::fs::write(&tmp, text).map_err(io)?;
     std::fs::rename(&tmp, &path).map_err(io)?;
     Ok(path)
+}
+
+/// The mark of an analysed run, `analysis/complete`: it holds the options it was analysed
+/// with.
+fn analysis_mark(opts: &AnalyzeOptions) -> String {
+    format!("{opts:?}\n")
+}
+
+/// Analyses ([`crate::analyze::analyze`]) every complete run of `points` in `dir` that has not
+/// been analysed with `opts` yet, `params.jobs` at a time, and marks each analysed run.
+///
+/// # Errors
+/// The first run that cannot be analysed, or whose mark cannot be written.
+pub fn analyze_points(
+    points: &[Point],
+    dir: &Path,
+    opts: &AnalyzeOptions,
+    params: SweepParams,
+) -> Result<(), SweepError> {
+    let mark = analysis_mark(opts);
+    let todo: Vec<PathBuf> = points
+        .iter()
+        .filter(|p| is_complete(dir, p))
+        .map(|p| run_dir(dir, p))
+        .filter(|r| {
+            std::fs::read_to_string(r.join("analysis/complete")).map_or(true, |m| m != mark)
+        })
+        .collect();
+    in_jobs(&todo, params, |run| -> Result<(), SweepError> {
+        let path = run.join("analysis/complete");
+        let _ = std::fs::remove_file(&path);
+        analyze(run, opts).map_err(|source| SweepError::Analyze {
+            run: run.clone(),
+            source,
+        })?;
+        std::fs::write(&path, &mark).map_err(|source| SweepError::write("analysis", &path, source))
+    })
 }

@@ -1,4 +1,4 @@
-//! `monolayer analyze RUN_DIR`: from a run directory to the paper's quantities, in
+//! The analysis pipeline of a run directory (`monolayer analyze RUN_DIR`): from a run directory to the paper's quantities, in
 //! `RUN_DIR/analysis/`.
 //!
 //! For every frame at or after `--from` (default: the end of relaxation) the state is rebuilt
@@ -7,23 +7,69 @@
 //! nearest 3R), accumulates their correlations, finds and orients the defects of the smoothed
 //! `Q`, tracks them, and averages the raw fields around each defect in its own frame.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use analysis::correlation::{first_minimum, Correlator};
+use analysis::crop::CropFields;
 use analysis::crop::{DefectAverage, COMPONENTS};
 use analysis::defects::{detect, net_charge};
 use analysis::fields::{rms, s_rms, vorticity};
 use analysis::smooth::{box_smooth, paper_box_side};
 use analysis::tracking::{TrackParams, Tracker};
-use anyhow::{bail, ensure, Context, Result};
-use mechanics::{Tissue, Workspace};
+use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
 use rundir::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
 use scene::{Scene, SceneFile};
-use study::pipeline::crop_fields;
+
+/// What stops the analysis of a run, naming the file or option.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum AnalyzeError {
+    /// A file of the run is missing, damaged or inconsistent with the scene.
+    #[error("{}: {why}", path.display())]
+    Input {
+        /// The file or directory.
+        path: PathBuf,
+        /// What is wrong, and what to do.
+        why: String,
+    },
+    /// An option cannot be used.
+    #[error("{0}")]
+    Options(String),
+    /// An output file could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+type Result<T, E = AnalyzeError> = std::result::Result<T, E>;
+
+fn input(path: &Path, why: impl Into<String>) -> AnalyzeError {
+    AnalyzeError::Input {
+        path: path.to_path_buf(),
+        why: why.into(),
+    }
+}
+
+/// The fields of a state that the defect-centred averages crop.
+pub fn crop_fields(f: &TissueFields) -> CropFields<'_> {
+    CropFields {
+        vx: &f.vx,
+        vy: &f.vy,
+        sigma_xx: &f.sigma_xx,
+        sigma_yy: &f.sigma_yy,
+        sigma_xy: &f.sigma_xy,
+        pressure: &f.pressure,
+        qxx: &f.qxx,
+        qxy: &f.qxy,
+    }
+}
 
 /// Options of `monolayer analyze`.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,20 +110,18 @@ pub struct AnalyzeInfo {
     pub defects: usize,
     /// Creation and annihilation events.
     pub events: usize,
+    /// Partially written frames (`*.partial`) that were skipped.
+    pub partial: usize,
 }
 
 /// The frames of a run directory, in step order, and how many partial files were skipped.
 fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
     let dir = run_dir.join("frames");
-    let entries = std::fs::read_dir(&dir).with_context(|| {
-        format!(
-            "{} has no frames/ directory: the run wrote no frame yet",
-            run_dir.display()
-        )
-    })?;
+    let entries = std::fs::read_dir(&dir)
+        .map_err(|_| input(run_dir, "no frames/ directory: the run wrote no frame yet"))?;
     let (mut frames, mut partial) = (Vec::new(), 0);
     for e in entries {
-        let p = e?.path();
+        let p = e.map_err(|e| input(&dir, e.to_string()))?.path();
         let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
         if name.ends_with(".partial") {
             partial += 1;
@@ -86,34 +130,31 @@ fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
         }
     }
     frames.sort();
-    ensure!(!frames.is_empty(), "{} holds no frame_*.npz", dir.display());
+    if frames.is_empty() {
+        return Err(input(&dir, "holds no frame_*.npz"));
+    }
     Ok((frames, partial))
 }
 
 /// Reads the run's resolved scene.
 fn read_scene(run_dir: &Path) -> Result<Scene> {
-    ensure!(
-        run_dir.is_dir(),
-        "no run directory at {}",
-        run_dir.display()
-    );
+    if !run_dir.is_dir() {
+        return Err(input(run_dir, "no run directory there"));
+    }
     let path = run_dir.join("scene.toml");
-    let text = std::fs::read_to_string(&path).with_context(|| {
-        format!(
-            "{} is not a monolayer run directory: scene.toml is missing",
-            run_dir.display()
+    let text = std::fs::read_to_string(&path).map_err(|_| {
+        input(
+            run_dir,
+            "not a monolayer run directory: scene.toml is missing",
         )
     })?;
-    let file = SceneFile::parse(&text, &[]).with_context(|| {
-        format!(
-            "{} does not parse with this version of monolayer",
-            path.display()
+    let file = SceneFile::parse(&text, &[]).map_err(|e| {
+        input(
+            &path,
+            format!("does not parse with this version of monolayer: {e}"),
         )
     })?;
-    let scene = file
-        .validate()
-        .with_context(|| format!("in {}", path.display()))?;
-    Ok(scene)
+    file.validate().map_err(|e| input(&path, e.to_string()))
 }
 
 /// One frame's state, rebuilt as a tissue.
@@ -136,33 +177,33 @@ fn load_frame(
             "shape_tensor",
         ],
     )
-    .with_context(|| {
-        format!(
-            "frame {} was written by another version or is damaged",
-            path.display()
+    .map_err(|e| {
+        input(
+            path,
+            format!("the frame was written by another version or is damaged: {e}"),
         )
     })?;
     let [step, time, zeta, lat, origin, phi, shape_tensor]: [Array; 7] = arrays
         .try_into()
         .expect("read_npz returns one array per name");
     let (step, time, zeta) = (step.data[0] as u64, time.data[0], zeta.data[0]);
-    ensure!(
-        lat.data == [lattice.lx as f64, lattice.ly as f64],
-        "frame {} is on a {:?} lattice but scene.toml says {}×{}",
-        path.display(),
-        lat.data,
-        lattice.lx,
-        lattice.ly
-    );
+    if lat.data != [lattice.lx as f64, lattice.ly as f64] {
+        return Err(input(
+            path,
+            format!(
+                "the frame is on a {:?} lattice but scene.toml says {}×{}",
+                lat.data, lattice.lx, lattice.ly
+            ),
+        ));
+    }
     let n = scene.file().cells.count;
     let want = vec![n as u64, shape.nx as u64, shape.ny as u64];
-    ensure!(
-        phi.shape == want,
-        "frame {}: phi has shape {:?}, the scene implies {:?}",
-        path.display(),
-        phi.shape,
-        want
-    );
+    if phi.shape != want {
+        return Err(input(
+            path,
+            format!("phi has shape {:?}, the scene implies {want:?}", phi.shape),
+        ));
+    }
     let origins: Vec<[usize; 2]> = origin
         .data
         .chunks_exact(2)
@@ -186,25 +227,40 @@ fn load_frame(
 
 /// The time of a frame, after checking that this version can read it.
 fn frame_time(path: &Path) -> Result<f64> {
-    let a = read_npz(path, &["format", "time"]).with_context(|| {
-        format!(
-            "frame {} was written by another version or is damaged",
-            path.display()
+    let a = read_npz(path, &["format", "time"]).map_err(|e| {
+        input(
+            path,
+            format!("the frame was written by another version or is damaged: {e}"),
         )
     })?;
     let format = a[0].data[0] as i64;
-    ensure!(
-        format == FRAME_FORMAT,
-        "frame {} has format {format}, this version reads format {FRAME_FORMAT}",
-        path.display()
-    );
+    if format != FRAME_FORMAT {
+        return Err(input(
+            path,
+            format!("the frame has format {format}, this version reads format {FRAME_FORMAT}"),
+        ));
+    }
     Ok(a[1].data[0])
 }
 
-fn csv(path: &Path) -> Result<BufWriter<File>> {
-    Ok(BufWriter::new(File::create(path).with_context(|| {
-        format!("cannot create {}", path.display())
-    })?))
+/// Writes `text` to `path` whole: under a temporary name first, so that an error leaves no
+/// empty or truncated table behind.
+fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = path.with_extension("partial");
+    let err = |source| AnalyzeError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    std::fs::write(&tmp, bytes).map_err(err)?;
+    std::fs::rename(&tmp, path).map_err(err)
+}
+
+/// Appends one formatted line to a table held in a `String`.
+macro_rules! row {
+    ($buf:expr, $($arg:tt)*) => {{
+        use std::fmt::Write as _;
+        let _ = writeln!($buf, $($arg)*);
+    }};
 }
 
 /// Runs the analysis of `run_dir` into `run_dir/analysis/`.
@@ -216,19 +272,18 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let lattice = scene.lattice();
     let shape = scene.patch_shape();
     let (frames, partial) = list_frames(run_dir)?;
-    if partial > 0 {
-        eprintln!("note: skipping {partial} partially written frame(s)");
-    }
     let from = opts.from.unwrap_or(scene.file().run.relax_time);
     let radius = scene.file().cells.radius;
     let box_side = opts
         .box_side
         .unwrap_or_else(|| paper_box_side(radius).min(lattice.lx.min(lattice.ly) | 1));
-    box_smooth(lattice, &vec![0.0; lattice.len()], box_side).map_err(anyhow::Error::from)?;
-    ensure!(
-        opts.crop_side % 2 == 1,
-        "--crop must be odd (the defect sits on the centre node), e.g. 101"
-    );
+    box_smooth(lattice, &vec![0.0; lattice.len()], box_side)
+        .map_err(|e| AnalyzeError::Options(format!("--box {box_side}: {e}")))?;
+    if opts.crop_side % 2 != 1 {
+        return Err(AnalyzeError::Options(
+            "--crop must be odd (the defect sits on the centre node), e.g. 101".into(),
+        ));
+    }
     let defaults = TrackParams::for_radius(radius);
     let params = TrackParams::new(
         opts.max_link.unwrap_or(defaults.max_link),
@@ -244,21 +299,26 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         .map(|(p, _)| p)
         .collect();
     if selected.is_empty() {
-        bail!("no frame at or after t = {from}; use --from with an earlier time");
+        return Err(AnalyzeError::Options(format!(
+            "no frame at or after t = {from}; use --from with an earlier time"
+        )));
     }
 
     let out = run_dir.join("analysis");
-    std::fs::create_dir_all(&out)?;
-    let mut obs = csv(&out.join("observables.csv"))?;
-    writeln!(
+    std::fs::create_dir_all(&out).map_err(|source| AnalyzeError::Write {
+        path: out.clone(),
+        source,
+    })?;
+    let mut obs = String::new();
+    row!(
         obs,
         "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate"
-    )?;
-    let mut defects_csv = csv(&out.join("defects.csv"))?;
-    writeln!(defects_csv, "# axes: x is the first lattice index, y the second, right-handed; angle in radians counterclockwise from +x (+1/2: direction of div Q; -1/2: one arm, modulo 2pi/3)")?;
-    writeln!(defects_csv, "frame,time,x,y,charge,angle,track")?;
-    let mut events_csv = csv(&out.join("defect_events.csv"))?;
-    writeln!(events_csv, "frame,time,kind,x,y")?;
+    );
+    let mut defects_csv = String::new();
+    row!(defects_csv, "# axes: x is the first lattice index, y the second, right-handed; angle in radians counterclockwise from +x (+1/2: direction of div Q; -1/2: one arm, modulo 2pi/3)");
+    row!(defects_csv, "frame,time,x,y,charge,angle,track");
+    let mut events_csv = String::new();
+    row!(events_csv, "frame,time,kind,x,y");
 
     let mut ws: Option<Workspace> = None;
     let mut corr = [
@@ -272,6 +332,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         frames: 0,
         defects: 0,
         events: 0,
+        partial,
     };
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
@@ -290,11 +351,14 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         let tracks = tracker.push(&found);
         let time = tissue.time();
         for (d, t) in found.iter().zip(&tracks.track) {
-            writeln!(
+            row!(
                 defects_csv,
                 "{step},{time:.6},{},{},{},{},{t}",
-                d.x, d.y, d.charge, d.angle
-            )?;
+                d.x,
+                d.y,
+                d.charge,
+                d.angle
+            );
         }
         let (mut creations, mut annihilations) = (0, 0);
         for e in &tracks.events {
@@ -302,13 +366,13 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
                 analysis::tracking::EventKind::Creation => creations += 1,
                 analysis::tracking::EventKind::Annihilation => annihilations += 1,
             }
-            writeln!(
+            row!(
                 events_csv,
                 "{step},{time:.6},{},{},{}",
                 e.kind.name(),
                 e.x,
                 e.y
-            )?;
+            );
         }
         avg.add(lattice, &crop_fields(&f), &found);
         let n_plus = found.iter().filter(|d| d.charge == 0.5).count();
@@ -318,7 +382,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             Some(p) if time > p => creations as f64 / ((time - p) * area),
             _ => f64::NAN,
         };
-        writeln!(
+        row!(
             obs,
             "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e}",
             rms(&[&f.vx, &f.vy]),
@@ -329,50 +393,59 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             found.len() as f64 / area,
             tracks.unpaired,
             rate
-        )?;
+        );
         prev_time = Some(time);
         info.frames += 1;
         info.defects += found.len();
         info.events += tracks.events.len();
     }
-    obs.flush()?;
-    defects_csv.flush()?;
-    events_csv.flush()?;
+    write_file(&out.join("observables.csv"), obs.as_bytes())?;
+    write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
+    write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
 
     let radial: Vec<Vec<f64>> = corr.iter().map(|c| c.radial()).collect();
-    let mut c = csv(&out.join("correlations.csv"))?;
-    writeln!(c, "r,c_velocity,c_vorticity,c_q")?;
+    let mut c = String::new();
+    row!(c, "r,c_velocity,c_vorticity,c_q");
     for r in 0..radial[0].len() {
-        writeln!(
+        row!(
             c,
             "{r},{:e},{:e},{:e}",
-            radial[0][r], radial[1][r], radial[2][r]
-        )?;
+            radial[0][r],
+            radial[1][r],
+            radial[2][r]
+        );
     }
-    c.flush()?;
-    let mut l = csv(&out.join("lengths.csv"))?;
-    writeln!(l, "field,length")?;
+    write_file(&out.join("correlations.csv"), c.as_bytes())?;
+    let mut l = String::new();
+    row!(l, "field,length");
     for (name, r) in ["velocity", "vorticity", "q"].iter().zip(&radial) {
-        writeln!(l, "{name},{}", first_minimum(r).unwrap_or(f64::NAN))?;
+        row!(l, "{name},{}", first_minimum(r).unwrap_or(f64::NAN));
     }
-    l.flush()?;
+    write_file(&out.join("lengths.csv"), l.as_bytes())?;
     write_averages(&out.join("defect_averages.npz"), &avg)?;
     Ok(info)
 }
 
 fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {
+    let err = |e: &dyn std::fmt::Display| input(path, e.to_string());
     let side = avg.side() as u64;
     let mut arrays = vec![
-        ("n_plus".to_string(), npy(&[], [avg.n_plus as f64])?),
-        ("n_minus".to_string(), npy(&[], [avg.n_minus as f64])?),
+        (
+            "n_plus".to_string(),
+            npy(&[], [avg.n_plus as f64]).map_err(|e| err(&e))?,
+        ),
+        (
+            "n_minus".to_string(),
+            npy(&[], [avg.n_minus as f64]).map_err(|e| err(&e))?,
+        ),
     ];
     for (plus, prefix) in [(true, "plus"), (false, "minus")] {
         for name in COMPONENTS {
             arrays.push((
                 format!("{prefix}_{name}"),
-                npy(&[side, side], avg.average(plus, name))?,
+                npy(&[side, side], avg.average(plus, name)).map_err(|e| err(&e))?,
             ));
         }
     }
-    Ok(write_npz(path, arrays)?)
+    write_npz(path, arrays).map_err(|e| err(&e))
 }
