@@ -99,6 +99,26 @@ enum Command {
         #[arg(long, default_value = "model.zeta")]
         key: String,
     },
+    /// Reproduce a figure of the paper from its scene: the sweeps it needs (resumable, in
+    /// OUT/sweeps/), its data as CSV, its plots as PNG and OUT/FIGURE/verdict.md, a verdict
+    /// on each claim of the paper that it tests.
+    Reproduce {
+        /// threshold, lengths, defects, defect-fields, contractile, scaling, or all.
+        figure: String,
+        /// The output directory (created if missing; a second call resumes).
+        #[arg(long)]
+        out: PathBuf,
+        /// quick (3 seeds, short runs, minutes per figure on 2 cores) or paper (5 seeds, the
+        /// paper's sizes and integrator).
+        #[arg(long, default_value = "quick")]
+        scale: String,
+        /// Runs at a time; each gets cores / jobs threads. Results do not depend on it.
+        #[arg(long, default_value_t = 1)]
+        jobs: usize,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Analyse a run directory: observables, correlations, defects and defect-centred
     /// averages, written into RUN_DIR/analysis/.
     Analyze {
@@ -245,6 +265,25 @@ fn real_main() -> Result<()> {
                 }
                 _ => {}
             }
+            Ok(())
+        }
+        Command::Reproduce {
+            figure,
+            out,
+            scale,
+            jobs,
+            quiet,
+        } => {
+            anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            monolayer_cli::reproduce::run(
+                &figure,
+                &out,
+                &scale,
+                jobs,
+                (cores / jobs).max(1),
+                quiet,
+            )?;
             Ok(())
         }
         Command::Threshold { dir, key } => {

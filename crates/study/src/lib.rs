@@ -43,6 +43,7 @@
 
 pub mod analyze;
 mod plan;
+pub mod reproduce;
 mod slurm;
 mod spec;
 pub mod summary;
@@ -138,6 +139,12 @@ pub enum SweepError {
         /// The error.
         #[source]
         source: analyze::AnalyzeError,
+    },
+    /// A figure cannot be made.
+    #[error("reproduce: {why}")]
+    Reproduce {
+        /// What is wrong.
+        why: String,
     },
     /// The thread pools could not be built.
     #[error("cannot start the worker threads: {0}")]

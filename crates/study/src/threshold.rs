@@ -1,21 +1,28 @@
 //! The activity threshold ζ_cr from the late growth rates of `ln v_rms` (issue 11).
 //!
 //! The paper's criterion (v_rms > 1e-7 after 3000 steps) separates nothing here: at ζ = 0 the
-//! packing keeps coarsening and v_rms is still ~1e-3 after 1200 TU. The protocol used instead:
-//! every activity ζ runs from the same relaxed states (the same seeds and relaxation) as a
-//! ζ = 0 baseline, and the *excess growth rate*
+//! packing keeps coarsening and v_rms is still ~1e-3 after 1200 TU. The protocol used instead
+//! looks at the late growth rate
 //!
 //! ```text
-//! Δ(ζ) = ⟨r(ζ)⟩_seeds − ⟨r(0)⟩_seeds,   r = d ln v_rms / dt over the second half of the active phase
+//! r = d ln v_rms / dt,   a least-squares slope over the second half of the active phase,
 //! ```
 //!
-//! is negative below the threshold (the flow decays as the passive tissue does, or faster)
-//! and positive above it (the activity drives a flow that grows, or decays more slowly).
-//! ζ_cr is where Δ first changes sign from − to +, by linear interpolation between the two
-//! activities that bracket it; the bracket is reported with it. Near the threshold the rates
-//! are small and the estimate moves as runs get longer, so the run length is part of the
-//! protocol.
-
+//! of runs that start from the same relaxed states (the same seeds and relaxation) at every
+//! activity, and gives two estimates from the same runs:
+//!
+//! - **growth** (the primary one): ζ_cr is where the seed mean ⟨r(ζ)⟩ first turns positive:
+//!   above it the activity makes the flow grow against the relaxation, below it the flow
+//!   decays. It is a conservative (upper) estimate for a finite run, because the passive
+//!   decay r(0) < 0 still has to be overcome; as runs get longer r(0) → 0⁻ and it moves down.
+//! - **excess**: ζ_cr is where `Δ(ζ) = ⟨r(ζ)⟩ − ⟨r(0)⟩` first turns positive, i.e. where the
+//!   flow decays more slowly than the passive one. Δ(0) = 0 by construction and Δ rises
+//!   smoothly from there, so this estimate sits near the smallest activity tried and is set
+//!   by the seed noise; it is a lower bound, not a threshold.
+//!
+//! Both interpolate linearly between the two activities that bracket the sign change and
+//! report the bracket. Near the threshold the rates are small and the estimates move as runs
+//! get longer, so the run length is part of the protocol.
 /// The growth rates of one activity over its seeds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RatePoint {
@@ -55,8 +62,10 @@ fn mean(v: &[f64]) -> f64 {
 }
 
 /// The threshold from the rates of the activities `points` (any order, ζ > 0) against the
-/// rates `baseline` of ζ = 0 (see the module docs). Activities without a finite rate are left
-/// out.
+/// rates `baseline`: the first activity where the mean rate exceeds the mean baseline, by
+/// linear interpolation. With the rates of ζ = 0 as the baseline this is the *excess*
+/// estimate of the module docs, with `&[0.0]` the *growth* estimate ([`growth_threshold`]).
+/// Activities without a finite rate are left out.
 ///
 /// # Panics
 /// If `baseline` is empty.
@@ -85,14 +94,32 @@ pub fn threshold(baseline: &[f64], points: &[RatePoint]) -> Threshold {
     }
 }
 
-/// The header of `threshold.csv` after the other varied keys.
-pub const THRESHOLD_COLUMNS: &str = "zeta_cr,zeta_cr_lo,zeta_cr_hi,seeds,activities";
+/// The *growth* estimate of the module docs: where the mean late growth rate turns positive.
+pub fn growth_threshold(points: &[RatePoint]) -> Threshold {
+    threshold(&[0.0], points)
+}
+
+/// `(estimate, lo, hi)` of a threshold as CSV fields: empty on an open side.
+pub fn csv_fields(t: Threshold) -> [String; 3] {
+    match t {
+        Threshold::Bracketed { zeta_cr, lo, hi } => {
+            [zeta_cr.to_string(), lo.to_string(), hi.to_string()]
+        }
+        Threshold::Below { hi } => [String::new(), String::new(), hi.to_string()],
+        Threshold::Above { lo } => [String::new(), lo.to_string(), String::new()],
+    }
+}
+
+/// The header of `threshold.csv` after the other varied keys: the growth estimate, the excess
+/// estimate (module docs), the seeds of the baseline and the number of activities.
+pub const THRESHOLD_COLUMNS: &str =
+    "zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities";
 
 /// The threshold of every combination of the other axes of a sweep, from its `summary.csv`
 /// text: rows grouped by every varied key but `zeta_key`, the rows with ζ = 0 as the
-/// baseline, the others as the activities ([`threshold`]). Returns the text of
-/// `threshold.csv`: the other keys, then [`THRESHOLD_COLUMNS`]; an open bracket leaves
-/// `zeta_cr` empty, and `zeta_cr_lo` or `zeta_cr_hi` empty on its open side.
+/// baseline, the others as the activities; both estimates of the module docs. Returns the
+/// text of `threshold.csv`: the other keys, then [`THRESHOLD_COLUMNS`]; an open bracket
+/// leaves the estimate empty, and its `_lo` or `_hi` empty on its open side.
 ///
 /// # Errors
 /// [`crate::SweepError::Threshold`] when the summary has no `zeta_key` column, no growth rates, or a
@@ -155,18 +182,13 @@ pub fn threshold_table(summary: &str, zeta_key: &str) -> Result<String, crate::S
                 if key.is_empty() { "the sweep".to_string() } else { key.join(",") }
             )));
         }
-        let (cr, lo, hi) = match threshold(baseline, points) {
-            Threshold::Bracketed { zeta_cr, lo, hi } => {
-                (zeta_cr.to_string(), lo.to_string(), hi.to_string())
-            }
-            Threshold::Below { hi } => (String::new(), String::new(), hi.to_string()),
-            Threshold::Above { lo } => (String::new(), lo.to_string(), String::new()),
-        };
+        let growth = csv_fields(growth_threshold(points)).join(",");
+        let excess = csv_fields(threshold(baseline, points)).join(",");
         for v in key {
             out += v;
             out += ",";
         }
-        out += &format!("{cr},{lo},{hi},{},{}\n", baseline.len(), points.len());
+        out += &format!("{growth},{excess},{},{}\n", baseline.len(), points.len());
     }
     Ok(out)
 }
@@ -246,16 +268,36 @@ mod tests {
         let lines: Vec<&str> = table.lines().collect();
         assert_eq!(
             lines[0],
-            "model.gamma,zeta_cr,zeta_cr_lo,zeta_cr_hi,seeds,activities"
+            "model.gamma,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities"
         );
+        let fields =
+            |line: &str| -> Vec<Option<f64>> { line.split(',').map(|v| v.parse().ok()).collect() };
+        // The excess estimate is ζ_cr itself: Δ = 1.5 (ζ − ζ_cr).
         for (line, (gamma, lo, hi)) in lines[1..]
             .iter()
             .zip([(0.01, 0.006, 0.008), (0.02, 0.008, 0.01)])
         {
-            let f: Vec<f64> = line.split(',').map(|v| v.parse().unwrap()).collect();
-            assert_eq!((f[0], f[2], f[3], f[4], f[5]), (gamma, lo, hi, 2.0, 4.0));
-            assert!((f[1] - (0.004 + 0.2 * gamma)).abs() < 1e-12, "{line}");
+            let f = fields(line);
+            assert_eq!(
+                (f[0], f[5], f[6], f[7], f[8]),
+                (Some(gamma), Some(lo), Some(hi), Some(2.0), Some(4.0))
+            );
+            assert!(
+                (f[4].unwrap() - (0.004 + 0.2 * gamma)).abs() < 1e-12,
+                "{line}"
+            );
         }
+        // The growth estimate is where r itself turns positive, ζ_cr + 0.004/1.5: bracketed
+        // for γ = 0.01, above every activity tried for γ = 0.02 (open bracket).
+        let f = fields(lines[1]);
+        assert_eq!((f[2], f[3]), (Some(0.008), Some(0.01)));
+        assert!(
+            (f[1].unwrap() - (0.006 + 0.004 / 1.5)).abs() < 1e-12,
+            "{}",
+            lines[1]
+        );
+        let f = fields(lines[2]);
+        assert_eq!((f[1], f[2], f[3]), (None, Some(0.01), None));
         let no_base = "model.zeta,seed,growth_rate\n0.005,1,0.1\n";
         let e = threshold_table(no_base, "model.zeta")
             .unwrap_err()

@@ -1,0 +1,298 @@
+//! `reproduce lengths`: Fig. 3 (the vorticity correlation and its length against ζ and γ)
+//! and the supplementary velocity and Q length figures.
+
+use std::path::Path;
+
+use render::{Plot, Series};
+
+use super::AtValue;
+use super::{
+    drawn, g, mean_std, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, SweepResult,
+    Table, Verdict,
+};
+use crate::analyze::AnalyzeOptions;
+use crate::SweepError;
+
+/// The activities of the ζ sweep (γ = 0.01).
+pub(super) const ZETAS: [&str; 6] = ["0", "0.002", "0.004", "0.006", "0.008", "0.012"];
+/// The stiffnesses of the γ sweep, at ζ = [`ZETA_OF_GAMMA_SWEEP`].
+pub(super) const GAMMAS: [&str; 4] = ["0.006", "0.01", "0.014", "0.02"];
+/// The activity of the γ sweep.
+pub(super) const ZETA_OF_GAMMA_SWEEP: &str = "0.01";
+/// Activities at or above this are in active turbulence for every γ of the figures.
+const ACTIVE: f64 = 0.004;
+
+/// The active time of the turbulence runs and the first analysed time.
+pub(super) fn times(scale: Scale) -> (f64, f64) {
+    let t = match scale {
+        Scale::Quick => 400.0,
+        Scale::Paper => 1000.0,
+    };
+    (t, 200.0 + 0.5 * t)
+}
+
+/// The two analysed sweeps of active turbulence on L = 200 (240 cells, the paper's Fig. 2a
+/// and 3 size): ζ at γ = 0.01, and γ at ζ = 0.01. Shared with `reproduce defects`.
+pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResult), SweepError> {
+    let (t, from) = times(p.scale);
+    let mut sets = vec![
+        "domain.lx=200".to_string(),
+        "domain.ly=200".into(),
+        "cells.count=240".into(),
+        format!("run.time={t}"),
+        "run.output_every=10".into(),
+    ];
+    sets.extend(p.scale.integrator());
+    let analyze = Some(AnalyzeOptions {
+        from: Some(from),
+        ..AnalyzeOptions::default()
+    });
+    let zeta = super::sweep(
+        p,
+        SweepJob {
+            name: format!("turbulence-zeta-{}", p.scale.name()),
+            sets: sets.clone(),
+            varies: vec![format!("model.zeta={}", ZETAS.join(","))],
+            analyze: analyze.clone(),
+        },
+    )?;
+    let mut gsets = sets;
+    gsets.push(format!("model.zeta={ZETA_OF_GAMMA_SWEEP}"));
+    let gamma = super::sweep(
+        p,
+        SweepJob {
+            name: format!("turbulence-gamma-{}", p.scale.name()),
+            sets: gsets,
+            varies: vec![format!("model.gamma={}", GAMMAS.join(","))],
+            analyze,
+        },
+    )?;
+    Ok((zeta, gamma))
+}
+
+/// The seed statistics of a column of the analysed summary, per value of the (only) axis.
+pub(super) fn by_value(
+    res: &SweepResult,
+    values: &[&str],
+    column: &str,
+) -> Result<Vec<AtValue>, SweepError> {
+    let groups = res
+        .summary
+        .group(&[res.summary.header[0].as_str()], column)?;
+    Ok(values
+        .iter()
+        .filter_map(|v| {
+            groups.iter().find(|g| g.0[0] == *v).map(|g| {
+                (
+                    v.parse().unwrap_or(f64::NAN),
+                    mean_std(&g.1),
+                    g.1.iter().filter(|x| x.is_finite()).count(),
+                )
+            })
+        })
+        .collect())
+}
+
+/// Whether a quantity moves with the axis in the expected direction (`sign` ±1), from its
+/// first to its last point: more than two standard errors either way decides.
+pub(super) fn trend(pts: &[AtValue], sign: f64) -> (Verdict, String) {
+    let pts: Vec<&AtValue> = pts.iter().filter(|p| p.1 .0.is_finite()).collect();
+    let (Some(a), Some(b)) = (pts.first(), pts.last()) else {
+        return (Verdict::Inconclusive, "no finite value".into());
+    };
+    if pts.len() < 2 {
+        return (Verdict::Inconclusive, "a single point".into());
+    }
+    let se = |p: &AtValue| p.1 .1 / (p.2.max(1) as f64).sqrt();
+    let d = b.1 .0 - a.1 .0;
+    let err = (se(a).powi(2) + se(b).powi(2)).sqrt();
+    let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+    let y: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
+    let slope = crate::summary::slope(&x, &y);
+    let text = format!(
+        "from {} at {} to {} at {} (change {} ± {} s.e.; slope {})",
+        g(a.1 .0),
+        a.0,
+        g(b.1 .0),
+        b.0,
+        g(d),
+        g(err),
+        g(slope)
+    );
+    let v = if sign * d > 2.0 * err {
+        Verdict::Holds
+    } else if sign * d < -2.0 * err {
+        Verdict::DoesNotHold
+    } else {
+        Verdict::Inconclusive
+    };
+    (v, text)
+}
+
+const FIELDS: [(&str, &str); 3] = [
+    ("vorticity", "length_vorticity"),
+    ("velocity", "length_velocity"),
+    ("Q", "length_q"),
+];
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let (zeta, gamma) = turbulence(p)?;
+    p.reporter.stage("lengths: tables and plots");
+    let active: Vec<&str> = ZETAS
+        .iter()
+        .copied()
+        .filter(|z| z.parse::<f64>().unwrap_or(0.0) >= ACTIVE)
+        .collect();
+
+    // The correlation curves, averaged over seeds, per ζ.
+    let recs = zeta.records(None)?;
+    let mut corr_csv =
+        String::from("zeta,r,c_velocity,c_velocity_std,c_vorticity,c_vorticity_std,c_q,c_q_std\n");
+    let mut plots = [
+        Plot::new("Fig. 3a: vorticity autocorrelation", "r (nodes)", "C_ω(r)"),
+        Plot::new("Velocity autocorrelation", "r (nodes)", "C_v(r)"),
+        Plot::new("Q autocorrelation", "r (nodes)", "C_Q(r)"),
+    ];
+    for pl in &mut plots {
+        pl.hlines.push((0.0, String::new()));
+    }
+    for z in &active {
+        let runs: Vec<&Rec> = recs.iter().filter(|r| r.values[0] == *z).collect();
+        let tables: Vec<Table> = runs
+            .iter()
+            .map(|r| Table::read(&r.run.join("analysis/correlations.csv")))
+            .collect::<Result<_, _>>()?;
+        let Some(first) = tables.first() else {
+            continue;
+        };
+        let r = first.f64s("r")?;
+        let cols = ["c_velocity", "c_vorticity", "c_q"];
+        let data: Vec<Vec<Vec<f64>>> = tables
+            .iter()
+            .map(|t| {
+                cols.iter()
+                    .map(|c| t.f64s(c))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .collect::<Result<_, _>>()?;
+        let mut stats = vec![Vec::new(); 3];
+        for k in 0..r.len() {
+            corr_csv += &format!("{z},{}", r[k]);
+            for c in 0..3 {
+                let s = mean_std(
+                    &data
+                        .iter()
+                        .map(|d| d[c].get(k).copied().unwrap_or(f64::NAN))
+                        .collect::<Vec<_>>(),
+                );
+                corr_csv += &format!(",{:e},{:e}", s.0, s.1);
+                stats[c].push(s);
+            }
+            corr_csv += "\n";
+        }
+        // Out to r = 50 (a quarter of the box): the minimum sits well inside.
+        let n = r.len().min(51);
+        for (pl, c) in plots.iter_mut().zip([1, 0, 2]) {
+            let m: Vec<f64> = stats[c][..n].iter().map(|s| s.0).collect();
+            let e: Vec<f64> = stats[c][..n]
+                .iter()
+                .enumerate()
+                .map(|(k, s)| if k % 5 == 0 { s.1 } else { 0.0 })
+                .collect();
+            pl.series
+                .push(Series::new(format!("ζ = {z}")).with_points(&r[..n], &m, &e));
+        }
+    }
+    write_text(&dir.join("correlations.csv"), &corr_csv)?;
+    drawn(plots[0].save_png(&dir.join("fig3a_c_vorticity.png")))?;
+    drawn(plots[1].save_png(&dir.join("c_velocity.png")))?;
+    drawn(plots[2].save_png(&dir.join("c_q.png")))?;
+
+    // The lengths against ζ and γ.
+    let box_side = analysis::smooth::paper_box_side(8.0) as f64;
+    let mut claims = Vec::new();
+    let mut csv_z = String::from("zeta,field,length,length_std,seeds\n");
+    let mut csv_g = String::from("gamma,field,length,length_std,seeds\n");
+    let mut pz = Plot::new(
+        "Fig. 3b: correlation lengths against ζ (γ = 0.01)",
+        "activity ζ",
+        "first minimum of C(r) (nodes)",
+    );
+    let mut pg = Plot::new(
+        format!("Fig. 3c: correlation lengths against γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
+        "interface stiffness γ",
+        "first minimum of C(r) (nodes)",
+    );
+    pz.hlines
+        .push((box_side, format!("smoothing box side {box_side}")));
+    pg.hlines
+        .push((box_side, format!("smoothing box side {box_side}")));
+    for (name, col) in FIELDS {
+        let lz = by_value(&zeta, &active, col)?;
+        let lg = by_value(&gamma, &GAMMAS, col)?;
+        for (x, (m, s), n) in &lz {
+            csv_z += &format!("{x},{name},{m},{s},{n}\n");
+        }
+        for (x, (m, s), n) in &lg {
+            csv_g += &format!("{x},{name},{m},{s},{n}\n");
+        }
+        let series = |pts: &[AtValue]| {
+            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            let m: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
+            let e: Vec<f64> = pts.iter().map(|p| p.1 .1).collect();
+            Series::new(format!("{name} length")).with_points(&x, &m, &e)
+        };
+        pz.series.push(series(&lz));
+        pg.series.push(series(&lg));
+        let (vz, tz) = trend(&lz, -1.0);
+        let (vg, tg) = trend(&lg, 1.0);
+        let floor = |pts: &[AtValue]| {
+            pts.iter()
+                .map(|p| p.1 .0)
+                .filter(|v| v.is_finite())
+                .fold(f64::INFINITY, f64::min)
+                / box_side
+        };
+        let reason = |v: Verdict, what: &str| {
+            match v {
+            Verdict::Holds => format!("it {what} by more than two standard errors"),
+            Verdict::DoesNotHold => "it moves against the claim by more than two standard errors".to_string(),
+            Verdict::Inconclusive => format!("the change is within two standard errors: it neither clearly {what} nor the opposite"),
+        }
+        };
+        claims.push(Claim::new(
+            format!("9.4: the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})"),
+            format!(
+                "{tz}; the shortest is {}× the smoothing box ({box_side})",
+                g(floor(&lz))
+            ),
+            vz,
+            reason(vz, "shrinks"),
+        ));
+        claims.push(Claim::new(
+            format!("9.4: the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
+            format!(
+                "{tg}; the shortest is {}× the smoothing box ({box_side})",
+                g(floor(&lg))
+            ),
+            vg,
+            reason(vg, "grows"),
+        ));
+    }
+    write_text(&dir.join("lengths_vs_zeta.csv"), &csv_z)?;
+    write_text(&dir.join("lengths_vs_gamma.csv"), &csv_g)?;
+    drawn(pz.save_png(&dir.join("fig3b_lengths_vs_zeta.png")))?;
+    drawn(pg.save_png(&dir.join("fig3c_lengths_vs_gamma.png")))?;
+    let (t, from) = times(p.scale);
+    let settings = format!(
+        "- Paper scene on L = 200 (240 cells, as the paper's Fig. 2a), paper pressure. ζ sweep at γ = 0.01: ζ ∈ {{{}}} (lengths for ζ ≥ {ACTIVE}); γ sweep at ζ = {ZETA_OF_GAMMA_SWEEP}: γ ∈ {{{}}}; seeds {}.\n\
+         - 200 TU of relaxation, then {t} TU; integrator {}; a frame every 10 TU, analysed from t = {from} (the second half of the active phase).\n\
+         - `monolayer analyze` on every run: v, ω and Q smoothed with a periodic {box_side}×{box_side} box (3R), their autocorrelations averaged over the frames; a length is the first minimum of the radially averaged correlation.\n\
+         - Files: `correlations.csv`, `lengths_vs_zeta.csv`, `lengths_vs_gamma.csv`, `fig3a_c_vorticity.png`, `c_velocity.png`, `c_q.png`, `fig3b_lengths_vs_zeta.png`, `fig3c_lengths_vs_gamma.png`; the runs in `../sweeps/turbulence-*`.",
+        ZETAS.join(", "),
+        GAMMAS.join(", "),
+        p.scale.seeds(),
+        p.scale.integrator().join(" ").replace("integrator.", "")
+    );
+    Ok((claims, settings))
+}

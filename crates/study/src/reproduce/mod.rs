@@ -1,0 +1,514 @@
+//! `monolayer reproduce FIGURE`: the paper's figures from the paper's scene, each with its
+//! data (CSV), its pictures (PNG, drawn by the `render` crate) and a verdict on every claim
+//! of MODEL.md §9 that it tests (`verdict.md`).
+//!
+//! Every figure is one or more sweeps ([`crate::run_points`]) in `OUT/sweeps/NAME/`, so an
+//! interrupted `reproduce` resumes where it stopped and figures that share a sweep run it
+//! once; the figure's own files go to `OUT/FIGURE/`. Two scales:
+//! - [`Scale::Quick`]: 3 seeds, short runs, the default integrator (dt 0.5, margin 16, f32):
+//!   each figure in minutes on 2 cores;
+//! - [`Scale::Paper`]: 5 seeds, the paper's integrator (dt 0.2, margin 12), longer runs.
+//!
+//! The settings of each figure are written at the top of its `verdict.md`.
+
+mod contractile;
+mod defect_fields;
+mod defects;
+mod lengths;
+mod scaling;
+mod table;
+mod threshold;
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::sync::Arc;
+use std::time::Instant;
+
+use crate::analyze::AnalyzeOptions;
+use crate::{
+    analyze_points, run_points, write_summary, Seeds, SweepError, SweepParams, SweepSpec, Vary,
+};
+
+pub use table::Table;
+
+/// The paper's scene (MODEL.md §8): 60 cells of radius 8 in a periodic 100² box (15 cells per
+/// 50²), γ = 0.01, relaxed at ζ = 0 for 200 TU. Figures change the box, the activity and the
+/// run length with overrides.
+pub const PAPER_SCENE: &str = "\
+[domain]
+lx = 100
+ly = 100
+
+[cells]
+count = 60
+radius = 8.0
+init = \"random\"
+
+[model]
+gamma = 0.01
+mu = 3.0
+lambda = 2.5
+kappa = 0.1
+xi = 2.0
+zeta = 0.0
+pressure = \"paper\"
+
+[run]
+relax_time = 200.0
+time = 400.0
+seed = 1
+output_every = 400.0
+series_every = 1.0
+";
+
+/// How big a reproduction is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    /// Minutes per figure on 2 cores: 3 seeds, short runs, the default integrator.
+    Quick,
+    /// The paper's sizes: 5 seeds, longer runs, the paper's integrator (dt 0.2, margin 12).
+    Paper,
+}
+
+impl Scale {
+    /// The seeds of every point.
+    pub fn seeds(self) -> Seeds {
+        match self {
+            Self::Quick => Seeds { first: 1, last: 3 },
+            Self::Paper => Seeds { first: 1, last: 5 },
+        }
+    }
+
+    /// The integrator overrides.
+    pub fn integrator(self) -> Vec<String> {
+        match self {
+            Self::Quick => vec!["integrator.dt=0.5".into(), "integrator.margin=16".into()],
+            Self::Paper => vec!["integrator.dt=0.2".into(), "integrator.margin=12".into()],
+        }
+    }
+
+    /// Its name, as given to `--scale`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Quick => "quick",
+            Self::Paper => "paper",
+        }
+    }
+}
+
+impl FromStr for Scale {
+    type Err = SweepError;
+
+    fn from_str(s: &str) -> Result<Self, SweepError> {
+        match s {
+            "quick" => Ok(Self::Quick),
+            "paper" => Ok(Self::Paper),
+            _ => Err(SweepError::Reproduce {
+                why: format!("--scale {s}: write quick or paper"),
+            }),
+        }
+    }
+}
+
+/// A figure of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Figure {
+    /// Fig. 2a and 2b: v_rms and S_rms against ζ; ζ_cr against γ and L, both pressure forms.
+    Threshold,
+    /// Fig. 3 and the supplementary length figures: correlations and lengths against ζ and γ.
+    Lengths,
+    /// The supplementary defect figure: density and creation rate against ζ, charge in time.
+    Defects,
+    /// Fig. 4: flow and stress averaged around ±½ defects.
+    DefectFields,
+    /// Supplementary: contractile activity stays at rest.
+    Contractile,
+    /// Cost of subdomains against the full domain.
+    Scaling,
+}
+
+impl Figure {
+    /// Every figure, in the order `all` makes them.
+    pub const ALL: [Figure; 6] = [
+        Self::Threshold,
+        Self::Lengths,
+        Self::Defects,
+        Self::DefectFields,
+        Self::Contractile,
+        Self::Scaling,
+    ];
+
+    /// Its name, as given on the command line and as its directory.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Threshold => "threshold",
+            Self::Lengths => "lengths",
+            Self::Defects => "defects",
+            Self::DefectFields => "defect-fields",
+            Self::Contractile => "contractile",
+            Self::Scaling => "scaling",
+        }
+    }
+
+    /// What the figure shows.
+    pub fn title(self) -> &'static str {
+        match self {
+            Self::Threshold => "The activity threshold (Fig. 2a, 2b)",
+            Self::Lengths => "Correlation lengths in active turbulence (Fig. 3, supplement)",
+            Self::Defects => "Defect density and creation (supplement)",
+            Self::DefectFields => "Flow and stress around ±1/2 defects (Fig. 4)",
+            Self::Contractile => "Contractile activity stays at rest (supplement)",
+            Self::Scaling => "Cost of subdomains against the full domain (supplement)",
+        }
+    }
+}
+
+impl FromStr for Figure {
+    type Err = SweepError;
+
+    fn from_str(s: &str) -> Result<Self, SweepError> {
+        Self::ALL
+            .into_iter()
+            .find(|f| f.name() == s)
+            .ok_or_else(|| SweepError::Reproduce {
+                why: format!(
+                    "no figure {s}: write one of {}, or all",
+                    Self::ALL.map(Figure::name).join(", ")
+                ),
+            })
+    }
+}
+
+/// A judgement on a claim.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The measurement agrees with the claim.
+    Holds,
+    /// The measurement contradicts the claim.
+    DoesNotHold,
+    /// The measurement cannot decide, with the reason given.
+    Inconclusive,
+}
+
+impl fmt::Display for Verdict {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Holds => "holds",
+            Self::DoesNotHold => "does not hold",
+            Self::Inconclusive => "inconclusive",
+        })
+    }
+}
+
+/// One claim of MODEL.md §9, what was measured and the verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Claim {
+    /// The claim, with its number in MODEL.md §9.
+    pub claim: String,
+    /// The measured value, with its seed spread.
+    pub measured: String,
+    /// The verdict.
+    pub verdict: Verdict,
+    /// Why.
+    pub reason: String,
+}
+
+impl Claim {
+    fn new(
+        claim: impl Into<String>,
+        measured: impl Into<String>,
+        verdict: Verdict,
+        reason: impl Into<String>,
+    ) -> Self {
+        Self {
+            claim: claim.into(),
+            measured: measured.into(),
+            verdict,
+            reason: reason.into(),
+        }
+    }
+}
+
+/// What a figure produced.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct FigureReport {
+    /// The figure.
+    pub figure: Figure,
+    /// Its directory.
+    pub dir: PathBuf,
+    /// The claims it tests.
+    pub claims: Vec<Claim>,
+    /// Wall time of this call, seconds (a resumed figure counts only what it redid).
+    pub wall_s: f64,
+}
+
+/// Told what a reproduction is doing. Nothing below the binary prints; the CLI shows this.
+pub trait Reporter: Send + Sync {
+    /// A sweep `name` starts, with `runs` runs and `steps` steps left to take.
+    fn sweep(&self, name: &str, runs: usize, steps: u64);
+    /// `n` more steps were taken.
+    fn steps(&self, n: u64);
+    /// A stage without steps (analysis, drawing) starts.
+    fn stage(&self, what: &str);
+}
+
+/// The settings of a reproduction.
+#[derive(Clone)]
+#[non_exhaustive]
+pub struct ReproduceParams {
+    /// The output directory: sweeps in `OUT/sweeps/`, figures in `OUT/FIGURE/`.
+    pub out: PathBuf,
+    /// The scale.
+    pub scale: Scale,
+    /// How runs share the machine.
+    pub sweep: SweepParams,
+    /// Told of progress.
+    pub reporter: Arc<dyn Reporter>,
+}
+
+impl ReproduceParams {
+    /// A reproduction into `out` at `scale`.
+    pub fn new(
+        out: PathBuf,
+        scale: Scale,
+        sweep: SweepParams,
+        reporter: Arc<dyn Reporter>,
+    ) -> Self {
+        Self {
+            out,
+            scale,
+            sweep,
+            reporter,
+        }
+    }
+
+    fn figure_dir(&self, figure: Figure) -> Result<PathBuf, SweepError> {
+        let d = self.out.join(figure.name());
+        std::fs::create_dir_all(&d).map_err(|e| SweepError::write(figure.name(), &d, e))?;
+        Ok(d)
+    }
+}
+
+/// One sweep of a figure.
+pub(crate) struct SweepJob {
+    /// Its directory name under `OUT/sweeps/`.
+    pub name: String,
+    /// Overrides of [`PAPER_SCENE`].
+    pub sets: Vec<String>,
+    /// Axes, `key=V1,V2`.
+    pub varies: Vec<String>,
+    /// Analyse every run, with these options.
+    pub analyze: Option<AnalyzeOptions>,
+}
+
+/// A finished sweep: its directory and summary.
+pub(crate) struct SweepResult {
+    pub dir: PathBuf,
+    pub summary: Table,
+    pub points: Vec<crate::Point>,
+}
+
+/// Runs (or resumes) a sweep of the figure and reads its summary.
+pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, SweepError> {
+    let dir = p.out.join("sweeps").join(&job.name);
+    let spec = SweepSpec {
+        scene_text: PAPER_SCENE.to_string(),
+        sets: job.sets,
+        varies: job
+            .varies
+            .iter()
+            .map(|v| v.parse::<Vary>())
+            .collect::<Result<_, _>>()?,
+        seeds: Some(p.scale.seeds()),
+    };
+    let points = spec.plan()?;
+    std::fs::create_dir_all(&dir).map_err(|e| SweepError::write(&job.name, &dir, e))?;
+    spec.save(&dir)?;
+    let (todo, steps) = crate::pending(&dir, &points);
+    p.reporter.sweep(&job.name, todo.len(), steps);
+    let rep = p.reporter.clone();
+    run_points(&points, &dir, p.sweep, Arc::new(move |n| rep.steps(n)))?;
+    if let Some(opts) = &job.analyze {
+        p.reporter.stage(&format!("analysing {}", job.name));
+        analyze_points(&points, &dir, opts, p.sweep)?;
+    }
+    let path = write_summary(&dir, &spec.keys(), &points, job.analyze.is_some())?;
+    let summary = Table::read(&path)?;
+    Ok(SweepResult {
+        dir,
+        summary,
+        points,
+    })
+}
+
+/// Makes `figure` (see the module docs).
+///
+/// # Errors
+/// A run that fails, a file that cannot be written, or a picture that cannot be drawn.
+pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, SweepError> {
+    let start = Instant::now();
+    let dir = p.figure_dir(figure)?;
+    let (claims, settings) = match figure {
+        Figure::Threshold => threshold::make(p, &dir)?,
+        Figure::Lengths => lengths::make(p, &dir)?,
+        Figure::Defects => defects::make(p, &dir)?,
+        Figure::DefectFields => defect_fields::make(p, &dir)?,
+        Figure::Contractile => contractile::make(p, &dir)?,
+        Figure::Scaling => scaling::make(p, &dir)?,
+    };
+    let wall_s = start.elapsed().as_secs_f64();
+    write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;
+    Ok(FigureReport {
+        figure,
+        dir,
+        claims,
+        wall_s,
+    })
+}
+
+fn write_verdict(
+    dir: &Path,
+    figure: Figure,
+    scale: Scale,
+    settings: &str,
+    claims: &[Claim],
+    wall_s: f64,
+) -> Result<(), SweepError> {
+    let mut s = format!(
+        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (MODEL.md §9) | measured (mean ± std over seeds) | verdict | reason |\n|---|---|---|---|\n",
+        figure.title(),
+        scale.name(),
+        figure.name(),
+        scale.name(),
+        wall_s,
+        settings.trim()
+    );
+    for c in claims {
+        s += &format!(
+            "| {} | {} | **{}** | {} |\n",
+            c.claim.replace('|', "\\|"),
+            c.measured.replace('|', "\\|"),
+            c.verdict,
+            c.reason.replace('|', "\\|")
+        );
+    }
+    write_text(&dir.join("verdict.md"), &s)
+}
+
+/// Writes a text file whole (under a temporary name first).
+pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), SweepError> {
+    let tmp = path.with_extension("partial");
+    let io = |e| SweepError::write("the figure", path, e);
+    std::fs::write(&tmp, text).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// A picture that cannot be drawn.
+pub(crate) fn drawn(r: Result<(), render::RenderError>) -> Result<(), SweepError> {
+    r.map_err(|e| SweepError::Reproduce { why: e.to_string() })
+}
+
+/// A mean and its spread (sample standard deviation) over seeds.
+pub(crate) type Stat = (f64, f64);
+
+/// A value on an axis, the statistics of a quantity there, and the number of runs.
+pub(crate) type AtValue = (f64, Stat, usize);
+
+/// Mean and sample standard deviation (0 for one value); NaN values are left out.
+pub(crate) fn mean_std(v: &[f64]) -> (f64, f64) {
+    let v: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    if v.len() < 2 {
+        return (m, 0.0);
+    }
+    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+    (m, var.sqrt())
+}
+
+/// A short number for tables and verdicts: 3 significant digits.
+pub(crate) fn g(v: f64) -> String {
+    if !v.is_finite() {
+        return "–".into();
+    }
+    if v == 0.0 {
+        return "0".into();
+    }
+    let a = v.abs();
+    if (1e-3..1e4).contains(&a) {
+        let digits = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// `mean ± std`.
+pub(crate) fn pm((m, s): (f64, f64)) -> String {
+    format!("{} ± {}", g(m), g(s))
+}
+
+/// One run of a sweep: its values on the axes, its seed, its directory and its summary over
+/// the window given.
+pub(crate) struct Rec {
+    pub values: Vec<String>,
+    pub seed: u64,
+    pub run: PathBuf,
+    pub summary: crate::summary::RunSummary,
+}
+
+impl SweepResult {
+    /// Every run, summarised over the second half of the first `time` TU of its active phase
+    /// (the whole active phase when `time` is `None`). A run is deterministic, so its first
+    /// `time` TU are the run of that length.
+    pub(crate) fn records(&self, time: Option<f64>) -> Result<Vec<Rec>, SweepError> {
+        self.points
+            .iter()
+            .map(|pt| {
+                let r = &pt.scene.file().run;
+                let run = crate::run_dir(&self.dir, pt);
+                let summary = crate::summary::summarise(
+                    &run,
+                    crate::summary::window(r.relax_time, time.unwrap_or(r.time).min(r.time)),
+                )?;
+                Ok(Rec {
+                    values: pt.values.clone(),
+                    seed: pt.seed,
+                    run,
+                    summary,
+                })
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_numbers_read_back() {
+        for f in Figure::ALL {
+            assert_eq!(f.name().parse::<Figure>().unwrap(), f);
+        }
+        let e = "fig9".parse::<Figure>().unwrap_err().to_string();
+        assert!(e.contains("threshold") && e.contains("all"), "{e}");
+        assert_eq!("paper".parse::<Scale>().unwrap(), Scale::Paper);
+        let (m, s) = mean_std(&[1.0, 2.0, 3.0, f64::NAN]);
+        assert_eq!((m, s), (2.0, 1.0));
+        assert_eq!(g(0.001234), "0.00123");
+        assert_eq!(g(12.345), "12.3");
+        assert_eq!(g(2.5e-5), "2.50e-5");
+    }
+
+    /// The paper scene is valid as it stands.
+    #[test]
+    fn the_paper_scene_validates() {
+        scene::Scene::parse(PAPER_SCENE, &[]).unwrap();
+    }
+}

@@ -1,0 +1,671 @@
+//! `reproduce threshold`: Fig. 2a (v_rms and S_rms − S_rms(0) against ζ) and Fig. 2b (ζ_cr
+//! against γ for two box sizes), for both pressure forms, with the protocol of
+//! [`crate::threshold`], its dependence on the run length, and (quick scale) the paper's
+//! integrator on one box.
+
+use std::path::Path;
+
+use render::{Plot, Series};
+
+use super::{
+    drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict,
+};
+use crate::threshold::{growth_threshold, threshold, RatePoint, Threshold};
+use crate::SweepError;
+
+const ZETAS: &str = "0,0.001,0.0015,0.002,0.0025,0.003,0.004,0.006,0.008";
+const GAMMAS: [f64; 3] = [0.006, 0.01, 0.014];
+const BOXES: [(usize, usize); 2] = [(100, 60), (200, 240)];
+const PRESSURES: [&str; 2] = ["paper", "interaction"];
+
+/// The active time of each run.
+fn run_time(scale: Scale) -> f64 {
+    match scale {
+        Scale::Quick => 400.0,
+        Scale::Paper => 800.0,
+    }
+}
+
+/// One group of runs (a box, a pressure form, a γ, an integrator): its threshold and the
+/// seed statistics at each ζ.
+struct Group {
+    lx: usize,
+    pressure: String,
+    gamma: f64,
+    integrator: String,
+    zetas: Vec<f64>,
+    v_rms: Vec<(f64, f64)>,
+    s_excess: Vec<(f64, f64)>,
+    rate_excess: Vec<(f64, f64)>,
+    /// The late growth rate (mean, std over seeds).
+    rate: Vec<(f64, f64)>,
+    /// The growth estimate (primary).
+    threshold: Threshold,
+    /// The excess estimate (a lower bound).
+    excess: Threshold,
+    seeds: usize,
+    /// The growth rate at ζ = 0 (mean, std over seeds).
+    rate0: (f64, f64),
+}
+
+/// Groups the records of a sweep whose axes are `[pressure, gamma, zeta]` (gamma given
+/// separately when it is not an axis).
+fn groups(recs: &[Rec], lx: usize, integrator: &str, gamma_axis: bool) -> Vec<Group> {
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for r in recs {
+        let k = (
+            r.values[0].clone(),
+            if gamma_axis {
+                r.values[1].clone()
+            } else {
+                "0.01".into()
+            },
+        );
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let zi = if gamma_axis { 2 } else { 1 };
+    keys.into_iter()
+        .map(|(pressure, gamma)| {
+            let mine: Vec<&Rec> = recs
+                .iter()
+                .filter(|r| r.values[0] == pressure && (!gamma_axis || r.values[1] == gamma))
+                .collect();
+            let zeta_of = |r: &Rec| r.values[zi].parse::<f64>().unwrap_or(f64::NAN);
+            let base: Vec<&Rec> = mine.iter().copied().filter(|r| zeta_of(r) == 0.0).collect();
+            let base_of = |seed: u64| base.iter().find(|b| b.seed == seed);
+            let mut zetas: Vec<f64> = mine.iter().map(|r| zeta_of(r)).collect();
+            zetas.sort_by(f64::total_cmp);
+            zetas.dedup();
+            let (mut v_rms, mut s_excess, mut rate_excess, mut rate, mut points) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for &z in &zetas {
+                let at: Vec<&Rec> = mine.iter().copied().filter(|r| zeta_of(r) == z).collect();
+                v_rms.push(mean_std(
+                    &at.iter().map(|r| r.summary.v_rms).collect::<Vec<_>>(),
+                ));
+                let paired = |f: fn(&Rec) -> f64| -> Vec<f64> {
+                    at.iter()
+                        .filter_map(|r| base_of(r.seed).map(|b| f(r) - f(b)))
+                        .collect()
+                };
+                s_excess.push(mean_std(&paired(|r| r.summary.s_rms)));
+                rate_excess.push(mean_std(&paired(|r| r.summary.growth_rate)));
+                rate.push(mean_std(
+                    &at.iter().map(|r| r.summary.growth_rate).collect::<Vec<_>>(),
+                ));
+                if z != 0.0 {
+                    points.push(RatePoint {
+                        zeta: z,
+                        rates: at.iter().map(|r| r.summary.growth_rate).collect(),
+                    });
+                }
+            }
+            let baseline: Vec<f64> = base.iter().map(|b| b.summary.growth_rate).collect();
+            let excess = if baseline.is_empty() {
+                Threshold::Above { lo: f64::NAN }
+            } else {
+                threshold(&baseline, &points)
+            };
+            let threshold = growth_threshold(&points);
+            Group {
+                lx,
+                pressure,
+                gamma: gamma.parse().unwrap_or(f64::NAN),
+                integrator: integrator.into(),
+                zetas,
+                v_rms,
+                s_excess,
+                rate_excess,
+                rate,
+                threshold,
+                excess,
+                seeds: baseline.len(),
+                rate0: mean_std(&baseline),
+            }
+        })
+        .collect()
+}
+
+/// `(ζ_cr, lo, hi)`; NaN on an open side.
+fn bracket(t: Threshold) -> (f64, f64, f64) {
+    match t {
+        Threshold::Bracketed { zeta_cr, lo, hi } => (zeta_cr, lo, hi),
+        Threshold::Below { hi } => (f64::NAN, f64::NAN, hi),
+        Threshold::Above { lo } => (f64::NAN, lo, f64::NAN),
+    }
+}
+
+fn num(v: f64) -> String {
+    if v.is_finite() {
+        v.to_string()
+    } else {
+        String::new()
+    }
+}
+
+/// A least-squares line `y = a + b x`: `(a, b, largest |residual|)`.
+fn line(x: &[f64], y: &[f64]) -> (f64, f64, f64) {
+    let b = crate::summary::slope(x, y);
+    let n = x.len() as f64;
+    let a = (y.iter().sum::<f64>() - b * x.iter().sum::<f64>()) / n;
+    let res = x
+        .iter()
+        .zip(y)
+        .map(|(x, y)| (y - a - b * x).abs())
+        .fold(0.0, f64::max);
+    (a, b, res)
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let t = run_time(p.scale);
+    let integ = p.scale.integrator();
+    let integ_name = integ.join(" ").replace("integrator.", "");
+    let mut all: Vec<Group> = Vec::new();
+    let mut long_recs: Vec<(usize, Vec<Rec>, super::SweepResult)> = Vec::new();
+    for (lx, count) in BOXES {
+        let mut sets = vec![
+            format!("domain.lx={lx}"),
+            format!("domain.ly={lx}"),
+            format!("cells.count={count}"),
+            format!("run.time={t}"),
+            format!("run.output_every={t}"),
+        ];
+        sets.extend(integ.iter().cloned());
+        let res = super::sweep(
+            p,
+            SweepJob {
+                name: format!("threshold-L{lx}-{}", p.scale.name()),
+                sets,
+                varies: vec![
+                    format!("model.pressure={}", PRESSURES.join(",")),
+                    format!("model.gamma={}", GAMMAS.map(|g| g.to_string()).join(",")),
+                    format!("model.zeta={ZETAS}"),
+                ],
+                analyze: None,
+            },
+        )?;
+        let recs = res.records(None)?;
+        all.extend(groups(&recs, lx, &integ_name, true));
+        long_recs.push((lx, recs, res));
+    }
+    // The paper's integrator on the small box, to show the verdicts do not depend on it.
+    let mut compare: Vec<Group> = Vec::new();
+    if p.scale == Scale::Quick {
+        let mut sets = vec![format!("run.time={t}"), format!("run.output_every={t}")];
+        sets.extend(Scale::Paper.integrator());
+        let res = super::sweep(
+            p,
+            SweepJob {
+                name: "threshold-L100-paper-integrator".into(),
+                sets,
+                varies: vec![
+                    format!("model.pressure={}", PRESSURES.join(",")),
+                    format!("model.zeta={ZETAS}"),
+                ],
+                analyze: None,
+            },
+        )?;
+        let name = Scale::Paper
+            .integrator()
+            .join(" ")
+            .replace("integrator.", "");
+        compare = groups(&res.records(None)?, 100, &name, false);
+    }
+    p.reporter.stage("threshold: tables and plots");
+
+    // threshold.csv
+    let mut csv = String::from(
+        "gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities,run_time,integrator\n",
+    );
+    for gr in all.iter().chain(&compare) {
+        let (z, lo, hi) = bracket(gr.threshold);
+        let (ze, loe, hie) = bracket(gr.excess);
+        csv += &format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{t},{}\n",
+            gr.gamma,
+            gr.lx,
+            gr.pressure,
+            num(z),
+            num(lo),
+            num(hi),
+            num(ze),
+            num(loe),
+            num(hie),
+            gr.seeds,
+            gr.zetas.len() - 1,
+            gr.integrator
+        );
+    }
+    write_text(&dir.join("threshold.csv"), &csv)?;
+
+    // fig2a.csv: the seed statistics of every group.
+    let mut a = String::from("gamma,lx,pressure,integrator,zeta,v_rms,v_rms_std,s_rms_excess,s_rms_excess_std,growth_rate,growth_rate_std,growth_rate_excess,growth_rate_excess_std\n");
+    for gr in all.iter().chain(&compare) {
+        for (k, z) in gr.zetas.iter().enumerate() {
+            a += &format!(
+                "{},{},{},{},{z},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}\n",
+                gr.gamma,
+                gr.lx,
+                gr.pressure,
+                gr.integrator,
+                gr.v_rms[k].0,
+                gr.v_rms[k].1,
+                gr.s_excess[k].0,
+                gr.s_excess[k].1,
+                gr.rate[k].0,
+                gr.rate[k].1,
+                gr.rate_excess[k].0,
+                gr.rate_excess[k].1
+            );
+        }
+    }
+    write_text(&dir.join("fig2a.csv"), &a)?;
+
+    // How the estimate moves with the run length: the same runs, cut at T/4 and T/2.
+    let mut by_length = String::from(
+        "run_time,gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi\n",
+    );
+    let mut length_series: Vec<Series> = Vec::new();
+    for (lx, _, res) in &long_recs {
+        for frac in [0.25, 0.5, 1.0] {
+            let tt = t * frac;
+            let recs = res.records(Some(tt))?;
+            for gr in groups(&recs, *lx, &integ_name, true) {
+                let (z, lo, hi) = bracket(gr.threshold);
+                let (ze, loe, hie) = bracket(gr.excess);
+                by_length += &format!(
+                    "{tt},{},{lx},{},{},{},{},{},{},{}\n",
+                    gr.gamma,
+                    gr.pressure,
+                    num(z),
+                    num(lo),
+                    num(hi),
+                    num(ze),
+                    num(loe),
+                    num(hie)
+                );
+                if gr.gamma == 0.01 {
+                    let label = format!("L = {lx}, {} pressure", gr.pressure);
+                    let (mid, half) = mid_half(z, lo, hi);
+                    match length_series.iter_mut().find(|s| s.label == label) {
+                        Some(s) => s.points.push((tt, mid, half)),
+                        None => {
+                            let mut sr = Series::new(label);
+                            sr.points.push((tt, mid, half));
+                            length_series.push(sr);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    write_text(&dir.join("threshold_vs_run_length.csv"), &by_length)?;
+
+    // Pictures.
+    for pressure in PRESSURES {
+        let of = |lx: usize| {
+            all.iter()
+                .find(|gr| gr.lx == lx && gr.pressure == pressure && gr.gamma == 0.01)
+        };
+        let mut v = Plot::new(
+            format!("Fig. 2a: v_rms against ζ ({pressure} pressure, γ = 0.01)"),
+            "activity ζ",
+            "v_rms (mean ± std over seeds)",
+        );
+        v.log_y = true;
+        let mut s = Plot::new(
+            format!("Fig. 2a: extra order against ζ ({pressure} pressure, γ = 0.01)"),
+            "activity ζ",
+            "S_rms − S_rms(ζ = 0)",
+        );
+        s.hlines.push((0.0, String::new()));
+        let mut r = Plot::new(
+            format!("Late growth rate of ln v_rms ({pressure} pressure, γ = 0.01)"),
+            "activity ζ",
+            "d ln v_rms/dt (1/TU)",
+        );
+        r.hlines.push((0.0, "ζ_cr: where it turns positive".into()));
+        for (lx, _) in BOXES {
+            if let Some(gr) = of(lx) {
+                let label = format!("L = {lx}");
+                let pick = |st: &[(f64, f64)]| -> (Vec<f64>, Vec<f64>) {
+                    (
+                        st.iter().map(|x| x.0).collect(),
+                        st.iter().map(|x| x.1).collect(),
+                    )
+                };
+                let (m, e) = pick(&gr.v_rms);
+                v.series
+                    .push(Series::new(&label).with_points(&gr.zetas, &m, &e));
+                let (m, e) = pick(&gr.s_excess);
+                s.series
+                    .push(Series::new(&label).with_points(&gr.zetas, &m, &e));
+                let (m, e) = pick(&gr.rate);
+                r.series
+                    .push(Series::new(&label).with_points(&gr.zetas, &m, &e));
+            }
+        }
+        drawn(v.save_png(&dir.join(format!("fig2a_v_rms_{pressure}.png"))))?;
+        drawn(s.save_png(&dir.join(format!("fig2a_s_rms_{pressure}.png"))))?;
+        drawn(r.save_png(&dir.join(format!("growth_rate_{pressure}.png"))))?;
+    }
+    let mut b = Plot::new(
+        "Fig. 2b: threshold against γ",
+        "interface stiffness γ",
+        "ζ_cr (bar: the bracketing activities)",
+    );
+    for pressure in PRESSURES {
+        for (lx, _) in BOXES {
+            let mut pts = Vec::new();
+            for gr in all
+                .iter()
+                .filter(|gr| gr.lx == lx && gr.pressure == pressure)
+            {
+                let (z, lo, hi) = bracket(gr.threshold);
+                let (mid, half) = mid_half(z, lo, hi);
+                pts.push((gr.gamma, mid, half));
+            }
+            let mut sr = Series::new(format!("L = {lx}, {pressure} pressure"));
+            sr.points = pts;
+            b.series.push(sr);
+        }
+    }
+    drawn(b.save_png(&dir.join("fig2b_zeta_cr.png")))?;
+    let mut rl = Plot::new(
+        "ζ_cr against the run length (γ = 0.01)",
+        "active time of the runs (TU)",
+        "ζ_cr (bar: bracket)",
+    );
+    rl.series.extend(length_series);
+    drawn(rl.save_png(&dir.join("threshold_vs_run_length.png")))?;
+
+    let claims = verdicts(&all, &compare);
+    let settings = format!(
+        "- Paper scene (MODEL.md §8), γ ∈ {{{}}}, boxes L = 100 (60 cells) and L = 200 (240 cells), both pressure forms; ζ ∈ {{{ZETAS}}}; seeds {}.\n\
+         - Each run: 200 TU of relaxation at ζ = 0, then {t} TU at ζ; integrator {integ_name}, f32 storage.\n\
+         - Protocol (`crates/study/src/threshold.rs`): the late growth rate r = d ln v_rms/dt, a least-squares slope over the second half of the active phase, of runs from the same relaxed states (seeds) at every ζ. ζ_cr (the *growth* estimate) is where the seed mean ⟨r(ζ)⟩ turns positive — the activity makes the flow grow against the relaxation — interpolated linearly between the bracketing activities. `zeta_cr_excess` is where ⟨r(ζ)⟩ − ⟨r(0)⟩ turns positive: a noise-limited lower bound (it is 0 at ζ = 0 and rises smoothly).\n\
+         - `threshold_vs_run_length.csv`: the same protocol on the first T/4, T/2 and T of the same runs.{}\n\
+         - Files: `threshold.csv`, `fig2a.csv`, `threshold_vs_run_length.csv`, `fig2a_*.png`, `growth_rate_*.png`, `fig2b_zeta_cr.png`, `threshold_vs_run_length.png`; the runs in `../sweeps/threshold-*`.",
+        GAMMAS.map(|g| g.to_string()).join(", "),
+        p.scale.seeds(),
+        if compare.is_empty() {
+            String::new()
+        } else {
+            "\n- The paper's integrator (dt 0.2, margin 12) on L = 100, γ = 0.01, both forms, for comparison (rows with that integrator in `threshold.csv`).".to_string()
+        }
+    );
+    Ok((claims, settings))
+}
+
+/// The middle of a bracket and its half-width, for a bar; an open bracket draws nothing.
+fn mid_half(z: f64, lo: f64, hi: f64) -> (f64, f64) {
+    if z.is_finite() {
+        (z, 0.5 * (hi - lo))
+    } else {
+        (f64::NAN, f64::NAN)
+    }
+}
+
+fn describe(t: Threshold) -> String {
+    match t {
+        Threshold::Bracketed { zeta_cr, lo, hi } => format!("{} [{lo}, {hi}]", g(zeta_cr)),
+        Threshold::Below { hi } => format!("< {hi}"),
+        Threshold::Above { lo } => format!("> {lo}"),
+    }
+}
+
+fn verdicts(all: &[Group], compare: &[Group]) -> Vec<Claim> {
+    let mut claims = Vec::new();
+    for pressure in PRESSURES {
+        let mine: Vec<&Group> = all.iter().filter(|g| g.pressure == pressure).collect();
+        // 9.1: rest below, flow and order above.
+        let at = |gr: &Group, z: f64| gr.zetas.iter().position(|&x| x == z);
+        let mut measured = Vec::new();
+        let mut ok = true;
+        for gr in mine.iter().filter(|g| g.gamma == 0.01) {
+            let (Some(k0), Some(k1)) = (at(gr, 0.0), Some(gr.zetas.len() - 1)) else {
+                continue;
+            };
+            let ratio = gr.v_rms[k1].0 / gr.v_rms[k0].0;
+            let (se, ss) = gr.s_excess[k1];
+            let decays = gr.rate0.0 < 0.0;
+            ok &= ratio > 3.0 && se > 2.0 * ss && decays;
+            measured.push(format!(
+                "L = {}: v_rms(ζ = {}) / v_rms(0) = {}; S_rms − S_rms(0) = {}; at ζ = 0 v_rms = {} and d ln v_rms/dt = {} /TU",
+                gr.lx,
+                gr.zetas[k1],
+                g(ratio),
+                pm((se, ss)),
+                pm(gr.v_rms[k0]),
+                pm(gr.rate0)
+            ));
+        }
+        claims.push(Claim::new(
+            format!("9.1 ({pressure} pressure): below ζ_cr the tissue relaxes to rest; above it flow and extra nematic order persist"),
+            measured.join("; "),
+            if ok { Verdict::Holds } else { Verdict::DoesNotHold },
+            if ok {
+                "v_rms rises by more than 3× over the ζ = 0 level and S_rms by more than 2 seed spreads; at ζ = 0 the flow decays (negative growth rate), and below ζ_cr it decays too. The paper's criterion (v_rms > 1e-7) would call every run flowing: the passive packing still moves at v_rms(0)."
+            } else {
+                "at γ = 0.01 the largest ζ does not raise v_rms 3× and S_rms by 2 seed spreads over ζ = 0, or the passive flow does not decay"
+            },
+        ));
+        // 9.2: linear in γ, independent of L.
+        let mut lin = Vec::new();
+        let mut verdict = Verdict::Holds;
+        let mut reasons = Vec::new();
+        for (lx, _) in BOXES {
+            let gs: Vec<&&Group> = mine.iter().filter(|g| g.lx == lx).collect();
+            let pts: Vec<(f64, f64, f64, f64)> = gs
+                .iter()
+                .map(|gr| {
+                    let (z, lo, hi) = bracket(gr.threshold);
+                    (gr.gamma, z, lo, hi)
+                })
+                .collect();
+            if pts.iter().any(|p| !p.1.is_finite()) {
+                verdict = Verdict::Inconclusive;
+                reasons.push(format!(
+                    "L = {lx}: an open bracket ({})",
+                    gs.iter()
+                        .map(|g| describe(g.threshold))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+                continue;
+            }
+            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
+            let (a, b, res) = line(&x, &y);
+            let half = pts
+                .iter()
+                .map(|p| 0.5 * (p.3 - p.2))
+                .fold(f64::INFINITY, f64::min);
+            lin.push(format!(
+                "L = {lx}: ζ_cr = {} + {}·γ (largest residual {}; ζ_cr at γ = {}: {})",
+                g(a),
+                g(b),
+                g(res),
+                x.iter()
+                    .map(|v| v.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                gs.iter()
+                    .map(|g| describe(g.threshold))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+            let increasing = y.windows(2).all(|w| w[1] >= w[0]);
+            if !(b > 0.0 && increasing) {
+                verdict = Verdict::DoesNotHold;
+                reasons.push(format!("L = {lx}: ζ_cr does not rise with γ"));
+            } else if res > half {
+                if verdict == Verdict::Holds {
+                    verdict = Verdict::Inconclusive;
+                }
+                reasons.push(format!(
+                    "L = {lx}: a residual exceeds the half-bracket {}",
+                    g(half)
+                ));
+            } else {
+                reasons.push(format!(
+                    "L = {lx}: rises, residuals within the half-bracket; the line {} zero (intercept {})",
+                    if a.abs() > half { "does not pass through" } else { "passes near" },
+                    g(a)
+                ));
+            }
+        }
+        claims.push(Claim::new(
+            format!("9.2a ({pressure} pressure): ζ_cr grows linearly with γ"),
+            lin.join("; "),
+            verdict,
+            reasons.join("; "),
+        ));
+        // Independence of L: brackets overlap at every γ.
+        let mut same = Vec::new();
+        let mut shifts = Vec::new();
+        let mut verdict = Verdict::Holds;
+        for gamma in GAMMAS {
+            let b: Vec<(f64, f64, f64)> = BOXES
+                .iter()
+                .filter_map(|(lx, _)| {
+                    mine.iter()
+                        .find(|g| g.lx == *lx && g.gamma == gamma)
+                        .map(|g| bracket(g.threshold))
+                })
+                .collect();
+            if b.len() < 2 {
+                continue;
+            }
+            let lo = |x: &(f64, f64, f64)| {
+                if x.1.is_finite() {
+                    x.1
+                } else {
+                    f64::NEG_INFINITY
+                }
+            };
+            let hi = |x: &(f64, f64, f64)| if x.2.is_finite() { x.2 } else { f64::INFINITY };
+            // Touching brackets agree within the grid's resolution.
+            let overlap = lo(&b[0]) <= hi(&b[1]) && lo(&b[1]) <= hi(&b[0]);
+            if !overlap {
+                verdict = Verdict::DoesNotHold;
+            } else if !(b[0].0.is_finite() && b[1].0.is_finite()) && verdict == Verdict::Holds {
+                verdict = Verdict::Inconclusive;
+            }
+            if b[0].0.is_finite() && b[1].0.is_finite() {
+                shifts.push(b[1].0 - b[0].0);
+            }
+            same.push(format!(
+                "γ = {gamma}: L = 100 {} vs L = 200 {}",
+                describe_b(b[0]),
+                describe_b(b[1])
+            ));
+        }
+        if !shifts.is_empty() {
+            same.push(format!(
+                "mean shift ζ_cr(200) − ζ_cr(100) = {}",
+                pm(mean_std(&shifts))
+            ));
+        }
+        claims.push(Claim::new(
+            format!("9.2b ({pressure} pressure): ζ_cr does not depend on the domain size"),
+            same.join("; "),
+            verdict,
+            match verdict {
+                Verdict::Holds => "the brackets of L = 100 and L = 200 overlap (or touch: agree within the ζ grid) at every γ",
+                Verdict::DoesNotHold => "at some γ the brackets of the two boxes are disjoint",
+                Verdict::Inconclusive => "the brackets overlap, but some are open",
+            },
+        ));
+    }
+    // The pressure form.
+    let mut diffs = Vec::new();
+    let mut lower = 0;
+    let mut n = 0;
+    for (lx, _) in BOXES {
+        for gamma in GAMMAS {
+            let z = |p: &str| {
+                all.iter()
+                    .find(|g| g.lx == lx && g.gamma == gamma && g.pressure == p)
+                    .map_or(f64::NAN, |g| bracket(g.threshold).0)
+            };
+            let (zp, zi) = (z("paper"), z("interaction"));
+            if zp.is_finite() && zi.is_finite() {
+                n += 1;
+                if zi < zp {
+                    lower += 1;
+                }
+            }
+            diffs.push(format!(
+                "L = {lx}, γ = {gamma}: {} (paper) vs {} (interaction)",
+                g(zp),
+                g(zi)
+            ));
+        }
+    }
+    claims.push(Claim::new(
+        "Pressure form (issue 11): does the interaction pressure give a lower ζ_cr than the paper form?",
+        diffs.join("; "),
+        if n == 0 {
+            Verdict::Inconclusive
+        } else if lower == n {
+            Verdict::Holds
+        } else if lower == 0 {
+            Verdict::DoesNotHold
+        } else {
+            Verdict::Inconclusive
+        },
+        format!("lower in {lower} of {n} bracketed pairs"),
+    ));
+    if !compare.is_empty() {
+        let mut text = Vec::new();
+        let mut same = true;
+        for c in compare {
+            let d = all
+                .iter()
+                .find(|g| g.lx == c.lx && g.gamma == c.gamma && g.pressure == c.pressure);
+            if let Some(d) = d {
+                let (a, b) = (bracket(d.threshold), bracket(c.threshold));
+                let lo = |x: (f64, f64, f64)| {
+                    if x.1.is_finite() {
+                        x.1
+                    } else {
+                        f64::NEG_INFINITY
+                    }
+                };
+                let hi = |x: (f64, f64, f64)| if x.2.is_finite() { x.2 } else { f64::INFINITY };
+                same &= lo(a) <= hi(b) && lo(b) <= hi(a);
+                text.push(format!(
+                    "{} pressure: {} ({}) vs {} ({})",
+                    c.pressure,
+                    describe(d.threshold),
+                    d.integrator,
+                    describe(c.threshold),
+                    c.integrator
+                ));
+            }
+        }
+        claims.push(Claim::new(
+            "Integrator (issue 11): the verdicts do not change between the default integrator and the paper's dt 0.2 / margin 12 (L = 100, γ = 0.01)",
+            text.join("; "),
+            if same { Verdict::Holds } else { Verdict::DoesNotHold },
+            if same {
+                "the brackets overlap for both pressure forms"
+            } else {
+                "a bracket moves with the integrator"
+            },
+        ));
+    }
+    claims
+}
+
+fn describe_b(b: (f64, f64, f64)) -> String {
+    match (b.0.is_finite(), b.1.is_finite(), b.2.is_finite()) {
+        (true, _, _) => format!("{} [{}, {}]", g(b.0), b.1, b.2),
+        (false, false, true) => format!("< {}", b.2),
+        (false, true, false) => format!("> {}", b.1),
+        _ => "–".into(),
+    }
+}
