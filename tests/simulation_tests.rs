@@ -186,3 +186,40 @@ fn heun_is_second_order_and_euler_first_order_in_dt() {
         }
     }
 }
+
+/// The memory a simulation reports is its buffers: the tissue holds the patch fields
+/// (N × patch nodes of T) and the workspace three more copies (old state, two slopes) plus
+/// lattice-sized sums, so at f32 the workspace grows by at least 3 × 4 bytes per patch node
+/// and cell, and both grow linearly in N at fixed patch size.
+#[test]
+fn heap_bytes_count_the_patch_buffers() {
+    let bytes = |count: usize| {
+        let text = format!(
+            "[domain]\nlx = 96\nly = 96\n[cells]\ncount = {count}\nradius = 8.0\n[integrator]\nmargin = 12\n[run]\ntime = 1\n"
+        );
+        let s = scene::Scene::parse(&text, &[]).unwrap();
+        let sim = s.simulation::<f32>();
+        let patch = s.patch_shape().len();
+        (
+            sim.tissue().heap_bytes(),
+            sim.workspace().heap_bytes(),
+            patch,
+        )
+    };
+    let (t1, w1, patch) = bytes(10);
+    let (t2, w2, _) = bytes(20);
+    assert!(
+        t1 >= 10 * patch * 4 && t1 < 10 * patch * 4 * 2,
+        "{t1} for {patch}-node patches"
+    );
+    let per_cell = (t2 - t1) / 10;
+    assert!(
+        per_cell >= patch * 4 && per_cell < patch * 4 + 2048,
+        "{per_cell}"
+    );
+    let per_cell_ws = (w2 - w1) / 10;
+    assert!(
+        per_cell_ws >= 3 * patch * 4 && per_cell_ws < 3 * patch * 4 + 4096,
+        "{per_cell_ws}"
+    );
+}

@@ -36,6 +36,14 @@ pub struct LatticeSums<const K: usize> {
 }
 
 impl<const K: usize> LatticeSums<K> {
+    /// Bytes of heap memory held by the sums and the stripe index.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.data.capacity() * std::mem::size_of::<f64>()
+            + self.dirty.capacity()
+            + self.offsets.capacity() * std::mem::size_of::<usize>()
+            + self.members.capacity() * std::mem::size_of::<u32>()
+    }
+
     /// `K` fields on `lattice`, all zero.
     pub fn new(lattice: Lattice) -> Self {
         Self {

@@ -32,6 +32,14 @@ pub struct Tissue<T: Real = f64> {
 }
 
 impl<T: Real> Tissue<T> {
+    /// Bytes of heap memory held by the tissue: its fields, patch map, centres and ids.
+    /// With [`crate::Workspace::heap_bytes`], the memory a simulation needs.
+    pub fn heap_bytes(&self) -> usize {
+        self.cells.heap_bytes()
+            + self.centre.capacity() * std::mem::size_of::<[f64; 2]>()
+            + self.cell_id.capacity() * std::mem::size_of::<usize>()
+    }
+
     /// A tissue from initial fields at time 0; centres of mass are computed and patches
     /// centred on them.
     pub fn new(cells: Cells<T>, params: ModelParams) -> Self {

@@ -83,6 +83,17 @@ pub struct Workspace<T: Real = f64> {
 }
 
 impl<T: Real> Workspace<T> {
+    /// Bytes of heap memory held by the scratch buffers, lattice sums and tables.
+    pub fn heap_bytes(&self) -> usize {
+        (self.phi_old.capacity() + self.k1.capacity() + self.k2.capacity())
+            * std::mem::size_of::<T>()
+            + self.sums.heap_bytes()
+            + self.cell_state.capacity() * std::mem::size_of::<CellState>()
+            + self.velocity_field.heap_bytes()
+            + self.observed_centre.capacity() * std::mem::size_of::<[f64; 2]>()
+            + self.com.heap_bytes()
+    }
+
     /// Scratch memory for a tissue of this size.
     pub fn new(cells: &Cells<T>) -> Self {
         let n = cells.n_cells() * cells.patch_len();

@@ -23,6 +23,13 @@ pub struct PatchMap {
 }
 
 impl PatchMap {
+    /// Bytes of heap memory held by the map.
+    pub fn heap_bytes(&self) -> usize {
+        self.origin.capacity() * std::mem::size_of::<[usize; 2]>()
+            + self.offset.capacity() * std::mem::size_of::<[usize; 2]>()
+            + (self.lat_x.capacity() + self.lat_y.capacity()) * std::mem::size_of::<u32>()
+    }
+
     /// Lattice x of each storage column of cell `i`.
     #[inline]
     pub fn cell_x<'a>(&'a self, shape: &PatchShape, i: usize) -> &'a [u32] {
@@ -319,6 +326,11 @@ impl<T: Real> Cells<T> {
 }
 
 impl<T: Real> Cells<T> {
+    /// Bytes of heap memory held by the fields and their patch map.
+    pub fn heap_bytes(&self) -> usize {
+        self.phi.capacity() * std::mem::size_of::<T>() + self.map.heap_bytes()
+    }
+
     /// The same cells stored in precision `U`, consuming `self`: without a copy when `U` is
     /// `T`, else as [`Cells::to_precision`].
     pub fn into_precision<U: Real>(self) -> Cells<U> {

@@ -18,6 +18,15 @@ pub struct ComTable {
 }
 
 impl ComTable {
+    /// Bytes of heap memory held by the table.
+    pub fn heap_bytes(&self) -> usize {
+        (self.cos_x.capacity()
+            + self.sin_x.capacity()
+            + self.cos_y.capacity()
+            + self.sin_y.capacity())
+            * std::mem::size_of::<f64>()
+    }
+
     /// Tables for `lattice`.
     pub fn new(lattice: Lattice) -> Self {
         let tab = |l: usize| -> (Vec<f64>, Vec<f64>) {

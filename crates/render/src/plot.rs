@@ -17,6 +17,8 @@ pub struct Series {
     pub points: Vec<(f64, f64, f64)>,
     /// Join the points with a line (default) or only mark them.
     pub line: bool,
+    /// Mark each point with a dot (default).
+    pub markers: bool,
 }
 
 impl Series {
@@ -26,6 +28,7 @@ impl Series {
             label: label.into(),
             points: Vec::new(),
             line: true,
+            markers: true,
         }
     }
 
@@ -43,6 +46,14 @@ impl Series {
     /// Only markers, no line.
     pub fn markers_only(mut self) -> Self {
         self.line = false;
+        self.markers = true;
+        self
+    }
+
+    /// Only a line, no markers (for dense series such as time series).
+    pub fn line_only(mut self) -> Self {
+        self.line = true;
+        self.markers = false;
         self
     }
 }
@@ -177,6 +188,8 @@ impl Plot {
             .label_style((FONT, 15))
             .axis_desc_style((FONT, 18))
             .light_line_style(RGBColor(235, 235, 235))
+            .x_labels(8)
+            .y_labels(8)
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
             .draw()
@@ -215,10 +228,11 @@ impl Plot {
                     ))
                     .map_err(e)?;
             }
+            let radius = if series.markers { 4 } else { 0 };
             let marks = chart
                 .draw_series(
                     p.iter()
-                        .map(|q| Circle::new((q.0, q.1), 4, colour.filled())),
+                        .map(|q| Circle::new((q.0, q.1), radius, colour.filled())),
                 )
                 .map_err(e)?;
             if !series.label.is_empty() {
@@ -226,7 +240,7 @@ impl Plot {
                 marks.label(series.label.clone()).legend(move |(px, py)| {
                     EmptyElement::at((px + 10, py))
                         + PathElement::new(vec![(-10, 0), (10, 0)], colour.stroke_width(2))
-                        + Circle::new((0, 0), 4, colour.filled())
+                        + Circle::new((0, 0), radius, colour.filled())
                 });
             }
         }

@@ -99,7 +99,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             } else {
                 String::new()
             })
-            .with_points(&time, &net, &vec![0.0; time.len()]),
+            .with_points(&time, &net, &vec![0.0; time.len()])
+            .markers_only(),
         );
         if r.values[0].parse::<f64>().unwrap_or(0.0) > 0.0 {
             let ev = Table::read(&r.run.join("analysis/defect_events.csv"))?;

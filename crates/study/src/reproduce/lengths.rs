@@ -296,3 +296,21 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     );
     Ok((claims, settings))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A change of more than two standard errors in the claimed direction holds, against it
+    /// does not, and within them is inconclusive.
+    #[test]
+    fn trends_are_judged_by_their_standard_error() {
+        // std 0.3 over 9 seeds: standard error 0.1 at each end, 0.14 for the change.
+        let pts = |d: f64| vec![(0.0, (10.0, 0.3), 9), (1.0, (10.0 + d, 0.3), 9)];
+        assert_eq!(trend(&pts(-0.5), -1.0).0, Verdict::Holds);
+        assert_eq!(trend(&pts(0.5), -1.0).0, Verdict::DoesNotHold);
+        assert_eq!(trend(&pts(0.2), -1.0).0, Verdict::Inconclusive);
+        assert_eq!(trend(&pts(0.5), 1.0).0, Verdict::Holds);
+        assert_eq!(trend(&[(0.0, (1.0, 0.1), 3)], 1.0).0, Verdict::Inconclusive);
+    }
+}

@@ -669,3 +669,81 @@ fn describe_b(b: (f64, f64, f64)) -> String {
         _ => "–".into(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::summary::RunSummary;
+
+    /// Synthetic runs whose late growth rate is `r = 1.5 (ζ − ζ_cr(γ))` plus a seed offset that
+    /// cancels in the mean, on both boxes and forms.
+    fn recs(zeta_cr: impl Fn(f64, &str) -> f64) -> Vec<Rec> {
+        let mut out = Vec::new();
+        for pressure in PRESSURES {
+            for gamma in GAMMAS {
+                for z in ZETAS.split(',') {
+                    for (seed, off) in [(1, -1e-4), (2, 0.0), (3, 1e-4)] {
+                        let zeta: f64 = z.parse().unwrap();
+                        let rate = 1.5 * (zeta - zeta_cr(gamma, pressure)) + off;
+                        out.push(Rec {
+                            values: vec![pressure.into(), gamma.to_string(), z.into()],
+                            seed,
+                            run: std::path::PathBuf::new(),
+                            summary: RunSummary {
+                                window_start: 0.0,
+                                window_end: 1.0,
+                                rows: 2,
+                                v_rms: 1e-3 * (1.0 + 100.0 * zeta),
+                                s_rms: 1.0 + 50.0 * zeta,
+                                area_mean: 200.0,
+                                growth_rate: rate,
+                            },
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn verdict_of(claims: &[Claim], start: &str) -> Vec<Verdict> {
+        claims
+            .iter()
+            .filter(|c| c.claim.starts_with(start))
+            .map(|c| c.verdict)
+            .collect()
+    }
+
+    /// A threshold linear in γ, the same on both boxes and lower for the interaction form,
+    /// gives every verdict "holds" and recovers ζ_cr; one that falls with γ does not hold.
+    #[test]
+    fn synthetic_thresholds_get_the_right_verdicts() {
+        let cr = |gamma: f64, p: &str| {
+            if p == "paper" {
+                0.001 + 0.1 * gamma
+            } else {
+                0.0008 + 0.05 * gamma
+            }
+        };
+        let r = recs(cr);
+        let all: Vec<Group> = BOXES
+            .iter()
+            .flat_map(|(lx, _)| groups(&r, *lx, "test", true))
+            .collect();
+        for gr in &all {
+            let (z, _, _) = bracket(gr.threshold);
+            assert!((z - cr(gr.gamma, &gr.pressure)).abs() < 1e-12, "{z}");
+        }
+        let claims = verdicts(&all, &[]);
+        assert_eq!(verdict_of(&claims, "9.2a"), [Verdict::Holds; 2]);
+        assert_eq!(verdict_of(&claims, "9.2b"), [Verdict::Holds; 2]);
+        assert_eq!(verdict_of(&claims, "Pressure form"), [Verdict::Holds]);
+        let falling = recs(|gamma, _| 0.004 - 0.1 * gamma);
+        let all: Vec<Group> = BOXES
+            .iter()
+            .flat_map(|(lx, _)| groups(&falling, *lx, "test", true))
+            .collect();
+        let claims = verdicts(&all, &[]);
+        assert_eq!(verdict_of(&claims, "9.2a"), [Verdict::DoesNotHold; 2]);
+    }
+}
