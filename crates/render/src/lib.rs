@@ -36,7 +36,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 pub use heatmap::{save_heatmaps, Heatmap};
-pub use plot::{Plot, Series};
+pub use plot::{LegendAt, Plot, Series};
 
 /// What stops a picture from being drawn, naming the file.
 #[derive(Debug, thiserror::Error)]

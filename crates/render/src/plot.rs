@@ -78,6 +78,22 @@ pub struct Plot {
     pub hlines: Vec<(f64, String)>,
     /// Size in pixels.
     pub size: (u32, u32),
+    /// Where the legend goes.
+    pub legend: LegendAt,
+}
+
+/// A corner of the plot for the legend.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LegendAt {
+    /// Upper left (the default).
+    #[default]
+    UpperLeft,
+    /// Upper right.
+    UpperRight,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
 }
 
 impl Plot {
@@ -96,6 +112,7 @@ impl Plot {
             series: Vec::new(),
             hlines: Vec::new(),
             size: (800, 560),
+            legend: LegendAt::UpperLeft,
         }
     }
 
@@ -247,7 +264,12 @@ impl Plot {
         if legend || self.hlines.iter().any(|h| !h.1.is_empty()) {
             chart
                 .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(match self.legend {
+                    LegendAt::UpperLeft => SeriesLabelPosition::UpperLeft,
+                    LegendAt::UpperRight => SeriesLabelPosition::UpperRight,
+                    LegendAt::LowerLeft => SeriesLabelPosition::LowerLeft,
+                    LegendAt::LowerRight => SeriesLabelPosition::LowerRight,
+                })
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font((FONT, 15))
@@ -291,11 +313,18 @@ fn range(v: &[f64], log: bool) -> (f64, f64) {
 /// A tick label: plain for moderate magnitudes, scientific otherwise.
 pub(crate) fn tick(v: f64) -> String {
     let a = v.abs();
-    if v == 0.0 {
+    // Round-off residue of a tick meant to be 0.
+    if a < 1e-15 {
         "0".into()
     } else if (1e-3..1e4).contains(&a) {
-        let s = format!("{v:.4}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
+        // Three significant digits, trailing zeros dropped.
+        let digits = (2 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{v:.digits$}");
+        let s = if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            &s
+        };
         s.to_string()
     } else {
         format!("{v:.1e}")
@@ -313,6 +342,9 @@ mod tests {
         assert!((lo.log10() + 3.1).abs() < 1e-12 && (hi.log10() + 0.9).abs() < 1e-12);
         assert_eq!(range(&[2.0], false), (1.8, 2.2));
         assert_eq!(tick(0.0050), "0.005");
+        assert_eq!(tick(0.00115), "0.00115");
+        assert_eq!(tick(20.0), "20");
+        assert_eq!(tick(1.7e-18), "0");
         assert_eq!(tick(2.5e-4), "2.5e-4");
     }
 }

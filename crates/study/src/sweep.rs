@@ -2,11 +2,11 @@
 //! `runs/`, resumably; then `summary.csv`.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 
 use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
 use phasefield::Real;
-use rayon::prelude::*;
 
 use crate::analyze::{analyze, AnalyzeOptions};
 use crate::plan::Point;
@@ -92,8 +92,13 @@ pub fn run_points(
     })
 }
 
-/// Calls `f` on every item, `params.jobs` at a time, each call inside its own rayon pool of
-/// `params.threads` threads; stops starting new calls after the first error.
+/// Calls `f` on every item, at most `params.jobs` at a time, each call inside a rayon pool
+/// of `params.threads` threads (one pool per job, reused); stops starting new calls after the
+/// first error.
+///
+/// The jobs are plain threads, not a rayon pool: a rayon worker that waits in another pool's
+/// `install` keeps busy with its own pool's work, so an outer rayon pool would start more
+/// than `jobs` calls at once (every item at once, in practice).
 ///
 /// # Errors
 /// The first error of `f`, or [`SweepError::Threads`] (converted) when a pool cannot start.
@@ -102,18 +107,38 @@ pub fn in_jobs<I: Sync, E: From<SweepError> + Send>(
     params: SweepParams,
     f: impl Fn(&I) -> Result<(), E> + Sync,
 ) -> Result<(), E> {
-    let pool = |n: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| SweepError::Threads(e.to_string()))
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let first_error: Mutex<Option<E>> = Mutex::new(None);
+    let fail = |e: E| {
+        failed.store(true, Ordering::SeqCst);
+        let mut slot = first_error.lock().unwrap_or_else(|p| p.into_inner());
+        slot.get_or_insert(e);
     };
-    pool(params.jobs)?.install(|| {
-        items.par_iter().with_max_len(1).try_for_each(|item| {
-            let inner = pool(params.threads)?;
-            inner.install(|| f(item))
-        })
-    })
+    std::thread::scope(|scope| {
+        for _ in 0..params.jobs.min(items.len()) {
+            scope.spawn(|| {
+                let pool = match rayon::ThreadPoolBuilder::new()
+                    .num_threads(params.threads)
+                    .build()
+                {
+                    Ok(p) => p,
+                    Err(e) => return fail(SweepError::Threads(e.to_string()).into()),
+                };
+                while !failed.load(Ordering::SeqCst) {
+                    let k = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(item) = items.get(k) else { break };
+                    if let Err(e) = pool.install(|| f(item)) {
+                        fail(e);
+                    }
+                }
+            });
+        }
+    });
+    match first_error.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 /// Makes `point`'s run directory ready for a fresh run: no `complete` mark, no earlier
@@ -273,4 +298,48 @@ pub fn analyze_points(
         })?;
         std::fs::write(&path, &mark).map_err(|source| SweepError::write("analysis", &path, source))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rayon::prelude::*;
+
+    /// At most `jobs` calls run at once, even when each call runs rayon work of its own; every
+    /// item is called once; the first error stops the rest.
+    #[test]
+    fn in_jobs_keeps_to_its_jobs() {
+        let active = AtomicUsize::new(0);
+        let most = AtomicUsize::new(0);
+        let calls = AtomicUsize::new(0);
+        let items: Vec<u64> = (0..12).collect();
+        in_jobs(
+            &items,
+            SweepParams::new(2, 2),
+            |&i| -> Result<(), SweepError> {
+                let now = active.fetch_add(1, Ordering::SeqCst) + 1;
+                most.fetch_max(now, Ordering::SeqCst);
+                calls.fetch_add(1, Ordering::SeqCst);
+                let s: u64 = (0..200_000u64).into_par_iter().map(|k| k ^ i).sum();
+                std::thread::sleep(std::time::Duration::from_millis(5 + s % 2));
+                active.fetch_sub(1, Ordering::SeqCst);
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(calls.load(Ordering::SeqCst), 12);
+        assert!(
+            most.load(Ordering::SeqCst) <= 2,
+            "{} at once",
+            most.load(Ordering::SeqCst)
+        );
+        let r = in_jobs(&items, SweepParams::new(1, 1), |&i| {
+            if i == 3 {
+                Err(SweepError::Threads("boom".into()))
+            } else {
+                Ok(())
+            }
+        });
+        assert!(r.unwrap_err().to_string().contains("boom"));
+    }
 }

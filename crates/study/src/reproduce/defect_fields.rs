@@ -160,15 +160,20 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 csv += &format!(",{n}\n");
             }
         }
+        // The isotropic parts carry the mean pressure of the tissue: show their variation.
+        let less_mean = |v: &[f64]| -> Vec<f64> {
+            let m = v.iter().sum::<f64>() / v.len() as f64;
+            v.iter().map(|x| x - m).collect()
+        };
         let panels = |f: &[Vec<f64>], name: &str| {
             vec![
                 Heatmap::new("Q_xx (defect frame)", CROP, f[6].clone()),
-                Heatmap::new("σ_xx", CROP, f[2].clone()),
+                Heatmap::new("σ_xx − mean", CROP, less_mean(&f[2])),
                 Heatmap::new("σ_xy", CROP, f[4].clone()),
                 Heatmap::new("flow: v_u, arrows v", CROP, f[0].clone())
                     .with_arrows(f[0].clone(), f[1].clone()),
-                Heatmap::new("σ_yy", CROP, f[3].clone()),
-                Heatmap::new(format!("pressure P ({name})"), CROP, f[5].clone()),
+                Heatmap::new("σ_yy − mean", CROP, less_mean(&f[3])),
+                Heatmap::new(format!("P − mean ({name} form)"), CROP, less_mean(&f[5])),
             ]
         };
         for (file, title, f, n) in [

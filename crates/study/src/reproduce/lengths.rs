@@ -155,6 +155,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     ];
     for pl in &mut plots {
         pl.hlines.push((0.0, String::new()));
+        pl.legend = render::LegendAt::UpperRight;
     }
     for z in &active {
         let runs: Vec<&Rec> = recs.iter().filter(|r| r.values[0] == *z).collect();
