@@ -787,3 +787,34 @@ fn the_threshold_command_tabulates_a_sweep() {
     assert!((row[0] - (0.004 + 0.004 / 7.0)).abs() < 1e-15, "{table}");
     assert_eq!(&row[1..], &[0.004, 0.008, 1.0, 2.0]);
 }
+
+/// `reproduce` refuses an unknown figure or scale before anything runs, naming the choices,
+/// and leaves no output behind.
+#[test]
+fn reproduce_refuses_unknown_figures_and_scales() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let o = bin()
+        .args(["reproduce", "fig9", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("no figure fig9") && e.contains("defect-fields") && e.contains("all"),
+        "{e}"
+    );
+    let o = bin()
+        .args(["reproduce", "threshold", "--scale", "huge", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("--scale huge: write quick or paper"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+}
