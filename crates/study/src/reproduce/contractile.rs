@@ -61,94 +61,102 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         SweepJob {
             name: format!("contractile-{}", p.scale.name()),
             sets,
-            varies: vec![format!("model.zeta={}", ZETAS.join(","))],
+            varies: vec![
+                "model.pressure=paper,interaction".to_string(),
+                format!("model.zeta={}", ZETAS.join(",")),
+            ],
             analyze: None,
         },
     )?;
     p.reporter.stage("contractile: tables and plots");
     let recs = res.records(None)?;
-    let of = |z: &str| -> Vec<&Rec> { recs.iter().filter(|r| r.values[0] == z).collect() };
-    let mut csv = String::from("zeta,time,v_rms,v_rms_std,s_rms,s_rms_std\n");
-    let mut v = Plot::new(
-        "v_rms in time: contractile, passive and extensile",
-        "time (TU; activity from t = 200)",
-        "v_rms (mean ± std over seeds)",
-    );
-    v.log_y = true;
-    let mut s = Plot::new(
-        "Cell deformation in time",
-        "time (TU; activity from t = 200)",
-        "S_rms (mean ± std over seeds)",
-    );
-    for z in ZETAS {
-        let st = series_stats(&of(z), &["v_rms", "s_rms"], 10)?;
-        for (time, c) in &st {
-            csv += &format!(
-                "{z},{time},{:e},{:e},{:e},{:e}\n",
-                c[0].0, c[0].1, c[1].0, c[1].1
+    let mut claims = Vec::new();
+    let mut csv = String::from("pressure,zeta,time,v_rms,v_rms_std,s_rms,s_rms_std\n");
+    for pressure in ["paper", "interaction"] {
+        let of = |z: &str| -> Vec<&Rec> {
+            recs.iter()
+                .filter(|r| r.values[0] == pressure && r.values[1] == z)
+                .collect()
+        };
+        let mut v = Plot::new(
+            format!("v_rms in time: contractile, passive, extensile ({pressure} pressure)"),
+            "time (TU; activity from t = 200)",
+            "v_rms (mean ± std over seeds)",
+        );
+        v.log_y = true;
+        let mut s = Plot::new(
+            format!("Cell deformation in time ({pressure} pressure)"),
+            "time (TU; activity from t = 200)",
+            "S_rms (mean ± std over seeds)",
+        );
+        for z in ZETAS {
+            let st = series_stats(&of(z), &["v_rms", "s_rms"], 10)?;
+            for (time, c) in &st {
+                csv += &format!(
+                    "{pressure},{z},{time},{:e},{:e},{:e},{:e}\n",
+                    c[0].0, c[0].1, c[1].0, c[1].1
+                );
+            }
+            let time: Vec<f64> = st.iter().map(|x| x.0).collect();
+            let pick = |i: usize, j: bool| -> Vec<f64> {
+                st.iter()
+                    .map(|x| if j { x.1[i].1 } else { x.1[i].0 })
+                    .collect()
+            };
+            // Error bars every tenth point keep the curves readable.
+            let sparse = |e: Vec<f64>| -> Vec<f64> {
+                e.iter()
+                    .enumerate()
+                    .map(|(k, &x)| if k % 10 == 5 { x } else { 0.0 })
+                    .collect()
+            };
+            let label = format!("ζ = {z}");
+            v.series.push(
+                Series::new(&label)
+                    .with_points(&time, &pick(0, false), &sparse(pick(0, true)))
+                    .line_only(),
+            );
+            s.series.push(
+                Series::new(&label)
+                    .with_points(&time, &pick(1, false), &sparse(pick(1, true)))
+                    .line_only(),
             );
         }
-        let time: Vec<f64> = st.iter().map(|x| x.0).collect();
-        let pick = |i: usize, j: bool| -> Vec<f64> {
-            st.iter()
-                .map(|x| if j { x.1[i].1 } else { x.1[i].0 })
-                .collect()
-        };
-        // Error bars every tenth point keep the curves readable.
-        let sparse = |e: Vec<f64>| -> Vec<f64> {
-            e.iter()
-                .enumerate()
-                .map(|(k, &x)| if k % 10 == 5 { x } else { 0.0 })
-                .collect()
-        };
-        let label = format!("ζ = {z}");
-        v.series.push(
-            Series::new(&label)
-                .with_points(&time, &pick(0, false), &sparse(pick(0, true)))
-                .line_only(),
-        );
-        s.series.push(
-            Series::new(&label)
-                .with_points(&time, &pick(1, false), &sparse(pick(1, true)))
-                .line_only(),
-        );
-    }
-    write_text(&dir.join("contractile_series.csv"), &csv)?;
-    drawn(v.save_png(&dir.join("contractile_v_rms.png")))?;
-    drawn(s.save_png(&dir.join("contractile_s_rms.png")))?;
+        drawn(v.save_png(&dir.join(format!("contractile_v_rms_{pressure}.png"))))?;
+        drawn(s.save_png(&dir.join(format!("contractile_s_rms_{pressure}.png"))))?;
 
-    // The verdict: the contractile flow decays at least as the passive one, paired by seed.
-    let paired = |z: &str, f: fn(&Rec) -> f64| -> Vec<f64> {
-        of(z)
-            .iter()
-            .filter_map(|r| {
-                of("0")
-                    .into_iter()
-                    .find(|b| b.seed == r.seed)
-                    .map(|b| f(r) - f(b))
-            })
-            .collect()
-    };
-    let ratio = |z: &str| -> Vec<f64> {
-        of(z)
-            .iter()
-            .filter_map(|r| {
-                of("0")
-                    .into_iter()
-                    .find(|b| b.seed == r.seed)
-                    .map(|b| r.summary.v_rms / b.summary.v_rms)
-            })
-            .collect()
-    };
-    let d_rate = mean_std(&paired("-0.0018", |r| r.summary.growth_rate));
-    let d_s = mean_std(&paired("-0.0018", |r| r.summary.s_rms));
-    let v_ratio = mean_std(&ratio("-0.0018"));
-    let e_ratio = mean_std(&ratio("0.005"));
-    let e_rate = mean_std(&paired("0.005", |r| r.summary.growth_rate));
-    let stable = d_rate.0 <= 2.0 * d_rate.1.max(1e-12) && v_ratio.0 < 2.0;
-    let contrast = e_ratio.0 > 3.0;
-    let claims = vec![Claim::new(
-        "9.3: contractile activity (ζ = −0.0018) stays stable",
+        // The verdict: the contractile flow decays at least as the passive one, paired by seed.
+        let paired = |z: &str, f: fn(&Rec) -> f64| -> Vec<f64> {
+            of(z)
+                .iter()
+                .filter_map(|r| {
+                    of("0")
+                        .into_iter()
+                        .find(|b| b.seed == r.seed)
+                        .map(|b| f(r) - f(b))
+                })
+                .collect()
+        };
+        let ratio = |z: &str| -> Vec<f64> {
+            of(z)
+                .iter()
+                .filter_map(|r| {
+                    of("0")
+                        .into_iter()
+                        .find(|b| b.seed == r.seed)
+                        .map(|b| r.summary.v_rms / b.summary.v_rms)
+                })
+                .collect()
+        };
+        let d_rate = mean_std(&paired("-0.0018", |r| r.summary.growth_rate));
+        let d_s = mean_std(&paired("-0.0018", |r| r.summary.s_rms));
+        let v_ratio = mean_std(&ratio("-0.0018"));
+        let e_ratio = mean_std(&ratio("0.005"));
+        let e_rate = mean_std(&paired("0.005", |r| r.summary.growth_rate));
+        let stable = d_rate.0 <= 2.0 * d_rate.1.max(1e-12) && v_ratio.0 < 2.0;
+        let contrast = e_ratio.0 > 3.0;
+        claims.push(Claim::new(
+        format!("9.3 ({pressure} pressure): contractile activity (ζ = −0.0018) stays stable"),
         format!(
             "over the second half of the active phase, against ζ = 0 from the same seeds: v_rms ratio {}, excess growth rate {} /TU, S_rms excess {}; extensile ζ = 0.005 for contrast: v_rms ratio {}, excess growth rate {} /TU",
             pm(v_ratio),
@@ -171,11 +179,13 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             (false, _) => "the contractile flow grows or stays above twice the passive one".into(),
             (true, false) => "the extensile contrast does not flow either: the runs may be too short".into(),
         },
-    )];
+    ));
+    }
+    write_text(&dir.join("contractile_series.csv"), &csv)?;
     let settings = format!(
-        "- Paper scene (MODEL.md §8): 60 cells, L = 100, γ = 0.01, paper pressure; ζ ∈ {{{}}}; seeds {}.\n\
+        "- Paper scene (MODEL.md §8): 60 cells, L = 100, γ = 0.01, both pressure forms; ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation at ζ = 0, then {t} TU; integrator {}; f32 storage.\n\
-         - Verdict from the second half of the active phase; the series every 10 TU in `contractile_series.csv`, plotted in `contractile_v_rms.png` and `contractile_s_rms.png`.",
+         - Verdict from the second half of the active phase; the series every 10 TU in `contractile_series.csv`, plotted in `contractile_v_rms_*.png` and `contractile_s_rms_*.png` (one per pressure form).",
         ZETAS.join(", "),
         p.scale.seeds(),
         p.scale.integrator().join(" ").replace("integrator.", "")

@@ -5,19 +5,29 @@ use std::path::Path;
 
 use render::{Plot, Series};
 
-use super::lengths::{by_value, times, trend, turbulence, ZETAS};
-use super::{drawn, g, write_text, AtValue, Claim, ReproduceParams, Table, Verdict};
+use super::lengths::{by_value, times, trend, turbulence, PRESSURES, ZETAS};
+use super::{
+    drawn, g, write_text, AtValue, Claim, Rec, ReproduceParams, SweepResult, Table, Verdict,
+};
 use crate::SweepError;
 
 /// Bins per side of the creation-position test.
 const BINS: usize = 4;
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
-    let (zeta, _) = turbulence(p)?;
-    p.reporter.stage("defects: tables and plots");
-    let recs = zeta.records(None)?;
-    let density = by_value(&zeta, &ZETAS, "defect_density")?;
-    let rate = by_value(&zeta, &ZETAS, "creation_rate")?;
+/// The figure's tables, plots and claims for one pressure form.
+fn one_form(
+    p: &ReproduceParams,
+    dir: &Path,
+    zeta: &SweepResult,
+    pressure: &str,
+) -> Result<Vec<Claim>, SweepError> {
+    let recs: Vec<Rec> = zeta
+        .records(None)?
+        .into_iter()
+        .filter(|r| r.values[1] == pressure)
+        .collect();
+    let density = by_value(zeta, pressure, &ZETAS, "defect_density")?;
+    let rate = by_value(zeta, pressure, &ZETAS, "creation_rate")?;
     let mut csv = String::from(
         "zeta,defect_density,defect_density_std,creation_rate,creation_rate_std,seeds\n",
     );
@@ -27,7 +37,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             d.0, d.1 .0, d.1 .1, r.1 .0, r.1 .1, d.2
         );
     }
-    write_text(&dir.join("defects_vs_zeta.csv"), &csv)?;
+    write_text(&dir.join(format!("defects_vs_zeta_{pressure}.csv")), &csv)?;
     let series = |pts: &[AtValue], label: &str| {
         let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
         let m: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
@@ -35,29 +45,29 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         Series::new(label).with_points(&x, &m, &e)
     };
     let mut pd = Plot::new(
-        "Defect density against ζ (γ = 0.01, L = 200)",
+        format!("Defect density against ζ (γ = 0.01, L = 200, {pressure} pressure)"),
         "activity ζ",
         "±1/2 defects per node",
     );
     pd.series.push(series(&density, "defect density"));
-    drawn(pd.save_png(&dir.join("defect_density_vs_zeta.png")))?;
+    drawn(pd.save_png(&dir.join(format!("defect_density_vs_zeta_{pressure}.png"))))?;
     let mut pr = Plot::new(
-        "Creation rate of defect pairs against ζ",
+        format!("Creation rate of defect pairs against ζ ({pressure} pressure)"),
         "activity ζ",
         "pair creations per node per TU",
     );
     pr.series.push(series(&rate, "creation rate"));
-    drawn(pr.save_png(&dir.join("creation_rate_vs_zeta.png")))?;
+    drawn(pr.save_png(&dir.join(format!("creation_rate_vs_zeta_{pressure}.png"))))?;
 
     // Over time, and the charge of every frame.
     let mut time_csv = String::from("zeta,seed,time,n_plus,n_minus,defect_density,net_charge\n");
     let mut pt = Plot::new(
-        "Defect density in time (seed 1)",
+        format!("Defect density in time (seed 1, {pressure} pressure)"),
         "time (TU)",
         "±1/2 defects per node",
     );
     let mut pq = Plot::new(
-        "Net topological charge in time (every run)",
+        format!("Net topological charge in time (every run, {pressure} pressure)"),
         "time (TU)",
         "net charge",
     );
@@ -76,7 +86,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         for k in 0..time.len() {
             time_csv += &format!(
                 "{},{},{},{},{},{:e},{}\n",
-                r.values[0], r.seed, time[k], np[k], nm[k], dens[k], net[k]
+                r.values[1], r.seed, time[k], np[k], nm[k], dens[k], net[k]
             );
             frames += 1;
             if net[k] != 0.0 {
@@ -87,7 +97,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         unpaired += un.iter().filter(|x| x.is_finite()).sum::<f64>();
         if r.seed == p.scale.seeds().first {
             pt.series
-                .push(Series::new(format!("ζ = {}", r.values[0])).with_points(
+                .push(Series::new(format!("ζ = {}", r.values[1])).with_points(
                     &time,
                     &dens,
                     &vec![0.0; time.len()],
@@ -95,14 +105,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         }
         pq.series.push(
             Series::new(if r.seed == p.scale.seeds().first {
-                format!("ζ = {}", r.values[0])
+                format!("ζ = {}", r.values[1])
             } else {
                 String::new()
             })
             .with_points(&time, &net, &vec![0.0; time.len()])
             .markers_only(),
         );
-        if r.values[0].parse::<f64>().unwrap_or(0.0) > 0.0 {
+        if r.values[1].parse::<f64>().unwrap_or(0.0) > 0.0 {
             let ev = Table::read(&r.run.join("analysis/defect_events.csv"))?;
             let (kind, x, y) = (ev.strs("kind")?, ev.f64s("x")?, ev.f64s("y")?);
             for k in 0..kind.len() {
@@ -112,9 +122,12 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             }
         }
     }
-    write_text(&dir.join("defects_in_time.csv"), &time_csv)?;
-    drawn(pt.save_png(&dir.join("defect_density_in_time.png")))?;
-    drawn(pq.save_png(&dir.join("net_charge_in_time.png")))?;
+    write_text(
+        &dir.join(format!("defects_in_time_{pressure}.csv")),
+        &time_csv,
+    )?;
+    drawn(pt.save_png(&dir.join(format!("defect_density_in_time_{pressure}.png"))))?;
+    drawn(pq.save_png(&dir.join(format!("net_charge_in_time_{pressure}.png"))))?;
 
     // Where pairs are created: counts in BINS × BINS cells of the box against uniform.
     let lx = 200.0;
@@ -135,7 +148,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     for (k, c) in counts.iter().enumerate() {
         pos_csv += &format!("{},{},{c}\n", k / BINS, k % BINS);
     }
-    write_text(&dir.join("creation_positions.csv"), &pos_csv)?;
+    write_text(
+        &dir.join(format!("creation_positions_{pressure}.csv")),
+        &pos_csv,
+    )?;
 
     let active: Vec<AtValue> = density.iter().filter(|d| d.0 > 0.0).cloned().collect();
     let (vd, td) = trend(&density, 1.0);
@@ -150,15 +166,15 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     );
     let at_rest = density.first().map_or(f64::NAN, |d| d.1 .0);
     let top = density.last().map_or(f64::NAN, |d| d.1 .0);
-    let claims = vec![
+    Ok(vec![
         Claim::new(
-            "9.5: the total topological charge stays zero",
+            format!("9.5 ({pressure} pressure): the total topological charge stays zero"),
             format!("{charged} of {frames} analysed frames have a non-zero net charge (largest |charge| {max_charge})"),
             if frames == 0 { Verdict::Inconclusive } else if charged == 0 { Verdict::Holds } else { Verdict::DoesNotHold },
             "every +1/2 found has a −1/2 partner in the same frame, as a periodic domain requires",
         ),
         Claim::new(
-            "9.5: ±1/2 defects appear in pairs at random places",
+            format!("9.5 ({pressure} pressure): ±1/2 defects appear in pairs at random places"),
             format!(
                 "{} pair creations at ζ > 0; {} births or deaths without a partner within 2R; creation positions in {BINS}×{BINS} bins: χ² = {} (15 degrees of freedom, 1 % critical value {chi2_crit})",
                 creations.len(),
@@ -181,7 +197,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             },
         ),
         Claim::new(
-            "9.5: the defect density grows with ζ",
+            format!("9.5 ({pressure} pressure): the defect density grows with ζ"),
             format!("ζ from 0: {td}; among ζ > 0: {ta}; at rest {} of the largest density is already there", g(at_rest / top)),
             if vd == Verdict::Holds && va == Verdict::Holds { Verdict::Holds } else if vd == Verdict::DoesNotHold { Verdict::DoesNotHold } else { Verdict::Inconclusive },
             match (vd, va) {
@@ -191,7 +207,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             },
         ),
         Claim::new(
-            "9.5: the creation rate grows with ζ",
+            format!("9.5 ({pressure} pressure): the creation rate grows with ζ"),
             format!("among ζ > 0: {tr}"),
             vr,
             match vr {
@@ -200,12 +216,21 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 Verdict::Inconclusive => "the change is within two standard errors",
             },
         ),
-    ];
+    ])
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let (zeta, _) = turbulence(p)?;
+    p.reporter.stage("defects: tables and plots");
+    let mut claims = Vec::new();
+    for pressure in PRESSURES {
+        claims.extend(one_form(p, dir, &zeta, pressure)?);
+    }
     let (t, from) = times(p.scale);
     let settings = format!(
-        "- The ζ sweep of `reproduce lengths` (L = 200, 240 cells, γ = 0.01, ζ ∈ {{{}}}, seeds {}), 200 TU of relaxation then {t} TU; frames every 10 TU analysed from t = {from}.\n\
+        "- The ζ sweep of `reproduce lengths` (L = 200, 240 cells, γ = 0.01, both pressure forms, ζ ∈ {{{}}}, seeds {}), 200 TU of relaxation then {t} TU; frames every 10 TU analysed from t = {from}.\n\
          - Defects: ±1/2 of the box-smoothed Q (3R box); tracked between frames (links within R), births and deaths paired within 2R into creations and annihilations. Density = defects per node; creation rate = pair creations per node per TU, averaged over the frames.\n\
-         - Files: `defects_vs_zeta.csv`, `defects_in_time.csv`, `creation_positions.csv`, `defect_density_vs_zeta.png`, `creation_rate_vs_zeta.png`, `defect_density_in_time.png`, `net_charge_in_time.png`.",
+         - Files (one of each per pressure form, `_paper` and `_interaction`): `defects_vs_zeta_*.csv`, `defects_in_time_*.csv`, `creation_positions_*.csv`, `defect_density_vs_zeta_*.png`, `creation_rate_vs_zeta_*.png`, `defect_density_in_time_*.png`, `net_charge_in_time_*.png`.",
         ZETAS.join(", "),
         p.scale.seeds()
     );

@@ -52,7 +52,10 @@ pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResul
         SweepJob {
             name: format!("turbulence-zeta-{}", p.scale.name()),
             sets: sets.clone(),
-            varies: vec![format!("model.zeta={}", ZETAS.join(","))],
+            varies: vec![
+                format!("model.pressure={}", PRESSURES.join(",")),
+                format!("model.zeta={}", ZETAS.join(",")),
+            ],
             analyze: analyze.clone(),
         },
     )?;
@@ -63,32 +66,44 @@ pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResul
         SweepJob {
             name: format!("turbulence-gamma-{}", p.scale.name()),
             sets: gsets,
-            varies: vec![format!("model.gamma={}", GAMMAS.join(","))],
+            varies: vec![
+                format!("model.pressure={}", PRESSURES.join(",")),
+                format!("model.gamma={}", GAMMAS.join(",")),
+            ],
             analyze,
         },
     )?;
     Ok((zeta, gamma))
 }
 
-/// The seed statistics of a column of the analysed summary, per value of the (only) axis.
+/// Both pressure forms, compared on every figure (issue 11).
+pub(super) const PRESSURES: [&str; 2] = ["paper", "interaction"];
+
+/// The seed statistics of a column of an analysed summary whose axes are
+/// `[model.pressure, X]`, for one pressure form, per value of `X`.
 pub(super) fn by_value(
     res: &SweepResult,
+    pressure: &str,
     values: &[&str],
     column: &str,
 ) -> Result<Vec<AtValue>, SweepError> {
+    let axis = res.summary.header[1].clone();
     let groups = res
         .summary
-        .group(&[res.summary.header[0].as_str()], column)?;
+        .group(&["model.pressure", axis.as_str()], column)?;
     Ok(values
         .iter()
         .filter_map(|v| {
-            groups.iter().find(|g| g.0[0] == *v).map(|g| {
-                (
-                    v.parse().unwrap_or(f64::NAN),
-                    mean_std(&g.1),
-                    g.1.iter().filter(|x| x.is_finite()).count(),
-                )
-            })
+            groups
+                .iter()
+                .find(|g| g.0[0] == pressure && g.0[1] == *v)
+                .map(|g| {
+                    (
+                        v.parse().unwrap_or(f64::NAN),
+                        mean_std(&g.1),
+                        g.1.iter().filter(|x| x.is_finite()).count(),
+                    )
+                })
         })
         .collect())
 }
@@ -146,123 +161,139 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
 
     // The correlation curves, averaged over seeds, per ζ.
     let recs = zeta.records(None)?;
-    let mut corr_csv =
-        String::from("zeta,r,c_velocity,c_velocity_std,c_vorticity,c_vorticity_std,c_q,c_q_std\n");
-    let mut plots = [
-        Plot::new("Fig. 3a: vorticity autocorrelation", "r (nodes)", "C_ω(r)"),
-        Plot::new("Velocity autocorrelation", "r (nodes)", "C_v(r)"),
-        Plot::new("Q autocorrelation", "r (nodes)", "C_Q(r)"),
-    ];
-    for pl in &mut plots {
-        pl.hlines.push((0.0, String::new()));
-        pl.legend = render::LegendAt::UpperRight;
-    }
-    for z in &active {
-        let runs: Vec<&Rec> = recs.iter().filter(|r| r.values[0] == *z).collect();
-        let tables: Vec<Table> = runs
-            .iter()
-            .map(|r| Table::read(&r.run.join("analysis/correlations.csv")))
-            .collect::<Result<_, _>>()?;
-        let Some(first) = tables.first() else {
-            continue;
-        };
-        let r = first.f64s("r")?;
-        let cols = ["c_velocity", "c_vorticity", "c_q"];
-        let data: Vec<Vec<Vec<f64>>> = tables
-            .iter()
-            .map(|t| {
-                cols.iter()
-                    .map(|c| t.f64s(c))
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .collect::<Result<_, _>>()?;
-        let mut stats = vec![Vec::new(); 3];
-        for k in 0..r.len() {
-            corr_csv += &format!("{z},{}", r[k]);
-            for c in 0..3 {
-                let s = mean_std(
-                    &data
-                        .iter()
-                        .map(|d| d[c].get(k).copied().unwrap_or(f64::NAN))
-                        .collect::<Vec<_>>(),
-                );
-                corr_csv += &format!(",{:e},{:e}", s.0, s.1);
-                stats[c].push(s);
-            }
-            corr_csv += "\n";
-        }
-        // Out to r = 50 (a quarter of the box): the minimum sits well inside.
-        let n = r.len().min(51);
-        for (pl, c) in plots.iter_mut().zip([1, 0, 2]) {
-            let m: Vec<f64> = stats[c][..n].iter().map(|s| s.0).collect();
-            let e: Vec<f64> = stats[c][..n]
-                .iter()
-                .enumerate()
-                .map(|(k, s)| if k % 5 == 0 { s.1 } else { 0.0 })
-                .collect();
-            pl.series
-                .push(Series::new(format!("ζ = {z}")).with_points(&r[..n], &m, &e));
-        }
-    }
-    write_text(&dir.join("correlations.csv"), &corr_csv)?;
-    drawn(plots[0].save_png(&dir.join("fig3a_c_vorticity.png")))?;
-    drawn(plots[1].save_png(&dir.join("c_velocity.png")))?;
-    drawn(plots[2].save_png(&dir.join("c_q.png")))?;
-
-    // The lengths against ζ and γ.
+    let mut corr_csv = String::from(
+        "pressure,zeta,r,c_velocity,c_velocity_std,c_vorticity,c_vorticity_std,c_q,c_q_std\n",
+    );
     let box_side = analysis::smooth::paper_box_side(8.0) as f64;
     let mut claims = Vec::new();
-    let mut csv_z = String::from("zeta,field,length,length_std,seeds\n");
-    let mut csv_g = String::from("gamma,field,length,length_std,seeds\n");
-    let mut pz = Plot::new(
-        "Fig. 3b: correlation lengths against ζ (γ = 0.01)",
-        "activity ζ",
-        "first minimum of C(r) (nodes)",
-    );
-    let mut pg = Plot::new(
-        format!("Fig. 3c: correlation lengths against γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
+    let mut csv_z = String::from("pressure,zeta,field,length,length_std,seeds\n");
+    let mut csv_g = String::from("pressure,gamma,field,length,length_std,seeds\n");
+    for pressure in PRESSURES {
+        let mut plots = [
+            Plot::new(
+                format!("Fig. 3a: vorticity autocorrelation ({pressure} pressure)"),
+                "r (nodes)",
+                "C_ω(r)",
+            ),
+            Plot::new(
+                format!("Velocity autocorrelation ({pressure} pressure)"),
+                "r (nodes)",
+                "C_v(r)",
+            ),
+            Plot::new(
+                format!("Q autocorrelation ({pressure} pressure)"),
+                "r (nodes)",
+                "C_Q(r)",
+            ),
+        ];
+        for pl in &mut plots {
+            pl.hlines.push((0.0, String::new()));
+            pl.legend = render::LegendAt::UpperRight;
+        }
+        for z in &active {
+            let runs: Vec<&Rec> = recs
+                .iter()
+                .filter(|r| r.values[0] == pressure && r.values[1] == *z)
+                .collect();
+            let tables: Vec<Table> = runs
+                .iter()
+                .map(|r| Table::read(&r.run.join("analysis/correlations.csv")))
+                .collect::<Result<_, _>>()?;
+            let Some(first) = tables.first() else {
+                continue;
+            };
+            let r = first.f64s("r")?;
+            let cols = ["c_velocity", "c_vorticity", "c_q"];
+            let data: Vec<Vec<Vec<f64>>> = tables
+                .iter()
+                .map(|t| {
+                    cols.iter()
+                        .map(|c| t.f64s(c))
+                        .collect::<Result<Vec<_>, _>>()
+                })
+                .collect::<Result<_, _>>()?;
+            let mut stats = vec![Vec::new(); 3];
+            for k in 0..r.len() {
+                corr_csv += &format!("{pressure},{z},{}", r[k]);
+                for c in 0..3 {
+                    let s = mean_std(
+                        &data
+                            .iter()
+                            .map(|d| d[c].get(k).copied().unwrap_or(f64::NAN))
+                            .collect::<Vec<_>>(),
+                    );
+                    corr_csv += &format!(",{:e},{:e}", s.0, s.1);
+                    stats[c].push(s);
+                }
+                corr_csv += "\n";
+            }
+            // Out to r = 50 (a quarter of the box): the minimum sits well inside.
+            let n = r.len().min(51);
+            for (pl, c) in plots.iter_mut().zip([1, 0, 2]) {
+                let m: Vec<f64> = stats[c][..n].iter().map(|s| s.0).collect();
+                let e: Vec<f64> = stats[c][..n]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, s)| if k % 5 == 0 { s.1 } else { 0.0 })
+                    .collect();
+                pl.series
+                    .push(Series::new(format!("ζ = {z}")).with_points(&r[..n], &m, &e));
+            }
+        }
+        drawn(plots[0].save_png(&dir.join(format!("fig3a_c_vorticity_{pressure}.png"))))?;
+        drawn(plots[1].save_png(&dir.join(format!("c_velocity_{pressure}.png"))))?;
+        drawn(plots[2].save_png(&dir.join(format!("c_q_{pressure}.png"))))?;
+
+        // The lengths against ζ and γ.
+        let mut pz = Plot::new(
+            format!("Fig. 3b: correlation lengths against ζ (γ = 0.01, {pressure} pressure)"),
+            "activity ζ",
+            "first minimum of C(r) (nodes)",
+        );
+        let mut pg = Plot::new(
+        format!("Fig. 3c: correlation lengths against γ (ζ = {ZETA_OF_GAMMA_SWEEP}, {pressure} pressure)"),
         "interface stiffness γ",
         "first minimum of C(r) (nodes)",
     );
-    pz.hlines
-        .push((box_side, format!("smoothing box side {box_side}")));
-    pg.hlines
-        .push((box_side, format!("smoothing box side {box_side}")));
-    for (name, col) in FIELDS {
-        let lz = by_value(&zeta, &active, col)?;
-        let lg = by_value(&gamma, &GAMMAS, col)?;
-        for (x, (m, s), n) in &lz {
-            csv_z += &format!("{x},{name},{m},{s},{n}\n");
-        }
-        for (x, (m, s), n) in &lg {
-            csv_g += &format!("{x},{name},{m},{s},{n}\n");
-        }
-        let series = |pts: &[AtValue]| {
-            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
-            let m: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
-            let e: Vec<f64> = pts.iter().map(|p| p.1 .1).collect();
-            Series::new(format!("{name} length")).with_points(&x, &m, &e)
-        };
-        pz.series.push(series(&lz));
-        pg.series.push(series(&lg));
-        let (vz, tz) = trend(&lz, -1.0);
-        let (vg, tg) = trend(&lg, 1.0);
-        let floor = |pts: &[AtValue]| {
-            pts.iter()
-                .map(|p| p.1 .0)
-                .filter(|v| v.is_finite())
-                .fold(f64::INFINITY, f64::min)
-                / box_side
-        };
-        let reason = |v: Verdict, what: &str| {
-            match v {
+        pz.hlines
+            .push((box_side, format!("smoothing box side {box_side}")));
+        pg.hlines
+            .push((box_side, format!("smoothing box side {box_side}")));
+        for (name, col) in FIELDS {
+            let lz = by_value(&zeta, pressure, &active, col)?;
+            let lg = by_value(&gamma, pressure, &GAMMAS, col)?;
+            for (x, (m, s), n) in &lz {
+                csv_z += &format!("{pressure},{x},{name},{m},{s},{n}\n");
+            }
+            for (x, (m, s), n) in &lg {
+                csv_g += &format!("{pressure},{x},{name},{m},{s},{n}\n");
+            }
+            let series = |pts: &[AtValue]| {
+                let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+                let m: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
+                let e: Vec<f64> = pts.iter().map(|p| p.1 .1).collect();
+                Series::new(format!("{name} length")).with_points(&x, &m, &e)
+            };
+            pz.series.push(series(&lz));
+            pg.series.push(series(&lg));
+            let (vz, tz) = trend(&lz, -1.0);
+            let (vg, tg) = trend(&lg, 1.0);
+            let floor = |pts: &[AtValue]| {
+                pts.iter()
+                    .map(|p| p.1 .0)
+                    .filter(|v| v.is_finite())
+                    .fold(f64::INFINITY, f64::min)
+                    / box_side
+            };
+            let reason = |v: Verdict, what: &str| {
+                match v {
             Verdict::Holds => format!("it {what} by more than two standard errors"),
             Verdict::DoesNotHold => "it moves against the claim by more than two standard errors".to_string(),
             Verdict::Inconclusive => format!("the change is within two standard errors: it neither clearly {what} nor the opposite"),
         }
-        };
-        claims.push(Claim::new(
-            format!("9.4: the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})"),
+            };
+            claims.push(Claim::new(
+            format!("9.4 ({pressure} pressure): the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})"),
             format!(
                 "{tz}; the shortest is {}× the smoothing box ({box_side})",
                 g(floor(&lz))
@@ -270,8 +301,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             vz,
             reason(vz, "shrinks"),
         ));
-        claims.push(Claim::new(
-            format!("9.4: the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
+            claims.push(Claim::new(
+            format!("9.4 ({pressure} pressure): the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
             format!(
                 "{tg}; the shortest is {}× the smoothing box ({box_side})",
                 g(floor(&lg))
@@ -279,17 +310,19 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             vg,
             reason(vg, "grows"),
         ));
+        }
+        drawn(pz.save_png(&dir.join(format!("fig3b_lengths_vs_zeta_{pressure}.png"))))?;
+        drawn(pg.save_png(&dir.join(format!("fig3c_lengths_vs_gamma_{pressure}.png"))))?;
     }
+    write_text(&dir.join("correlations.csv"), &corr_csv)?;
     write_text(&dir.join("lengths_vs_zeta.csv"), &csv_z)?;
     write_text(&dir.join("lengths_vs_gamma.csv"), &csv_g)?;
-    drawn(pz.save_png(&dir.join("fig3b_lengths_vs_zeta.png")))?;
-    drawn(pg.save_png(&dir.join("fig3c_lengths_vs_gamma.png")))?;
     let (t, from) = times(p.scale);
     let settings = format!(
-        "- Paper scene on L = 200 (240 cells, as the paper's Fig. 2a), paper pressure. ζ sweep at γ = 0.01: ζ ∈ {{{}}} (lengths for ζ ≥ {ACTIVE}); γ sweep at ζ = {ZETA_OF_GAMMA_SWEEP}: γ ∈ {{{}}}; seeds {}.\n\
+        "- Paper scene on L = 200 (240 cells, as the paper's Fig. 2a), both pressure forms. ζ sweep at γ = 0.01: ζ ∈ {{{}}} (lengths for ζ ≥ {ACTIVE}); γ sweep at ζ = {ZETA_OF_GAMMA_SWEEP}: γ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {}; a frame every 10 TU, analysed from t = {from} (the second half of the active phase).\n\
          - `monolayer analyze` on every run: v, ω and Q smoothed with a periodic {box_side}×{box_side} box (3R), their autocorrelations averaged over the frames; a length is the first minimum of the radially averaged correlation.\n\
-         - Files: `correlations.csv`, `lengths_vs_zeta.csv`, `lengths_vs_gamma.csv`, `fig3a_c_vorticity.png`, `c_velocity.png`, `c_q.png`, `fig3b_lengths_vs_zeta.png`, `fig3c_lengths_vs_gamma.png`; the runs in `../sweeps/turbulence-*`.",
+         - Files: `correlations.csv`, `lengths_vs_zeta.csv`, `lengths_vs_gamma.csv`, `fig3a_c_vorticity_*.png`, `c_velocity_*.png`, `c_q_*.png`, `fig3b_lengths_vs_zeta_*.png`, `fig3c_lengths_vs_gamma_*.png` (one per pressure form); the runs in `../sweeps/turbulence-*`.",
         ZETAS.join(", "),
         GAMMAS.join(", "),
         p.scale.seeds(),
