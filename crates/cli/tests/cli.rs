@@ -776,7 +776,8 @@ fn the_threshold_command_tabulates_a_sweep() {
     let o = bin().arg("threshold").arg(dir.path()).output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     let table = std::fs::read_to_string(dir.path().join("threshold.csv")).unwrap();
-    // The excess rate is −0.001 at ζ = 0.004 and +0.006 at 0.008: ζ_cr = 0.004 + 0.004/7.
+    // The rate is −0.005 at ζ = 0.004 and +0.002 at 0.008: the growth estimate is
+    // 0.004 + 0.004·5/7. The excess rate is −0.001 and +0.006: 0.004 + 0.004/7.
     let row: Vec<f64> = table
         .lines()
         .nth(1)
@@ -784,8 +785,13 @@ fn the_threshold_command_tabulates_a_sweep() {
         .split(',')
         .map(|v| v.parse().unwrap())
         .collect();
-    assert!((row[0] - (0.004 + 0.004 / 7.0)).abs() < 1e-15, "{table}");
-    assert_eq!(&row[1..], &[0.004, 0.008, 1.0, 2.0]);
+    assert!(
+        (row[0] - (0.004 + 0.004 * 5.0 / 7.0)).abs() < 1e-15,
+        "{table}"
+    );
+    assert_eq!(&row[1..3], &[0.004, 0.008]);
+    assert!((row[3] - (0.004 + 0.004 / 7.0)).abs() < 1e-15, "{table}");
+    assert_eq!(&row[4..], &[0.004, 0.008, 1.0, 2.0]);
 }
 
 /// `reproduce` refuses an unknown figure or scale before anything runs, naming the choices,
