@@ -369,11 +369,28 @@ fn an_earlier_run_is_not_overwritten_by_accident() {
     assert_eq!(n, 3, "frames at t = 0, 5, 10 only; the old ones are gone");
 }
 
+/// The rows of a CSV after its header, checking that it is a plain table: one header line,
+/// no comment lines, every row as long as the header (what pandas and numpy read with their
+/// defaults).
 fn csv_rows(path: &Path) -> Vec<Vec<String>> {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| !l.starts_with('#'))
+    let text = std::fs::read_to_string(path).unwrap();
+    let header = text.lines().next().unwrap_or("").split(',').count();
+    for (k, l) in text.lines().enumerate() {
+        assert!(
+            !l.starts_with('#'),
+            "{}: comment line {}",
+            path.display(),
+            k + 1
+        );
+        assert_eq!(
+            l.split(',').count(),
+            header,
+            "{}: line {}",
+            path.display(),
+            k + 1
+        );
+    }
+    text.lines()
         .skip(1)
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect()

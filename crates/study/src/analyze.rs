@@ -315,7 +315,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate"
     );
     let mut defects_csv = String::new();
-    row!(defects_csv, "# axes: x is the first lattice index, y the second, right-handed; angle in radians counterclockwise from +x (+1/2: direction of div Q; -1/2: one arm, modulo 2pi/3)");
+    // Axes and angle conventions are in the README: a comment line here would be taken for
+    // the header by pandas and numpy.
     row!(defects_csv, "frame,time,x,y,charge,angle,track");
     let mut events_csv = String::new();
     row!(events_csv, "frame,time,kind,x,y");

@@ -354,7 +354,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let mut b = Plot::new(
         "Fig. 2b: threshold against γ",
         "interface stiffness γ",
-        "ζ_cr (bar: the bracketing activities)",
+        "ζ_cr (bar: ± half the bracket)",
     );
     for pressure in PRESSURES {
         for (lx, _) in BOXES {
@@ -376,7 +376,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let mut rl = Plot::new(
         "ζ_cr against the run length (γ = 0.01)",
         "active time of the runs (TU)",
-        "ζ_cr (bar: bracket)",
+        "ζ_cr (bar: ± half the bracket)",
     );
     rl.series.extend(length_series);
     drawn(rl.save_png(&dir.join("threshold_vs_run_length.png")))?;
