@@ -89,6 +89,9 @@ import numpy as np
 f = np.load("{}/frames/frame_00000050.npz")
 phi, origin, lx_ly = f["phi"], f["origin"], f["lattice"]
 assert phi.shape == (60, 25, 25), phi.shape
+# The run's storage precision (f32 by default); widened exactly for the checks below.
+assert phi.dtype == np.float32, phi.dtype
+phi = phi.astype(np.float64)
 assert f["centre"].shape == (60, 2) and f["velocity"].shape == (60, 2) and f["area"].shape == (60,)
 assert abs(float(f["time"]) - 10.0) < 1e-9
 # The area in the frame is the sum of phi^2 over the patch.

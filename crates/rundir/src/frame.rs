@@ -14,7 +14,11 @@
 //! | `area` | `(N,)` | `Σ φ_i²` |
 //! | `shape_tensor` | `(N, 2)` | `[S_xx, S_xy]` (`S_yy = −S_xx`) |
 //! | `origin` | `(N, 2)` int64 | lattice node of each patch's element `[0, 0]` |
-//! | `phi` | `(N, nx, ny)` | `phi[i, u, v]` is `φ_i` at node `((origin_x+u) % lx, (origin_y+v) % ly)` |
+//! | `phi` | `(N, nx, ny)`, float32 or float64: the run's storage precision (`[integrator] precision`) | `phi[i, u, v]` is `φ_i` at node `((origin_x+u) % lx, (origin_y+v) % ly)` |
+//!
+//! Arrays without a type in the table are float64. Cells are in identity order (`phi[i]` is
+//! cell `i` of the scene), whatever their order in memory. `format` 1 (before issue 12) is
+//! the same layout with `phi` always float64; [`read_npz`] reads both.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -27,7 +31,11 @@ use npyz::WriterBuilder;
 use phasefield::Real;
 
 /// Version of the frame layout; `monolayer analyze` refuses frames of another version.
-pub const FRAME_FORMAT: i64 = 1;
+/// Format 2 stores `phi` in the run's precision; format 1 stored it as float64.
+pub const FRAME_FORMAT: i64 = 2;
+
+/// The frame formats this version reads.
+pub const FRAME_FORMATS_READ: std::ops::RangeInclusive<i64> = 1..=FRAME_FORMAT;
 
 /// One `.npy` array in memory.
 pub fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
@@ -106,7 +114,12 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
             ),
             (
                 "phi",
-                npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?,
+                if T::NAME == "f32" {
+                    // Exact: the values were f32 before they were widened.
+                    npy(&[n64, nx as u64, ny as u64], phi.iter().map(|&v| v as f32))?
+                } else {
+                    npy(&[n64, nx as u64, ny as u64], phi.iter().copied())?
+                },
             ),
         ])
     };
@@ -146,8 +159,8 @@ pub struct Array {
     pub data: Vec<f64>,
 }
 
-/// Reads the arrays `names` (and only those) from an `.npz` archive. Integer arrays are
-/// converted to `f64`.
+/// Reads the arrays `names` (and only those) from an `.npz` archive. Integer and float32
+/// arrays are converted to `f64` (exactly).
 ///
 /// # Errors
 /// When the file is not a readable archive or lacks one of the arrays.
@@ -183,9 +196,58 @@ pub fn read_npz(path: &Path, names: &[&str]) -> Result<Vec<Array>> {
                 .into_iter()
                 .map(|v| v as f64)
                 .collect(),
+            npyz::DType::Plain(t)
+                if t.type_char() == npyz::TypeChar::Float && t.size_field() == 4 =>
+            {
+                npy.into_vec::<f32>()
+                    .map_err(|e| bad(e.to_string()))?
+                    .into_iter()
+                    .map(f64::from)
+                    .collect()
+            }
             _ => npy.into_vec::<f64>().map_err(|e| bad(e.to_string()))?,
         };
         out.push(Array { shape, data });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A frame stores φ in the run's precision, and reads back exactly: an f32 run writes a
+    /// float32 `phi` (half the bytes) whose values widen to the tissue's own; an f64 run
+    /// writes float64.
+    #[test]
+    fn phi_is_stored_in_the_runs_precision_and_reads_back_exactly() {
+        let text =
+            "[domain]\nlx = 48\nly = 48\n[cells]\ncount = 3\nradius = 6.0\n[run]\ntime = 1\n";
+        let scene = scene::Scene::parse(text, &[]).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        fn check<T: Real>(scene: &scene::Scene, dir: &Path, dtype: &str) {
+            let tissue = scene.tissue::<T>();
+            let mut ws = Workspace::new(tissue.cells());
+            tissue.observe(&mut ws);
+            let path = write_frame(dir, &tissue, &ws).unwrap();
+            let a = read_npz(&path, &["format", "phi"]).unwrap();
+            assert_eq!(a[0].data, [FRAME_FORMAT as f64]);
+            let shape = tissue.cells().shape();
+            let mut want = vec![0.0; shape.nx * shape.ny];
+            tissue.cells().unrolled_into(0, &mut want);
+            assert_eq!(&a[1].data[..want.len()], &want[..]);
+            // The .npy header names the dtype.
+            let f = File::open(&path).unwrap();
+            let mut zip = zip::ZipArchive::new(BufReader::new(f)).unwrap();
+            let mut bytes = Vec::new();
+            zip.by_name("phi.npy")
+                .unwrap()
+                .read_to_end(&mut bytes)
+                .unwrap();
+            let header = String::from_utf8_lossy(&bytes[..128.min(bytes.len())]).to_string();
+            assert!(header.contains(dtype), "{header}");
+        }
+        check::<f32>(&scene, &dir.path().join("a"), "'<f4'");
+        check::<f64>(&scene, &dir.path().join("b"), "'<f8'");
+    }
 }

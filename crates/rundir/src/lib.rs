@@ -18,7 +18,7 @@ mod writers;
 
 use std::path::{Path, PathBuf};
 
-pub use frame::{npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT};
+pub use frame::{npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
 pub use series::{SeriesWriter, SERIES_HEADER};
 pub use writers::{add_writers, FinalToo, Written};
 

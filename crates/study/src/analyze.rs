@@ -19,7 +19,7 @@ use analysis::tracking::{TrackParams, Tracker};
 use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
-use rundir::{npy, read_npz, write_npz, Array, FRAME_FORMAT};
+use rundir::{npy, read_npz, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
 use scene::{Scene, SceneFile};
 
 /// What stops the analysis of a run, naming the file or option.
@@ -234,10 +234,12 @@ fn frame_time(path: &Path) -> Result<f64> {
         )
     })?;
     let format = a[0].data[0] as i64;
-    if format != FRAME_FORMAT {
+    if !FRAME_FORMATS_READ.contains(&format) {
         return Err(input(
             path,
-            format!("the frame has format {format}, this version reads format {FRAME_FORMAT}"),
+            format!(
+                "the frame has format {format}, this version reads formats 1 to {FRAME_FORMAT}"
+            ),
         ));
     }
     Ok(a[1].data[0])
