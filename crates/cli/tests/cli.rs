@@ -61,6 +61,22 @@ fn a_run_writes_scene_series_and_frames() {
     let scene = scene::Scene::parse(&resolved, &[]).unwrap();
     assert_eq!(scene.file().run.time, 6.0);
     assert_eq!(scene.file().integrator.margin, 12);
+    // series.csv is a plain table, and run.json says what its columns are.
+    csv_rows(&dir.path().join("series.csv"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("run.json")).unwrap())
+            .unwrap();
+    assert_eq!(json["precision"], "f32");
+    assert_eq!(json["lattice"], serde_json::json!([100, 100]));
+    assert_eq!(json["frame_format"], 2);
+    assert_eq!(json["columns"]["series.csv"]["v_rms"], "nodes/TU");
+    let header = series.lines().next().unwrap();
+    for column in header.split(',') {
+        assert!(
+            json["columns"]["series.csv"][column].is_string(),
+            "run.json has no unit for series.csv column {column}"
+        );
+    }
 }
 
 /// The README's three-line snippet, run by NumPy itself. CI installs NumPy; elsewhere the test

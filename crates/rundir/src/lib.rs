@@ -14,12 +14,14 @@
 
 mod frame;
 mod series;
+mod sidecar;
 mod writers;
 
 use std::path::{Path, PathBuf};
 
 pub use frame::{npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
 pub use series::{SeriesWriter, SERIES_HEADER};
+pub use sidecar::{write_run_json, AXES};
 pub use writers::{add_writers, FinalToo, Written};
 
 /// A file of a run directory could not be read or written.
@@ -100,6 +102,7 @@ pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
         }
         std::fs::remove_file(&series).map_err(|e| RunDirError::io("remove", &series, e))?;
         let _ = std::fs::remove_file(dir.join("scene.toml"));
+        let _ = std::fs::remove_file(dir.join("run.json"));
         let frames = dir.join("frames");
         if frames.exists() {
             std::fs::remove_dir_all(&frames).map_err(|e| RunDirError::io("remove", &frames, e))?;
@@ -108,11 +111,13 @@ pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))
 }
 
-/// Writes the resolved scene as `dir/scene.toml`.
+/// Writes the resolved scene as `dir/scene.toml`, and `dir/run.json` (what the files mean:
+/// version, precision, lattice, axes, the unit of every column).
 ///
 /// # Errors
 /// When the file cannot be written.
 pub fn write_scene(dir: &Path, scene: &scene::Scene) -> Result<()> {
     let path = dir.join("scene.toml");
-    std::fs::write(&path, scene.to_toml()).map_err(|e| RunDirError::io("write", &path, e))
+    std::fs::write(&path, scene.to_toml()).map_err(|e| RunDirError::io("write", &path, e))?;
+    sidecar::write_run_json(dir, scene)
 }

@@ -1,0 +1,88 @@
+//! `run.json`: what a run directory's tables and frames mean, for a reader without this
+//! crate: the version that wrote it, the precision, the lattice, the axes, and the unit of
+//! every column. The CSVs stay plain tables (one header line, no comments).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::frame::FRAME_FORMAT;
+use crate::series::SERIES_HEADER;
+use crate::{Result, RunDirError};
+
+/// The axes and angle conventions of every file.
+pub const AXES: &str = "x is the first lattice index, y the second, right-handed; angles in radians counterclockwise from +x; a +1/2 defect's angle is the direction of div Q, a -1/2 defect's one of its three arms (modulo 2pi/3)";
+
+/// The contents of `run.json`.
+#[derive(Debug, Clone, Serialize)]
+struct RunJson {
+    monolayer_version: &'static str,
+    frame_format: i64,
+    scene: &'static str,
+    precision: &'static str,
+    lattice: [usize; 2],
+    cells: usize,
+    axes: &'static str,
+    units: BTreeMap<&'static str, &'static str>,
+    columns: BTreeMap<&'static str, BTreeMap<&'static str, &'static str>>,
+}
+
+/// The unit of a column of `series.csv` or of the analysis tables.
+fn unit(column: &str) -> &'static str {
+    match column {
+        "step" | "frame" => "time steps",
+        "time" => "TU",
+        "zeta" => "force/length (model units)",
+        "v_rms" | "cell_speed_rms" => "nodes/TU",
+        "area_mean" | "area_min" | "area_max" => "nodes² (Σ φ²)",
+        "x" | "y" | "r" | "length" => "nodes",
+        "angle" => "radians",
+        "defect_density" => "defects per node",
+        "creation_rate" => "pair creations per node per TU",
+        _ => "dimensionless",
+    }
+}
+
+/// Writes `dir/run.json` for a run of `scene`.
+///
+/// # Errors
+/// When the file cannot be written.
+pub fn write_run_json(dir: &Path, scene: &scene::Scene) -> Result<()> {
+    let table = |header: &'static str| -> BTreeMap<&'static str, &'static str> {
+        header.split(',').map(|c| (c, unit(c))).collect()
+    };
+    let lattice = scene.lattice();
+    let json = RunJson {
+        monolayer_version: env!("CARGO_PKG_VERSION"),
+        frame_format: FRAME_FORMAT,
+        scene: "scene.toml",
+        precision: match scene.precision() {
+            mechanics::Precision::F64 => "f64",
+            _ => "f32",
+        },
+        lattice: [lattice.lx, lattice.ly],
+        cells: scene.file().cells.count,
+        axes: AXES,
+        units: [
+            ("length", "lattice nodes"),
+            ("time", "model time units (TU)"),
+            ("phi", "dimensionless, 0 outside a cell and 1 inside"),
+        ]
+        .into_iter()
+        .collect(),
+        columns: [
+            ("series.csv", table(SERIES_HEADER)),
+            ("analysis/observables.csv", table("frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate")),
+            ("analysis/defects.csv", table("frame,time,x,y,charge,angle,track")),
+            ("analysis/defect_events.csv", table("frame,time,kind,x,y")),
+            ("analysis/correlations.csv", table("r,c_velocity,c_vorticity,c_q")),
+            ("analysis/lengths.csv", table("field,length")),
+        ]
+        .into_iter()
+        .collect(),
+    };
+    let path = dir.join("run.json");
+    let text = serde_json::to_string_pretty(&json).expect("run.json always serialises");
+    std::fs::write(&path, text + "\n").map_err(|e| RunDirError::io("write", &path, e))
+}
