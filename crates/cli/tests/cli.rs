@@ -486,6 +486,49 @@ fn analyze_after_run_writes_consistent_files() {
         .unwrap();
     assert!(a.status.success(), "{}", stderr(&a));
     assert_eq!(csv_rows(&an.join("observables.csv")).len(), 3);
+    pandas_reads_every_table(dir.path());
+}
+
+/// Every CSV of a run directory loads with `pandas.read_csv(path)` and no options, with the
+/// columns `run.json` lists and one row per data line. CI installs pandas (`.ci/run`);
+/// elsewhere the check is skipped when pandas is missing.
+fn pandas_reads_every_table(run_dir: &Path) {
+    let have = Command::new("python3")
+        .args(["-c", "import pandas"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have {
+        assert!(
+            std::env::var("CI").is_err(),
+            "CI must install pandas (see .ci/run)"
+        );
+        eprintln!("pandas not installed: skipping the pandas check");
+        return;
+    }
+    let script = format!(
+        r#"
+import json, os, pandas as pd
+d = "{}"
+meta = json.load(open(os.path.join(d, "run.json")))
+for name, units in meta["columns"].items():
+    path = os.path.join(d, name)
+    df = pd.read_csv(path)
+    lines = open(path).read().splitlines()
+    assert sorted(df.columns) == sorted(units), (name, list(df.columns))
+    assert len(df) == len(lines) - 1, (name, len(df), len(lines))
+print("ok")
+"#,
+        run_dir.display()
+    );
+    let py = Command::new("python3")
+        .args(["-c", &script])
+        .output()
+        .unwrap();
+    assert!(
+        py.status.success(),
+        "{}",
+        String::from_utf8_lossy(&py.stderr)
+    );
 }
 
 /// A missing, partial or foreign run directory gets a message that says what is wrong.
