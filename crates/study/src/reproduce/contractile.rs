@@ -5,49 +5,13 @@ use std::path::Path;
 
 use render::{Plot, Series};
 
-use super::Stat;
+use super::column_stats;
 use super::{
-    drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Table,
-    Verdict,
+    drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict,
 };
 use crate::SweepError;
 
 const ZETAS: [&str; 3] = ["-0.0018", "0", "0.005"];
-
-/// The mean and spread over seeds of columns `cols` of `series.csv`, at every `every`-th row
-/// the runs share: `(time, [(mean, std); cols])`.
-pub(super) fn series_stats(
-    runs: &[&Rec],
-    cols: &[&str],
-    every: usize,
-) -> Result<Vec<(f64, Vec<Stat>)>, SweepError> {
-    let tables: Vec<Table> = runs
-        .iter()
-        .map(|r| Table::read(&r.run.join("series.csv")))
-        .collect::<Result<_, _>>()?;
-    let Some(first) = tables.first() else {
-        return Ok(Vec::new());
-    };
-    let times = first.f64s("time")?;
-    let data: Vec<Vec<Vec<f64>>> = tables
-        .iter()
-        .map(|t| {
-            cols.iter()
-                .map(|c| t.f64s(c))
-                .collect::<Result<Vec<_>, _>>()
-        })
-        .collect::<Result<_, _>>()?;
-    let rows = data.iter().map(|d| d[0].len()).min().unwrap_or(0);
-    Ok((0..rows.min(times.len()))
-        .step_by(every.max(1))
-        .map(|k| {
-            let stats = (0..cols.len())
-                .map(|c| mean_std(&data.iter().map(|d| d[c][k]).collect::<Vec<_>>()))
-                .collect();
-            (times[k], stats)
-        })
-        .collect())
-}
 
 pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
     let t = match p.scale {
@@ -90,7 +54,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             "S_rms (mean ± std over seeds)",
         );
         for z in ZETAS {
-            let st = series_stats(&of(z), &["v_rms", "s_rms"], 10)?;
+            let st = column_stats(&of(z), "series.csv", "time", &["v_rms", "s_rms"], 10)?;
             for (time, c) in &st {
                 csv += &format!(
                     "{pressure},{z},{time},{:e},{:e},{:e},{:e}\n",
@@ -126,33 +90,25 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         drawn(s.save_png(&dir.join(format!("contractile_s_rms_{pressure}.png"))))?;
 
         // The verdict: the contractile flow decays at least as the passive one, paired by seed.
-        let paired = |z: &str, f: fn(&Rec) -> f64| -> Vec<f64> {
+        // `f(run, its ζ = 0 twin)` for every run of activity z with a twin of the same seed.
+        let paired = |z: &str, f: fn(&Rec, &Rec) -> f64| -> Vec<f64> {
             of(z)
                 .iter()
                 .filter_map(|r| {
                     of("0")
                         .into_iter()
                         .find(|b| b.seed == r.seed)
-                        .map(|b| f(r) - f(b))
+                        .map(|b| f(r, b))
                 })
                 .collect()
         };
-        let ratio = |z: &str| -> Vec<f64> {
-            of(z)
-                .iter()
-                .filter_map(|r| {
-                    of("0")
-                        .into_iter()
-                        .find(|b| b.seed == r.seed)
-                        .map(|b| r.summary.v_rms / b.summary.v_rms)
-                })
-                .collect()
-        };
-        let d_rate = mean_std(&paired("-0.0018", |r| r.summary.growth_rate));
-        let d_s = mean_std(&paired("-0.0018", |r| r.summary.s_rms));
-        let v_ratio = mean_std(&ratio("-0.0018"));
-        let e_ratio = mean_std(&ratio("0.005"));
-        let e_rate = mean_std(&paired("0.005", |r| r.summary.growth_rate));
+        let rate_excess = |r: &Rec, b: &Rec| r.summary.growth_rate - b.summary.growth_rate;
+        let v_rms_ratio = |r: &Rec, b: &Rec| r.summary.v_rms / b.summary.v_rms;
+        let d_rate = mean_std(&paired("-0.0018", rate_excess));
+        let d_s = mean_std(&paired("-0.0018", |r, b| r.summary.s_rms - b.summary.s_rms));
+        let v_ratio = mean_std(&paired("-0.0018", v_rms_ratio));
+        let e_ratio = mean_std(&paired("0.005", v_rms_ratio));
+        let e_rate = mean_std(&paired("0.005", rate_excess));
         // Stable: its flow decays, ⟨r⟩ < 0, the threshold protocol's "below ζ_cr".
         let rate = mean_std(
             &of("-0.0018")
@@ -196,7 +152,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
          - Verdict from the second half of the active phase; the series every 10 TU in `contractile_series.csv`, plotted in `contractile_v_rms_*.png` and `contractile_s_rms_*.png` (one per pressure form).",
         ZETAS.join(", "),
         p.scale.seeds(),
-        p.scale.integrator().join(" ").replace("integrator.", "")
+        p.scale.integrator_name()
     );
     Ok((claims, settings))
 }

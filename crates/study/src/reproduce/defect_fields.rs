@@ -263,7 +263,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
          - σ = −P·1 − ζQ (MODEL.md §3), so the isotropic stress is −P.\n\
          - Files: `defect_fields.csv` (every crop node, both charges and forms), `fig4a_plus_*.png`, `fig4b_minus_*.png`.",
         p.scale.seeds(),
-        p.scale.integrator().join(" ").replace("integrator.", "")
+        p.scale.integrator_name()
     );
     Ok((claims, settings))
 }

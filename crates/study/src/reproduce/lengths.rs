@@ -5,10 +5,11 @@ use std::path::Path;
 
 use render::{Plot, Series};
 
+use super::column_stats;
 use super::AtValue;
 use super::{
     drawn, g, mean_std, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, SweepResult,
-    Table, Verdict,
+    Verdict,
 };
 use crate::analyze::AnalyzeOptions;
 use crate::SweepError;
@@ -195,35 +196,18 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .iter()
                 .filter(|r| r.values[0] == pressure && r.values[1] == *z)
                 .collect();
-            let tables: Vec<Table> = runs
-                .iter()
-                .map(|r| Table::read(&r.run.join("analysis/correlations.csv")))
-                .collect::<Result<_, _>>()?;
-            let Some(first) = tables.first() else {
-                continue;
-            };
-            let r = first.f64s("r")?;
             let cols = ["c_velocity", "c_vorticity", "c_q"];
-            let data: Vec<Vec<Vec<f64>>> = tables
-                .iter()
-                .map(|t| {
-                    cols.iter()
-                        .map(|c| t.f64s(c))
-                        .collect::<Result<Vec<_>, _>>()
-                })
-                .collect::<Result<_, _>>()?;
+            let rows = column_stats(&runs, "analysis/correlations.csv", "r", &cols, 1)?;
+            if rows.is_empty() {
+                continue;
+            }
+            let r: Vec<f64> = rows.iter().map(|row| row.0).collect();
             let mut stats = vec![Vec::new(); 3];
-            for k in 0..r.len() {
-                corr_csv += &format!("{pressure},{z},{}", r[k]);
-                for c in 0..3 {
-                    let s = mean_std(
-                        &data
-                            .iter()
-                            .map(|d| d[c].get(k).copied().unwrap_or(f64::NAN))
-                            .collect::<Vec<_>>(),
-                    );
+            for (rk, st) in &rows {
+                corr_csv += &format!("{pressure},{z},{rk}");
+                for (c, s) in st.iter().enumerate() {
                     corr_csv += &format!(",{:e},{:e}", s.0, s.1);
-                    stats[c].push(s);
+                    stats[c].push(*s);
                 }
                 corr_csv += "\n";
             }
@@ -326,7 +310,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         ZETAS.join(", "),
         GAMMAS.join(", "),
         p.scale.seeds(),
-        p.scale.integrator().join(" ").replace("integrator.", "")
+        p.scale.integrator_name()
     );
     Ok((claims, settings))
 }

@@ -88,6 +88,11 @@ impl Scale {
         }
     }
 
+    /// The integrator overrides as the verdicts state them, e.g. `dt=0.5 margin=16`.
+    pub fn integrator_name(self) -> String {
+        self.integrator().join(" ").replace("integrator.", "")
+    }
+
     /// Its name, as given to `--scale`.
     pub fn name(self) -> &'static str {
         match self {
@@ -485,6 +490,44 @@ impl SweepResult {
             })
             .collect()
     }
+}
+
+/// The mean and spread over the runs `runs` of the columns `cols` of their table `file`
+/// (e.g. `series.csv`), at every `every`-th row the runs share: `(value of the column
+/// `index`, [(mean, std); cols])`. Empty without runs.
+pub(crate) fn column_stats(
+    runs: &[&Rec],
+    file: &str,
+    index: &str,
+    cols: &[&str],
+    every: usize,
+) -> Result<Vec<(f64, Vec<Stat>)>, SweepError> {
+    let tables: Vec<Table> = runs
+        .iter()
+        .map(|r| Table::read(&r.run.join(file)))
+        .collect::<Result<_, _>>()?;
+    let Some(first) = tables.first() else {
+        return Ok(Vec::new());
+    };
+    let times = first.f64s(index)?;
+    let data: Vec<Vec<Vec<f64>>> = tables
+        .iter()
+        .map(|t| {
+            cols.iter()
+                .map(|c| t.f64s(c))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .collect::<Result<_, _>>()?;
+    let rows = data.iter().map(|d| d[0].len()).min().unwrap_or(0);
+    Ok((0..rows.min(times.len()))
+        .step_by(every.max(1))
+        .map(|k| {
+            let stats = (0..cols.len())
+                .map(|c| mean_std(&data.iter().map(|d| d[c][k]).collect::<Vec<_>>()))
+                .collect();
+            (times[k], stats)
+        })
+        .collect())
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use render::{Plot, Series};
 use super::{
     drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict,
 };
-use crate::threshold::{growth_threshold, threshold, RatePoint, Threshold};
+use crate::threshold::{csv_fields, growth_threshold, threshold, RatePoint, Threshold};
 use crate::SweepError;
 
 const ZETAS: &str = "0,0.001,0.0015,0.002,0.0025,0.003,0.004,0.006,0.008";
@@ -137,14 +137,6 @@ fn bracket(t: Threshold) -> (f64, f64, f64) {
     }
 }
 
-fn num(v: f64) -> String {
-    if v.is_finite() {
-        v.to_string()
-    } else {
-        String::new()
-    }
-}
-
 /// A least-squares line `y = a + b x`: `(a, b, largest |residual|)`.
 fn line(x: &[f64], y: &[f64]) -> (f64, f64, f64) {
     let b = crate::summary::slope(x, y);
@@ -161,7 +153,7 @@ fn line(x: &[f64], y: &[f64]) -> (f64, f64, f64) {
 pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
     let t = run_time(p.scale);
     let integ = p.scale.integrator();
-    let integ_name = integ.join(" ").replace("integrator.", "");
+    let integ_name = p.scale.integrator_name();
     let mut all: Vec<Group> = Vec::new();
     let mut long_recs: Vec<(usize, Vec<Rec>, super::SweepResult)> = Vec::new();
     for (lx, count) in BOXES {
@@ -207,10 +199,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 analyze: None,
             },
         )?;
-        let name = Scale::Paper
-            .integrator()
-            .join(" ")
-            .replace("integrator.", "");
+        let name = Scale::Paper.integrator_name();
         compare = groups(&res.records(None)?, 100, &name, false);
     }
     p.reporter.stage("threshold: tables and plots");
@@ -220,19 +209,13 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         "gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities,run_time,integrator\n",
     );
     for gr in all.iter().chain(&compare) {
-        let (z, lo, hi) = bracket(gr.threshold);
-        let (ze, loe, hie) = bracket(gr.excess);
         csv += &format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{t},{}\n",
+            "{},{},{},{},{},{},{},{t},{}\n",
             gr.gamma,
             gr.lx,
             gr.pressure,
-            num(z),
-            num(lo),
-            num(hi),
-            num(ze),
-            num(loe),
-            num(hie),
+            csv_fields(gr.threshold).join(","),
+            csv_fields(gr.excess).join(","),
             gr.seeds,
             gr.zetas.len() - 1,
             gr.integrator
@@ -273,19 +256,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             let tt = t * frac;
             let recs = res.records(Some(tt))?;
             for gr in groups(&recs, *lx, &integ_name, true) {
-                let (z, lo, hi) = bracket(gr.threshold);
-                let (ze, loe, hie) = bracket(gr.excess);
                 by_length += &format!(
-                    "{tt},{},{lx},{},{},{},{},{},{},{}\n",
+                    "{tt},{},{lx},{},{},{}\n",
                     gr.gamma,
                     gr.pressure,
-                    num(z),
-                    num(lo),
-                    num(hi),
-                    num(ze),
-                    num(loe),
-                    num(hie)
+                    csv_fields(gr.threshold).join(","),
+                    csv_fields(gr.excess).join(",")
                 );
+                let (z, lo, hi) = bracket(gr.threshold);
                 if gr.gamma == 0.01 {
                     let label = format!("L = {lx}, {} pressure", gr.pressure);
                     let (mid, half) = mid_half(z, lo, hi);
