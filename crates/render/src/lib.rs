@@ -30,13 +30,19 @@
 #![deny(missing_docs)]
 
 mod heatmap;
+mod movie;
 mod plot;
+mod raster;
+mod tissue;
 
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
 pub use heatmap::{save_heatmaps, Heatmap};
+pub use movie::{Movie, MovieKind};
 pub use plot::{LegendAt, Plot, Series};
+pub use raster::Picture;
+pub use tissue::{CellAxes, Fill, LatticeVectors, Patches, TissuePicture, MINUS, PLUS};
 
 /// What stops a picture from being drawn, naming the file.
 #[derive(Debug, thiserror::Error)]
