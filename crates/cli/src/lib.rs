@@ -4,10 +4,12 @@
 //! validates scene files and builds the simulation, the `rundir` crate writes (and reads
 //! back) the files of a run directory; [`run`] runs a scene with a progress report,
 //! [`sweep`] runs a scene over a grid of values and seeds (the `study` crate), [`reproduce`]
-//! makes the paper's figures with a verdict on each claim, and
-//! `study::analyze` turns a run into the paper's quantities. Only this crate prints.
+//! makes the paper's figures with a verdict on each claim,
+//! `study::analyze` turns a run into the paper's quantities, and [`view`] reports the
+//! progress of `study::view`'s pictures and ParaView files. Only this crate prints.
 #![deny(missing_docs)]
 
 pub mod reproduce;
 pub mod run;
 pub mod sweep;
+pub mod view;

@@ -1,4 +1,5 @@
-//! The `monolayer` binary: `monolayer run SCENE --out DIR`.
+//! The `monolayer` binary: `monolayer run SCENE --out DIR`, and the commands that sweep,
+//! analyse, reproduce, draw and export runs.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -9,6 +10,7 @@ use monolayer_cli::run;
 use monolayer_cli::sweep::{SweepAction, SweepOutcome};
 use scene::Scene;
 use study::analyze::{analyze, AnalyzeOptions};
+use study::view::{export_vtk, render_run, RenderOptions};
 
 /// Multi-phase-field simulations of cell monolayers (Mueller, Yeomans & Doostmohammadi, PRL 2019).
 #[derive(Parser)]
@@ -119,6 +121,62 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Draw the frames of a run directory: one PNG per frame (each cell's contour φ_i = 1/2,
+    /// filled by a quantity with a colour bar; on request the director, the ±1/2 defects, the
+    /// flow and the deformation axes), and optionally a movie.
+    Render {
+        /// A directory written by `monolayer run`.
+        run_dir: PathBuf,
+        /// The directory of the PNGs (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// `all`, or steps such as `0,500,1000` (the numbers in frames/frame_STEP.npz).
+        #[arg(long, default_value = "all")]
+        frames: String,
+        /// What fills the cells: none, velocity, pressure, area, deformation or id.
+        #[arg(long, default_value = "none")]
+        colour: String,
+        /// The director of the smoothed Q, as short segments.
+        #[arg(long)]
+        director: bool,
+        /// The ±1/2 defects of the smoothed Q: a comet for +1/2 (tail along its orientation),
+        /// three arms for -1/2.
+        #[arg(long)]
+        defects: bool,
+        /// Arrows of the velocity field.
+        #[arg(long)]
+        flow: bool,
+        /// Each cell's principal deformation axis (with --colour none: the paper's Fig. 1b).
+        #[arg(long)]
+        axes: bool,
+        /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
+        #[arg(long)]
+        size: Option<u32>,
+        /// The colour bar's range `LOW,HIGH` (default: each frame's own; fix it for movies).
+        #[arg(long, value_name = "LOW,HIGH")]
+        range: Option<String>,
+        /// Also a movie of the frames: FILE.gif or FILE.apng (pure Rust) or FILE.mp4 (needs
+        /// ffmpeg on the PATH).
+        #[arg(long)]
+        movie: Option<PathBuf>,
+        /// Frames per second of the movie.
+        #[arg(long, default_value_t = 5.0)]
+        fps: f64,
+        /// With --movie: no PNG per frame.
+        #[arg(long, requires = "movie")]
+        no_pngs: bool,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Write a run directory as files other programs open.
+    Export {
+        #[command(subcommand)]
+        format: ExportFormat,
+    },
     /// Analyse a run directory: observables, correlations, defects and defect-centred
     /// averages, written into RUN_DIR/analysis/.
     Analyze {
@@ -145,6 +203,29 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+    },
+}
+
+#[derive(Subcommand)]
+enum ExportFormat {
+    /// ParaView: one ImageData .vti per frame (phi_sum, cell_id, velocity, Q, director,
+    /// pressure, stress), one PolyData .vtp of the cell centres per frame, and .pvd time series
+    /// of both.
+    Vtk {
+        /// A directory written by `monolayer run`.
+        run_dir: PathBuf,
+        /// The directory of the files (default: RUN_DIR/vtk).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// `all`, or steps such as `0,500,1000`.
+        #[arg(long, default_value = "all")]
+        frames: String,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress output.
+        #[arg(long, short)]
+        quiet: bool,
     },
 }
 
@@ -303,6 +384,89 @@ fn real_main() -> Result<()> {
             eprintln!("written to {}", out.display());
             Ok(())
         }
+        Command::Render {
+            run_dir,
+            out,
+            frames,
+            colour,
+            director,
+            defects,
+            flow,
+            axes,
+            size,
+            range,
+            movie,
+            fps,
+            no_pngs,
+            threads,
+            quiet,
+        } => {
+            let range = range
+                .map(|r| {
+                    let v: Vec<f64> = r.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+                    match v[..] {
+                        [lo, hi] => Ok((lo, hi)),
+                        _ => Err(anyhow::anyhow!(
+                            "--range {r}: give two numbers LOW,HIGH, e.g. --range 0,0.01"
+                        )),
+                    }
+                })
+                .transpose()?;
+            let opts = RenderOptions {
+                frames: frames.parse().map_err(anyhow::Error::msg)?,
+                colour: colour.parse().map_err(anyhow::Error::msg)?,
+                director,
+                defects,
+                flow,
+                axes,
+                size,
+                range,
+                movie,
+                fps,
+                pngs: !no_pngs,
+            };
+            let mut progress = monolayer_cli::view::frames_progress("drawn", quiet);
+            let info =
+                pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
+            if !quiet {
+                note_partial(info.partial);
+                match &opts.movie {
+                    Some(m) => eprintln!(
+                        "drew {} frames into {} and {}",
+                        info.frames,
+                        out.display(),
+                        m.display()
+                    ),
+                    None => eprintln!("drew {} frames into {}", info.frames, out.display()),
+                }
+            }
+            Ok(())
+        }
+        Command::Export {
+            format:
+                ExportFormat::Vtk {
+                    run_dir,
+                    out,
+                    frames,
+                    threads,
+                    quiet,
+                },
+        } => {
+            let out = out.unwrap_or_else(|| run_dir.join("vtk"));
+            let frames = frames.parse().map_err(anyhow::Error::msg)?;
+            let mut progress = monolayer_cli::view::frames_progress("exported", quiet);
+            let info =
+                pool(threads)?.install(|| export_vtk(&run_dir, &out, &frames, &mut progress))?;
+            if !quiet {
+                note_partial(info.partial);
+                eprintln!(
+                    "exported {} frames; open {} (and cells.pvd) in ParaView",
+                    info.frames,
+                    out.join("fields.pvd").display()
+                );
+            }
+            Ok(())
+        }
         Command::Analyze {
             run_dir,
             from,
@@ -322,9 +486,7 @@ fn real_main() -> Result<()> {
                 s_rms_baseline,
             };
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
-            if info.partial > 0 {
-                eprintln!("note: skipped {} partially written frame(s)", info.partial);
-            }
+            note_partial(info.partial);
             eprintln!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,
@@ -334,6 +496,12 @@ fn real_main() -> Result<()> {
             );
             Ok(())
         }
+    }
+}
+
+fn note_partial(partial: usize) {
+    if partial > 0 {
+        eprintln!("note: skipped {partial} partially written frame(s)");
     }
 }
 

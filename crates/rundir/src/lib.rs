@@ -7,6 +7,8 @@
 //! | `scene.toml` | [`prepare`] and [`write_scene`]: the resolved scene, every default filled in |
 //! | `series.csv` | [`SeriesWriter`], one row every `series_every` steps ([`SERIES_HEADER`]) |
 //! | `frames/frame_STEP.npz` | [`write_frame`], NumPy archives `numpy.load` reads as they are |
+//! | `run.json` | [`write_scene`]: version, precision, axes, the unit of every column |
+//! | `vtk/*.vti`, `*.vtp`, `*.pvd` | [`vtk`]: ParaView files (by `monolayer export vtk`) |
 //!
 //! [`add_writers`] adds the series and frame writers to a [`mechanics::Simulation`];
 //! [`read_npz`] reads frames back. Errors name the file ([`RunDirError`]).
@@ -15,6 +17,7 @@
 mod frame;
 mod series;
 mod sidecar;
+pub mod vtk;
 mod writers;
 
 use std::path::{Path, PathBuf};

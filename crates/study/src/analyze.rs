@@ -50,7 +50,7 @@ pub enum AnalyzeError {
 
 type Result<T, E = AnalyzeError> = std::result::Result<T, E>;
 
-fn input(path: &Path, why: impl Into<String>) -> AnalyzeError {
+pub(crate) fn input(path: &Path, why: impl Into<String>) -> AnalyzeError {
     AnalyzeError::Input {
         path: path.to_path_buf(),
         why: why.into(),
@@ -115,7 +115,7 @@ pub struct AnalyzeInfo {
 }
 
 /// The frames of a run directory, in step order, and how many partial files were skipped.
-fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
+pub(crate) fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
     let dir = run_dir.join("frames");
     let entries = std::fs::read_dir(&dir)
         .map_err(|_| input(run_dir, "no frames/ directory: the run wrote no frame yet"))?;
@@ -137,7 +137,7 @@ fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
 }
 
 /// Reads the run's resolved scene.
-fn read_scene(run_dir: &Path) -> Result<Scene> {
+pub(crate) fn read_scene(run_dir: &Path) -> Result<Scene> {
     if !run_dir.is_dir() {
         return Err(input(run_dir, "no run directory there"));
     }
@@ -157,13 +157,31 @@ fn read_scene(run_dir: &Path) -> Result<Scene> {
     file.validate().map_err(|e| input(&path, e.to_string()))
 }
 
+/// One frame as it was written, and its state rebuilt as a tissue.
+pub(crate) struct LoadedFrame {
+    pub tissue: Tissue,
+    pub step: u64,
+    /// The patch origins, `N × 2`.
+    pub origins: Vec<[usize; 2]>,
+    /// `φ`, `N × nx × ny`, as the frame stores it.
+    pub phi: Vec<f64>,
+    pub shapes: Vec<[f64; 2]>,
+    pub centres: Vec<[f64; 2]>,
+    pub velocities: Vec<[f64; 2]>,
+    pub areas: Vec<f64>,
+}
+
+fn pairs(a: &Array) -> Vec<[f64; 2]> {
+    a.data.chunks_exact(2).map(|s| [s[0], s[1]]).collect()
+}
+
 /// One frame's state, rebuilt as a tissue.
-fn load_frame(
+pub(crate) fn load_frame(
     path: &Path,
     scene: &Scene,
     shape: &PatchShape,
     lattice: Lattice,
-) -> Result<(Tissue, Vec<[f64; 2]>, u64)> {
+) -> Result<LoadedFrame> {
     // The format was checked when the frame was selected (`frame_time`).
     let arrays = read_npz(
         path,
@@ -175,6 +193,9 @@ fn load_frame(
             "origin",
             "phi",
             "shape_tensor",
+            "centre",
+            "velocity",
+            "area",
         ],
     )
     .map_err(|e| {
@@ -183,9 +204,10 @@ fn load_frame(
             format!("the frame was written by another version or is damaged: {e}"),
         )
     })?;
-    let [step, time, zeta, lat, origin, phi, shape_tensor]: [Array; 7] = arrays
-        .try_into()
-        .expect("read_npz returns one array per name");
+    let [step, time, zeta, lat, origin, phi, shape_tensor, centre, velocity, area]: [Array; 10] =
+        arrays
+            .try_into()
+            .expect("read_npz returns one array per name");
     let (step, time, zeta) = (step.data[0] as u64, time.data[0], zeta.data[0]);
     if lat.data != [lattice.lx as f64, lattice.ly as f64] {
         return Err(input(
@@ -204,17 +226,26 @@ fn load_frame(
             format!("phi has shape {:?}, the scene implies {want:?}", phi.shape),
         ));
     }
+    for (name, a, len) in [
+        ("origin", &origin, 2 * n),
+        ("shape_tensor", &shape_tensor, 2 * n),
+        ("centre", &centre, 2 * n),
+        ("velocity", &velocity, 2 * n),
+        ("area", &area, n),
+    ] {
+        if a.data.len() != len {
+            return Err(input(
+                path,
+                format!("{name} has {} values for {n} cells", a.data.len()),
+            ));
+        }
+    }
     let origins: Vec<[usize; 2]> = origin
         .data
         .chunks_exact(2)
         .map(|o| [o[0] as usize, o[1] as usize])
         .collect();
     let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &phi.data);
-    let shapes: Vec<[f64; 2]> = shape_tensor
-        .data
-        .chunks_exact(2)
-        .map(|s| [s[0], s[1]])
-        .collect();
     let tissue = Tissue::from_state(
         cells,
         scene.model_params(zeta),
@@ -222,11 +253,20 @@ fn load_frame(
         step,
         (0..n).collect(),
     );
-    Ok((tissue, shapes, step))
+    Ok(LoadedFrame {
+        tissue,
+        step,
+        origins,
+        phi: phi.data,
+        shapes: pairs(&shape_tensor),
+        centres: pairs(&centre),
+        velocities: pairs(&velocity),
+        areas: area.data,
+    })
 }
 
 /// The time of a frame, after checking that this version can read it.
-fn frame_time(path: &Path) -> Result<f64> {
+pub(crate) fn frame_time(path: &Path) -> Result<f64> {
     let a = read_npz(path, &["format", "time"]).map_err(|e| {
         input(
             path,
@@ -247,7 +287,7 @@ fn frame_time(path: &Path) -> Result<f64> {
 
 /// Writes `text` to `path` whole: under a temporary name first, so that an error leaves no
 /// empty or truncated table behind.
-fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension("partial");
     let err = |source| AnalyzeError::Write {
         path: path.to_path_buf(),
@@ -340,7 +380,12 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
     for path in &selected {
-        let (tissue, shapes, step) = load_frame(path, &scene, &shape, lattice)?;
+        let LoadedFrame {
+            tissue,
+            shapes,
+            step,
+            ..
+        } = load_frame(path, &scene, &shape, lattice)?;
         let ws = ws.get_or_insert_with(|| Workspace::new(tissue.cells()));
         let f = tissue.fields(ws);
         let smooth = |v: &[f64]| box_smooth(lattice, v, box_side).expect("checked above");

@@ -49,6 +49,7 @@ mod spec;
 pub mod summary;
 mod sweep;
 pub mod threshold;
+pub mod view;
 
 use std::path::PathBuf;
 

@@ -1,0 +1,37 @@
+//! `monolayer render` and `monolayer export vtk`: a progress report around
+//! `study::view::{render_run, export_vtk}`.
+
+use std::io::IsTerminal;
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// A progress report of frames: a bar on a terminal, a line about every 10 % otherwise,
+/// nothing when `quiet`. Call it with `(done, total)`.
+pub fn frames_progress(what: &'static str, quiet: bool) -> impl FnMut(usize, usize) {
+    let mut bar: Option<ProgressBar> = None;
+    let mut next_line = 0;
+    move |done, total| {
+        if quiet {
+            return;
+        }
+        if std::io::stderr().is_terminal() {
+            let b = bar.get_or_insert_with(|| {
+                let b = ProgressBar::new(total as u64);
+                b.set_style(
+                    ProgressStyle::with_template(&format!(
+                        "{{bar:40}} {{pos}}/{{len}} frames {what}  [{{elapsed_precise}} < {{eta_precise}}]"
+                    ))
+                    .expect("valid template"),
+                );
+                b
+            });
+            b.set_position(done as u64);
+            if done == total {
+                b.finish();
+            }
+        } else if done >= next_line || done == total {
+            eprintln!("{done}/{total} frames {what}");
+            next_line = done + total.div_ceil(10).max(1);
+        }
+    }
+}
