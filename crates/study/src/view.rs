@@ -419,11 +419,6 @@ pub fn render_run(
         let frame = run.load(path)?;
         let ws = ws.get_or_insert_with(|| Workspace::new(frame.tissue.cells()));
         let pic = picture(&run, &frame, ws, opts)?.draw()?;
-        if opts.pngs {
-            let png = out.join(format!("frame_{:08}.png", frame.step));
-            pic.save_png(&png)?;
-            files.push(png);
-        }
         if let Some(m) = &opts.movie {
             if movie.is_none() {
                 movie = Some(Movie::create(
@@ -435,6 +430,13 @@ pub fn render_run(
                 )?);
             }
             movie.as_mut().expect("created").push(&pic)?;
+        }
+        // After the movie has started, so that a movie that cannot be made (no ffmpeg)
+        // stops the render before anything is written.
+        if opts.pngs {
+            let png = out.join(format!("frame_{:08}.png", frame.step));
+            pic.save_png(&png)?;
+            files.push(png);
         }
         progress(k + 1, total);
     }
