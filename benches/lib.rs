@@ -1,5 +1,5 @@
 //! Shared set-up of the criterion benchmarks and studies in this package (`step.rs`,
-//! `analysis.rs`, `work_precision.rs`, `stability.rs`).
+//! `analysis.rs`, `work_precision.rs`, `stability.rs`, `view.rs`).
 
 use mechanics::{ModelParams, StepParams, Tissue, Workspace};
 use phasefield::{init, Lattice, PatchShape, Real};
