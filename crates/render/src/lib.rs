@@ -4,14 +4,42 @@
 //! DejaVu Sans, bundled in the crate (`fonts/`, with its licence), so nothing needs
 //! fontconfig.
 //!
-//! Today it draws the figures of `monolayer reproduce`:
+//! - [`TissuePicture`]: a tissue state, each cell's contour `φ_i = ½` filled by a quantity
+//!   ([`Fill`]) on a colour bar, with on request the director, the ±½ defects, the flow and the
+//!   deformation axes; → [`Picture`] → PNG, or one frame of a [`Movie`] (GIF, APNG, MP4);
 //! - [`Plot`]: a line plot of [`Series`] with vertical error bars (the seed spread), axis
 //!   labels, an optional logarithmic axis and a legend;
 //! - [`Heatmap`]: a lattice slice (row `u`, column `v`) in a diverging colour map with a
 //!   colour bar, optionally with arrows of a vector field, several to a picture
 //!   ([`save_heatmaps`]).
 //!
-//! Both draw from plain slices, so they serve measured fields as well as simulated ones.
+//! All draw from plain slices, so they serve measured fields as well as simulated ones. A
+//! director field measured in an experiment, with its defects, and no cells:
+//!
+//! ```
+//! use analysis::defects::detect;
+//! use phasefield::Lattice;
+//! use render::{LatticeVectors, TissuePicture};
+//!
+//! // A +1/2 defect at the centre of a 32 × 32 field: director angle θ = φ/2.
+//! let (lx, ly) = (32, 32);
+//! let (mut qxx, mut qxy) = (vec![0.0; lx * ly], vec![0.0; lx * ly]);
+//! for x in 0..lx {
+//!     for y in 0..ly {
+//!         let phi = (y as f64 - 16.5).atan2(x as f64 - 16.5);
+//!         (qxx[x * ly + y], qxy[x * ly + y]) = (phi.cos(), phi.sin());
+//!     }
+//! }
+//! let mut p = TissuePicture::new(lx, ly, 256);
+//! p.defects = detect(Lattice::new(lx, ly), &qxx, &qxy);
+//! p.director = Some(LatticeVectors { a: qxx, b: qxy, every: 2 });
+//! p.title = "measured director".into();
+//! let dir = tempfile::tempdir()?;
+//! p.draw()?.save_png(&dir.path().join("director.png"))?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! A line plot:
 //!
 //! ```
 //! use render::{Plot, Series};
