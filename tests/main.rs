@@ -1,6 +1,7 @@
 //! One integration-test binary for the whole workspace, with topical modules.
 
 mod analysis_tests;
+mod guard_tests;
 mod mechanics_tests;
 mod patch_tests;
 mod phasefield_tests;

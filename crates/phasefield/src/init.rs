@@ -94,9 +94,11 @@ pub fn positions(
             let min_dist = 2.0 * disc_radius;
             // Accepted centres binned in a grid of bins at least min_dist wide: a candidate
             // is checked against the 3 × 3 bins around it only, so placement is O(N).
+            // Wider bins are still correct; at most about 4N bins, whatever the radius.
+            let most = 2 * ((n_cells as f64).sqrt().ceil() as usize) + 1;
             let (bx, by) = (
-                ((lattice.lx as f64 / min_dist).floor() as usize).max(1),
-                ((lattice.ly as f64 / min_dist).floor() as usize).max(1),
+                ((lattice.lx as f64 / min_dist).floor() as usize).clamp(1, most),
+                ((lattice.ly as f64 / min_dist).floor() as usize).clamp(1, most),
             );
             let mut bins: Vec<Vec<usize>> = vec![Vec::new(); bx * by];
             let bin_of = |p: [f64; 2]| -> (usize, usize) {

@@ -37,7 +37,7 @@ mod file;
 mod validate;
 
 pub use file::{CellsSpec, Domain, InitKind, Integrator, Model, Run, SceneFile};
-pub use validate::SceneError;
+pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
 use mechanics::{ModelParams, Precision, Simulation, StepParams, Tissue};
 use phasefield::{init, Lattice, PatchShape, Real};
@@ -101,6 +101,29 @@ impl Scene {
     /// The patch shape.
     pub fn patch_shape(&self) -> PatchShape {
         PatchShape::new(self.lattice(), self.file.integrator.margin).expect("validated")
+    }
+
+    /// An estimate of the memory a run of this scene needs at its peak, in bytes, computed
+    /// from the scene alone (nothing is allocated): with `N` cells of `p` patch nodes, `b`
+    /// bytes per stored value (4 in f32, 8 in f64) and `L` lattice nodes,
+    ///
+    /// `N p (4b + 16) + 64 L + 1024 N + 16 MiB`:
+    ///
+    /// the fields and the three stage buffers of the step (`4b` per patch node), the f64 discs
+    /// of the initial state or the f64 copy a frame is written from (`16`), the seven f64
+    /// lattice sums of the step and the flow (`64` per node, with their stripe index), the
+    /// per-cell state, and the program itself. It bounds `Tissue::heap_bytes` +
+    /// `Workspace::heap_bytes` from above (tested), so a scene it refuses could not have run.
+    pub fn memory_estimate(&self) -> f64 {
+        let n = self.file.cells.count as f64;
+        let shape = self.patch_shape();
+        let p = (shape.nx * shape.ny) as f64;
+        let b = match self.precision() {
+            Precision::F32 => 4.0,
+            Precision::F64 => 8.0,
+        };
+        let l = self.lattice().len() as f64;
+        n * p * (4.0 * b + 16.0) + 64.0 * l + 1024.0 * n + 16.0 * 1024.0 * 1024.0
     }
 
     /// The storage precision of the fields.

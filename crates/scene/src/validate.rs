@@ -29,6 +29,22 @@ pub enum SceneError {
     },
 }
 
+/// The longest lattice side [`SceneFile::validate`] accepts.
+pub const MAX_SIDE: usize = 65536;
+
+/// The most steps a run may take (relaxation and activity together): 10⁹, days of wall time
+/// for the smallest scenes, and far below where the step counter or the clock lose precision.
+pub const MAX_STEPS: f64 = 1e9;
+
+/// `v` with three significant digits, never rounded to 0.
+fn sig3(v: f64) -> String {
+    if v != 0.0 && !(0.01..1e4).contains(&v.abs()) {
+        format!("{v:.2e}")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
 fn invalid(
     section: &'static str,
     key: &'static str,
@@ -63,6 +79,15 @@ impl SceneFile {
                     "use at least 8 nodes per side (the paper uses 100)",
                 ));
             }
+            if v > MAX_SIDE {
+                return Err(invalid(
+                    "domain",
+                    key,
+                    v,
+                    format!("a side of more than {MAX_SIDE} nodes cannot be simulated (a {MAX_SIDE}² lattice alone takes tens of GB)"),
+                    "use at most 65536 nodes per side (the paper uses 100; 3840 cells fit in 800²)",
+                ));
+            }
         }
         let c = &self.cells;
         if c.count == 0 {
@@ -84,14 +109,37 @@ impl SceneFile {
             ));
         }
         let r0 = self.init_radius();
-        if !(r0.is_finite() && r0 > 0.0 && r0 <= c.radius) {
+        if !(r0.is_finite() && r0 >= 1.0 && r0 <= c.radius) {
             return Err(invalid(
                 "cells",
                 "init_radius",
                 r0,
-                "the initial disc radius must be positive and at most the radius",
-                "leave it out (default R/2) or choose a value in (0, radius]",
+                "the initial disc radius must be at least one node (a smaller disc covers no node) and at most the radius",
+                format!(
+                    "leave it out (default R/2) or choose a value in [1, {}]",
+                    c.radius
+                ),
             ));
+        }
+        if c.radius.is_finite() && c.radius < 1.0 {
+            return Err(invalid(
+                "cells",
+                "radius",
+                c.radius,
+                "a cell smaller than one node cannot be resolved",
+                "use a radius of a few nodes (paper: 8)",
+            ));
+        }
+        if let (InitKind::Positions, Some(p)) = (c.init, &c.positions) {
+            if p.len() != c.count {
+                return Err(invalid(
+                    "cells",
+                    "positions",
+                    format!("[{} pairs]", p.len()),
+                    format!("count = {} cells but {} positions", c.count, p.len()),
+                    "give one [x, y] pair per cell, or set count to the number of positions",
+                ));
+            }
         }
         match (c.init, &c.positions) {
             (InitKind::Positions, None) => {
@@ -164,7 +212,11 @@ impl SceneFile {
             ));
         }
         if let Some(dt_max) = self.dt_above_estimate().filter(|_| it.stability_check) {
-            return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {dt_max:.3} for these parameters (a conservative estimate; docs/stability.csv)"), format!("use dt ≤ {dt_max:.3} (the paper uses 0.2), or set [integrator] stability_check = false to run above the estimate at your own risk")));
+            if dt_max <= 0.0 {
+                // γ = 0 with activity: nothing damps the advected interfaces at any dt.
+                return Err(invalid("model", "gamma", m.gamma, format!("with zeta = {} and no line tension the explicit scheme is unstable at any dt (the activity limit of docs/stability.csv is proportional to gamma)", m.zeta), "use gamma > 0 (the paper uses 0.01), set zeta = 0, or set [integrator] stability_check = false to run at your own risk"));
+            }
+            return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {} for these parameters (a conservative estimate; docs/stability.csv)", sig3(dt_max)), format!("use dt ≤ {} (the paper uses 0.2), or set [integrator] stability_check = false to run above the estimate at your own risk", sig3(dt_max))));
         }
         if it.npc > 16 {
             return Err(invalid(
@@ -211,6 +263,28 @@ impl SceneFile {
                     "give the time in model units (paper: 0.2 per step)",
                 ));
             }
+        }
+        let steps = (r.relax_time + r.time) / it.dt;
+        if steps > MAX_STEPS {
+            let (key, v) = if r.relax_time > r.time {
+                ("relax_time", r.relax_time)
+            } else {
+                ("time", r.time)
+            };
+            return Err(invalid(
+                "run",
+                key,
+                v,
+                format!(
+                    "relax_time + time = {} at dt = {} is {steps:.3e} steps, more than the {MAX_STEPS:.0e} a run may take",
+                    r.relax_time + r.time,
+                    it.dt
+                ),
+                format!(
+                    "shorten the run (at most {} TU at this dt) or raise [integrator] dt",
+                    sig3(MAX_STEPS * it.dt)
+                ),
+            ));
         }
         for (key, v) in [
             ("output_every", Some(r.output_every)),
