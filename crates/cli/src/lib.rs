@@ -9,6 +9,7 @@
 //! progress of `study::view`'s pictures and ParaView files. Only this crate prints.
 #![deny(missing_docs)]
 
+pub mod guard;
 pub mod reproduce;
 pub mod run;
 pub mod sweep;

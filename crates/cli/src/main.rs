@@ -41,6 +41,10 @@ enum Command {
         /// Replace the results of an earlier run in the output directory.
         #[arg(long)]
         overwrite: bool,
+        /// Refuse scenes whose memory estimate exceeds this, e.g. `8G` or `512M` (default:
+        /// the memory available on this machine).
+        #[arg(long, value_name = "BYTES")]
+        max_memory: Option<String>,
     },
     /// Run a scene over a grid of values and seeds: each point an ordinary run directory under
     /// OUT/runs/, and OUT/summary.csv with one row per run. A second call with the same
@@ -249,10 +253,13 @@ fn real_main() -> Result<()> {
             set,
             quiet,
             overwrite,
+            max_memory,
         } => {
             let text = std::fs::read_to_string(&scene)
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
             let parsed = Scene::parse(&text, &set)
+                .with_context(|| format!("in scene {}", scene.display()))?;
+            monolayer_cli::guard::memory(&parsed, max_memory.as_deref())
                 .with_context(|| format!("in scene {}", scene.display()))?;
             rundir::prepare(&out, overwrite)?;
             let pool = pool(threads)?;
@@ -508,8 +515,7 @@ fn note_partial(partial: usize) {
 fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(n) = threads {
-        anyhow::ensure!(n >= 1, "--threads must be at least 1");
-        pool = pool.num_threads(n);
+        pool = pool.num_threads(monolayer_cli::guard::threads(n)?);
     }
     Ok(pool.build()?)
 }

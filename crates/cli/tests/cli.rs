@@ -291,6 +291,32 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
     );
     let (ok, err, _d) = run_text(GOOD, &[]);
     assert!(ok, "the good scene runs: {err}");
+    // Guards before work (issue 13): a scene over the memory limit is refused with its
+    // estimate and the keys to change; a thread count beyond the cores is capped, not an
+    // error, since results do not depend on it.
+    let (ok, err, dir) = run_text(GOOD, &["--max-memory", "1M"]);
+    assert!(!ok, "over --max-memory must fail");
+    for n in [
+        "needs about",
+        "60 cell(s) of 33×33 patch nodes",
+        "--max-memory 1M",
+        "[cells] count",
+    ] {
+        assert!(err.contains(n), "{err:?} lacks {n:?}");
+    }
+    assert!(!dir.path().join("out/series.csv").exists());
+    let (ok, err, _d) = run_text(GOOD, &["--max-memory", "lots"]);
+    assert!(!ok && err.contains("give a size such as 8G"), "{err}");
+    let (ok, err, _d) = run_text(
+        GOOD,
+        &["--set", "domain.lx=20000", "--set", "domain.ly=20000"],
+    );
+    assert!(
+        !ok && err.contains("needs about") && !err.contains("panicked"),
+        "{err}"
+    );
+    let (ok, err, _d) = run_text(GOOD, &["--threads", "100000"]);
+    assert!(ok && err.contains("capped at the"), "{err}");
 }
 
 /// A run that blows up stops with an error naming the step and the cell, exits non-zero and
@@ -550,6 +576,22 @@ fn analyze_explains_what_is_wrong_with_a_run_directory() {
     assert!(!ok && err.contains("no frame at or after"), "{err}");
     let (ok, err) = analyze(&rd, &["--box", "24"]);
     assert!(!ok && err.contains("must be odd"), "{err}");
+    // Options that aborted or were used as if fine (issue 13).
+    for (args, want) in [
+        (&["--crop", "100001"][..], "use an odd side up to 201"),
+        (
+            &["--max-link", "nan"][..],
+            "--max-link NaN: give a positive number",
+        ),
+        (
+            &["--max-pair=-1"][..],
+            "--max-pair -1: give a positive number",
+        ),
+    ] {
+        let (ok, err) = analyze(&rd, args);
+        assert!(!ok && err.contains(want), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
     // A damaged (truncated) frame.
     let f = rd.join("frames/frame_00000050.npz");
     let bytes = std::fs::read(&f).unwrap();

@@ -326,6 +326,33 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             "--crop must be odd (the defect sits on the centre node), e.g. 101".into(),
         ));
     }
+    // A crop wraps the periodic lattice; beyond twice its side it only repeats it (and a
+    // huge one exhausts memory: --crop 100001 asked for 10¹⁰ nodes per component).
+    let most = 2 * lattice.lx.min(lattice.ly) + 1;
+    if opts.crop_side > most {
+        return Err(AnalyzeError::Options(format!(
+            "--crop {}: more than twice the lattice ({}×{}) only repeats it; use an odd side up to {most} (default 101)",
+            opts.crop_side, lattice.lx, lattice.ly
+        )));
+    }
+    for (flag, v) in [
+        ("--max-link", opts.max_link),
+        ("--max-pair", opts.max_pair),
+        ("--s-rms-baseline", opts.s_rms_baseline),
+    ] {
+        if let Some(v) = v {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(AnalyzeError::Options(format!(
+                    "{flag} {v}: give a positive number (the defaults are R for --max-link and 2R for --max-pair)"
+                )));
+            }
+        }
+    }
+    if opts.from.is_some_and(|f| !f.is_finite()) {
+        return Err(AnalyzeError::Options(
+            "--from must be a finite time (default: the end of relaxation)".into(),
+        ));
+    }
     let defaults = TrackParams::for_radius(radius);
     let params = TrackParams::new(
         opts.max_link.unwrap_or(defaults.max_link),

@@ -1,0 +1,95 @@
+//! Guards before work: a scene that would not fit in memory, and a thread count beyond the
+//! machine, are caught before anything is allocated or started.
+
+use anyhow::{bail, Result};
+use scene::Scene;
+
+/// Bytes from `8G`, `512M`, `64K`, `1.5G` or a plain number of bytes.
+///
+/// # Errors
+/// A message naming the flag and the accepted forms.
+pub fn parse_bytes(s: &str) -> Result<f64> {
+    let t = s.trim();
+    let (num, mult) = match t.char_indices().last() {
+        Some((i, c)) if c.eq_ignore_ascii_case(&'k') => (&t[..i], 1024.0),
+        Some((i, c)) if c.eq_ignore_ascii_case(&'m') => (&t[..i], 1024.0 * 1024.0),
+        Some((i, c)) if c.eq_ignore_ascii_case(&'g') => (&t[..i], 1024.0f64.powi(3)),
+        Some((i, c)) if c.eq_ignore_ascii_case(&'t') => (&t[..i], 1024.0f64.powi(4)),
+        _ => (t, 1.0),
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v * mult),
+        _ => bail!("--max-memory {s}: give a size such as 8G, 512M or 1073741824 (bytes)"),
+    }
+}
+
+/// The memory available to a new process, from `/proc/meminfo` (`MemAvailable`); `None`
+/// where that cannot be read.
+pub fn available_memory() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+fn gib(b: f64) -> String {
+    if b >= 1024.0f64.powi(3) {
+        format!("{:.1} GiB", b / 1024.0f64.powi(3))
+    } else {
+        format!("{:.0} MiB", b / 1024.0f64.powi(2))
+    }
+}
+
+/// Refuses a scene whose [`Scene::memory_estimate`] exceeds `--max-memory`, or by default the
+/// memory available now, with the estimate and the keys that change it.
+///
+/// # Errors
+/// The refusal, or a `--max-memory` that does not parse.
+pub fn memory(scene: &Scene, max_memory: Option<&str>) -> Result<()> {
+    let (limit, what) = match max_memory {
+        Some(m) => (parse_bytes(m)?, format!("--max-memory {m}")),
+        None => match available_memory() {
+            Some(a) => (a, "the memory available on this machine".to_string()),
+            None => return Ok(()),
+        },
+    };
+    let est = scene.memory_estimate();
+    if est > limit {
+        let f = scene.file();
+        let shape = scene.patch_shape();
+        let f32_hint = match scene.precision() {
+            mechanics::Precision::F64 => {
+                ", use [integrator] precision = \"f32\" (half the field memory)"
+            }
+            mechanics::Precision::F32 => "",
+        };
+        bail!(
+            "the run needs about {} ({} cell(s) of {}×{} patch nodes on a {}×{} lattice), more than {} ({what}); reduce [cells] count, [domain] lx and ly or [integrator] margin{f32_hint}, or give a larger --max-memory",
+            gib(est),
+            f.cells.count,
+            shape.nx,
+            shape.ny,
+            f.domain.lx,
+            f.domain.ly,
+            gib(limit)
+        );
+    }
+    Ok(())
+}
+
+/// The thread count to use for `--threads n`: at least 1, and at most the machine's cores
+/// (more only time-slice the same cores; results do not depend on the count).
+///
+/// # Errors
+/// `--threads 0`.
+pub fn threads(n: usize) -> Result<usize> {
+    if n == 0 {
+        bail!("--threads must be at least 1");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    if n > cores {
+        eprintln!("note: --threads {n} capped at the {cores} cores of this machine (results do not depend on it)");
+        return Ok(cores);
+    }
+    Ok(n)
+}
