@@ -436,7 +436,7 @@ fn real_main() -> Result<()> {
             let info =
                 pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
             if !quiet {
-                note_partial(info.partial);
+                note_skipped(info.partial, &info.stray);
                 match &opts.movie {
                     Some(m) => eprintln!(
                         "drew {} frames into {} and {}",
@@ -465,7 +465,7 @@ fn real_main() -> Result<()> {
             let info =
                 pool(threads)?.install(|| export_vtk(&run_dir, &out, &frames, &mut progress))?;
             if !quiet {
-                note_partial(info.partial);
+                note_skipped(info.partial, &info.stray);
                 eprintln!(
                     "exported {} frames; open {} (and cells.pvd) in ParaView",
                     info.frames,
@@ -493,7 +493,7 @@ fn real_main() -> Result<()> {
                 s_rms_baseline,
             };
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
-            note_partial(info.partial);
+            note_skipped(info.partial, &info.stray);
             eprintln!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,
@@ -506,9 +506,15 @@ fn real_main() -> Result<()> {
     }
 }
 
-fn note_partial(partial: usize) {
+fn note_skipped(partial: usize, stray: &[String]) {
     if partial > 0 {
         eprintln!("note: skipped {partial} partially written frame(s)");
+    }
+    if let Some(first) = stray.first() {
+        eprintln!(
+            "note: ignored {} file(s) in frames/ that are not frame_STEP.npz (e.g. {first})",
+            stray.len()
+        );
     }
 }
 

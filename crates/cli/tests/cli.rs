@@ -945,3 +945,103 @@ fn reproduce_refuses_unknown_figures_and_scales() {
     );
     assert!(!out.exists());
 }
+
+/// Rewrites a frame with `change` applied to its arrays (all written back as float64, int64
+/// for the integer ones), as a damaged or foreign file would be.
+fn rewrite_frame(path: &Path, change: impl Fn(&str, &mut Vec<f64>)) {
+    const NAMES: [&str; 12] = [
+        "format",
+        "step",
+        "time",
+        "zeta",
+        "lattice",
+        "centre",
+        "velocity",
+        "force",
+        "area",
+        "shape_tensor",
+        "origin",
+        "phi",
+    ];
+    let arrays = rundir::read_npz(path, &NAMES).unwrap();
+    let mut out = Vec::new();
+    for (name, mut a) in NAMES.iter().zip(arrays) {
+        change(name, &mut a.data);
+        let bytes = if ["format", "step", "lattice", "origin"].contains(name) {
+            rundir::npy(&a.shape, a.data.iter().map(|&v| v as i64))
+        } else {
+            rundir::npy(&a.shape, a.data.iter().copied())
+        };
+        out.push((name.to_string(), bytes.unwrap()));
+    }
+    rundir::write_npz(path, out).unwrap();
+}
+
+/// `analyze` validates what it reads (issue 13): a frame with NaN φ or a patch origin off the
+/// lattice is refused with the file and the array (where NaN φ gave 10 046 "defects" and an
+/// origin off the lattice panicked); a stray `frame_abc.npz` is ignored with a note; frames
+/// are taken in the order of their `step` arrays, not of their names; no empty table is left
+/// behind by a refusal.
+#[test]
+fn analyze_validates_frames_and_orders_them_by_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let rd = dir.path().join("run");
+    let o = run(&scene_path("paper.toml"), &rd, &SHORT);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let analyze = || {
+        let o = bin().arg("analyze").arg(&rd).output().unwrap();
+        (o.status.success(), stderr(&o))
+    };
+    // Names out of step order: the frame of step 50 renamed to sort first.
+    let frames = rd.join("frames");
+    std::fs::rename(
+        frames.join("frame_00000050.npz"),
+        frames.join("frame_0.npz"),
+    )
+    .unwrap();
+    std::fs::write(frames.join("frame_abc.npz"), b"not a frame").unwrap();
+    let (ok, err) = analyze();
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("ignored 1 file(s)") && err.contains("frame_abc.npz"),
+        "{err}"
+    );
+    let obs = std::fs::read_to_string(rd.join("analysis/observables.csv")).unwrap();
+    let steps: Vec<u64> = obs
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(steps.windows(2).all(|w| w[0] < w[1]), "steps {steps:?}");
+    assert_eq!(*steps.last().unwrap(), 50);
+    std::fs::remove_dir_all(rd.join("analysis")).unwrap();
+
+    let f = frames.join("frame_00000040.npz");
+    let good = std::fs::read(&f).unwrap();
+    rewrite_frame(&f, |name, d| {
+        if name == "phi" {
+            d[7] = f64::NAN;
+        }
+    });
+    let (ok, err) = analyze();
+    assert!(
+        !ok && err.contains("frame_00000040.npz") && err.contains("'phi' holds 1 non-finite"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"));
+    std::fs::write(&f, &good).unwrap();
+    rewrite_frame(&f, |name, d| {
+        if name == "origin" {
+            d[2] = 1e6;
+        }
+    });
+    let (ok, err) = analyze();
+    assert!(
+        !ok && err.contains("'origin' puts patch 1") && err.contains("off the 100×100 lattice"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"));
+    for t in ["observables.csv", "defects.csv", "defect_events.csv"] {
+        assert!(!rd.join("analysis").join(t).exists(), "{t} left behind");
+    }
+}

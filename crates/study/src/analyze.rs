@@ -102,7 +102,7 @@ impl Default for AnalyzeOptions {
 }
 
 /// What an analysis found.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AnalyzeInfo {
     /// Frames analysed.
     pub frames: usize,
@@ -112,28 +112,82 @@ pub struct AnalyzeInfo {
     pub events: usize,
     /// Partially written frames (`*.partial`) that were skipped.
     pub partial: usize,
+    /// Other files in `frames/` that were skipped (names that are not `frame_STEP.npz`).
+    pub stray: Vec<String>,
 }
 
-/// The frames of a run directory, in step order, and how many partial files were skipped.
-pub(crate) fn list_frames(run_dir: &Path) -> Result<(Vec<PathBuf>, usize)> {
+/// A frame file of a run, with the clock it holds.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FrameFile {
+    pub path: PathBuf,
+    pub step: u64,
+    pub time: f64,
+}
+
+/// The frames of a run directory.
+pub(crate) struct FrameList {
+    /// In the order of their `step` arrays.
+    pub frames: Vec<FrameFile>,
+    /// Partially written frames (`*.partial`) skipped.
+    pub partial: usize,
+    /// Other files in `frames/` skipped (a name that is not `frame_STEP.npz`).
+    pub stray: Vec<String>,
+}
+
+/// The frames of a run directory in the order of their `step` arrays (not of their names),
+/// each checked to be of a format this version reads; partial and stray files are counted
+/// and skipped.
+pub(crate) fn list_frames(run_dir: &Path) -> Result<FrameList> {
     let dir = run_dir.join("frames");
     let entries = std::fs::read_dir(&dir)
         .map_err(|_| input(run_dir, "no frames/ directory: the run wrote no frame yet"))?;
-    let (mut frames, mut partial) = (Vec::new(), 0);
+    let (mut frames, mut partial, mut stray) = (Vec::new(), 0, Vec::new());
     for e in entries {
         let p = e.map_err(|e| input(&dir, e.to_string()))?.path();
-        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        let name = p
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("")
+            .to_string();
+        let digits = name
+            .strip_prefix("frame_")
+            .and_then(|n| n.strip_suffix(".npz"))
+            .filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()));
         if name.ends_with(".partial") {
             partial += 1;
-        } else if name.starts_with("frame_") && name.ends_with(".npz") {
+        } else if digits.is_some() {
             frames.push(p);
+        } else {
+            stray.push(name);
         }
     }
-    frames.sort();
     if frames.is_empty() {
-        return Err(input(&dir, "holds no frame_*.npz"));
+        return Err(input(&dir, "holds no frame_STEP.npz"));
     }
-    Ok((frames, partial))
+    let mut frames = frames
+        .into_iter()
+        .map(|path| {
+            let (step, time) = frame_clock(&path)?;
+            Ok(FrameFile { path, step, time })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    frames.sort_by_key(|f| f.step);
+    if let Some(w) = frames.windows(2).find(|w| w[0].step == w[1].step) {
+        return Err(input(
+            &w[1].path,
+            format!(
+                "holds step {}, as {} does: remove the copy",
+                w[1].step,
+                w[0].path.display()
+            ),
+        ));
+    }
+    stray.sort();
+    Ok(FrameList {
+        frames,
+        partial,
+        stray,
+    })
 }
 
 /// Reads the run's resolved scene.
@@ -240,11 +294,41 @@ pub(crate) fn load_frame(
             ));
         }
     }
-    let origins: Vec<[usize; 2]> = origin
-        .data
-        .chunks_exact(2)
-        .map(|o| [o[0] as usize, o[1] as usize])
-        .collect();
+    for (name, a) in [
+        ("phi", &phi.data),
+        ("shape_tensor", &shape_tensor.data),
+        ("centre", &centre.data),
+        ("velocity", &velocity.data),
+        ("area", &area.data),
+    ] {
+        let bad = a.iter().filter(|v| !v.is_finite()).count();
+        if bad > 0 {
+            return Err(input(
+                path,
+                format!("array '{name}' holds {bad} non-finite values (NaN or infinite): the state is not one the model can have; analyse the frames before it with --from or rerun with a smaller dt"),
+            ));
+        }
+    }
+    if !(time.is_finite() && zeta.is_finite()) {
+        return Err(input(
+            path,
+            format!("time {time} or zeta {zeta} is not finite"),
+        ));
+    }
+    let mut origins: Vec<[usize; 2]> = Vec::with_capacity(n);
+    for (i, o) in origin.data.chunks_exact(2).enumerate() {
+        let ok = |v: f64, l: usize| v >= 0.0 && v.fract() == 0.0 && v < l as f64;
+        if !(ok(o[0], lattice.lx) && ok(o[1], lattice.ly)) {
+            return Err(input(
+                path,
+                format!(
+                    "array 'origin' puts patch {i} at {:?}, off the {}×{} lattice",
+                    o, lattice.lx, lattice.ly
+                ),
+            ));
+        }
+        origins.push([o[0] as usize, o[1] as usize]);
+    }
     let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &phi.data);
     let tissue = Tissue::from_state(
         cells,
@@ -265,15 +349,27 @@ pub(crate) fn load_frame(
     })
 }
 
-/// The time of a frame, after checking that this version can read it.
-pub(crate) fn frame_time(path: &Path) -> Result<f64> {
-    let a = read_npz(path, &["format", "time"]).map_err(|e| {
+/// The step and time of a frame, after checking that this version can read it.
+fn frame_clock(path: &Path) -> Result<(u64, f64)> {
+    let a = read_npz(path, &["format", "step", "time"]).map_err(|e| {
         input(
             path,
             format!("the frame was written by another version or is damaged: {e}"),
         )
     })?;
-    let format = a[0].data[0] as i64;
+    let scalar = |k: usize, name: &str| -> Result<f64> {
+        match a[k].data[..] {
+            [v] if v.is_finite() => Ok(v),
+            _ => Err(input(
+                path,
+                format!(
+                    "array '{name}' must hold one finite number, not {:?}",
+                    a[k].data
+                ),
+            )),
+        }
+    };
+    let format = scalar(0, "format")? as i64;
     if !FRAME_FORMATS_READ.contains(&format) {
         return Err(input(
             path,
@@ -282,7 +378,14 @@ pub(crate) fn frame_time(path: &Path) -> Result<f64> {
             ),
         ));
     }
-    Ok(a[1].data[0])
+    let step = scalar(1, "step")?;
+    if step < 0.0 || step.fract() != 0.0 {
+        return Err(input(
+            path,
+            format!("array 'step' holds {step}, not a step number"),
+        ));
+    }
+    Ok((step as u64, scalar(2, "time")?))
 }
 
 /// Writes `text` to `path` whole: under a temporary name first, so that an error leaves no
@@ -313,7 +416,11 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let scene = read_scene(run_dir)?;
     let lattice = scene.lattice();
     let shape = scene.patch_shape();
-    let (frames, partial) = list_frames(run_dir)?;
+    let FrameList {
+        frames,
+        partial,
+        stray,
+    } = list_frames(run_dir)?;
     let from = opts.from.unwrap_or(scene.file().run.relax_time);
     let radius = scene.file().cells.radius;
     let box_side = opts
@@ -361,11 +468,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
 
     let selected: Vec<PathBuf> = frames
         .into_iter()
-        .map(|p| frame_time(&p).map(|t| (p, t)))
-        .collect::<Result<Vec<_>>>()?
-        .into_iter()
-        .filter(|(_, t)| *t >= from - 1e-9)
-        .map(|(p, _)| p)
+        .filter(|f| f.time >= from - 1e-9)
+        .map(|f| f.path)
         .collect();
     if selected.is_empty() {
         return Err(AnalyzeError::Options(format!(
@@ -403,6 +507,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         defects: 0,
         events: 0,
         partial,
+        stray,
     };
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;

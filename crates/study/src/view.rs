@@ -23,7 +23,7 @@ use rundir::vtk::{write_pvd, write_vti, write_vtp, VtkArray, VtkValues};
 use rundir::RunDirError;
 use scene::Scene;
 
-use crate::analyze::{frame_time, list_frames, load_frame, read_scene, AnalyzeError, LoadedFrame};
+use crate::analyze::{list_frames, load_frame, read_scene, AnalyzeError, FrameList, LoadedFrame};
 
 /// What stops a render or an export.
 #[derive(Debug, thiserror::Error)]
@@ -168,6 +168,8 @@ pub struct ViewInfo {
     pub frames: usize,
     /// Partially written frames that were skipped.
     pub partial: usize,
+    /// Other files in `frames/` that were skipped.
+    pub stray: Vec<String>,
     /// The files written (PNGs, the movie; or the `.pvd` collections).
     pub files: Vec<PathBuf>,
 }
@@ -177,26 +179,26 @@ struct Run {
     scene: Scene,
     frames: Vec<PathBuf>,
     partial: usize,
+    stray: Vec<String>,
 }
 
 impl Run {
     fn open(run_dir: &Path, which: &Frames) -> Result<Self> {
         let scene = read_scene(run_dir)?;
-        let (all, partial) = list_frames(run_dir)?;
+        let FrameList {
+            frames: all,
+            partial,
+            stray,
+        } = list_frames(run_dir)?;
         let frames = match which {
-            Frames::All => all,
+            Frames::All => all.into_iter().map(|f| f.path).collect(),
             Frames::Steps(steps) => {
                 let mut picked = Vec::new();
                 for s in steps {
-                    let name = format!("frame_{s:08}.npz");
-                    match all
-                        .iter()
-                        .find(|p| p.file_name().is_some_and(|n| n == name.as_str()))
-                    {
-                        Some(p) => picked.push(p.clone()),
+                    match all.iter().find(|f| f.step == *s) {
+                        Some(f) => picked.push(f.path.clone()),
                         None => {
-                            let first = all.first().and_then(|p| step_of(p)).unwrap_or(0);
-                            let last = all.last().and_then(|p| step_of(p)).unwrap_or(0);
+                            let (first, last) = (all[0].step, all[all.len() - 1].step);
                             return Err(ViewError::Options(format!(
                                 "--frames: the run has no frame at step {s}; it has {} frames, steps {first} to {last} (see {})",
                                 all.len(),
@@ -208,13 +210,11 @@ impl Run {
                 picked
             }
         };
-        for p in &frames {
-            frame_time(p)?;
-        }
         Ok(Self {
             scene,
             frames,
             partial,
+            stray,
         })
     }
 
@@ -231,14 +231,6 @@ impl Run {
         let l = self.scene.lattice();
         paper_box_side(self.scene.file().cells.radius).min(l.lx.min(l.ly) | 1)
     }
-}
-
-fn step_of(p: &Path) -> Option<u64> {
-    p.file_stem()?
-        .to_str()?
-        .strip_prefix("frame_")?
-        .parse()
-        .ok()
 }
 
 fn create_dir(dir: &Path) -> Result<()> {
@@ -447,6 +439,7 @@ pub fn render_run(
     Ok(ViewInfo {
         frames: total,
         partial: run.partial,
+        stray: run.stray.clone(),
         files,
     })
 }
@@ -604,6 +597,7 @@ pub fn export_vtk(
     Ok(ViewInfo {
         frames: total,
         partial: run.partial,
+        stray: run.stray.clone(),
         files: vec![a, b],
     })
 }
