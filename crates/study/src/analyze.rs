@@ -262,7 +262,20 @@ pub(crate) fn load_frame(
         arrays
             .try_into()
             .expect("read_npz returns one array per name");
-    let (step, time, zeta) = (step.data[0] as u64, time.data[0], zeta.data[0]);
+    let one = |a: &Array, name: &str| -> Result<f64> {
+        match a.data[..] {
+            [v] => Ok(v),
+            _ => Err(input(
+                path,
+                format!("array '{name}' must hold one number, not {}", a.data.len()),
+            )),
+        }
+    };
+    let (step, time, zeta) = (
+        one(&step, "step")? as u64,
+        one(&time, "time")?,
+        one(&zeta, "zeta")?,
+    );
     if lat.data != [lattice.lx as f64, lattice.ly as f64] {
         return Err(input(
             path,
