@@ -25,10 +25,16 @@ enum Command {
     /// Run a scene file and write the series, frames and resolved scene into a directory.
     Run {
         /// The scene file (TOML).
-        scene: PathBuf,
+        #[arg(required_unless_present = "resume")]
+        scene: Option<PathBuf>,
         /// The output directory (created if missing).
-        #[arg(long)]
-        out: PathBuf,
+        #[arg(long, required_unless_present = "resume", conflicts_with = "resume")]
+        out: Option<PathBuf>,
+        /// Continue the run in DIR from its latest checkpoint to the end of its scene (with
+        /// `--set run.time=T`: extend a finished run). The directory ends as one
+        /// uninterrupted run would have left it.
+        #[arg(long, value_name = "DIR", conflicts_with = "scene")]
+        resume: Option<PathBuf>,
         /// Worker threads (default: all cores). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
@@ -254,7 +260,25 @@ fn real_main() -> Result<()> {
             quiet,
             overwrite,
             max_memory,
+            resume,
         } => {
+            if let Some(dir) = resume {
+                let pool = pool(threads)?;
+                let (from, info) = pool.install(|| run::resume(&dir, &set, quiet))?;
+                if !quiet {
+                    eprintln!(
+                        "done: resumed at step {from}, {} steps in {:.2} s, {} frames in {}",
+                        info.steps,
+                        info.wall_s,
+                        info.frames,
+                        dir.display()
+                    );
+                }
+                return Ok(());
+            }
+            let (Some(scene), Some(out)) = (scene, out) else {
+                anyhow::bail!("give a scene and --out DIR, or --resume DIR");
+            };
             let text = std::fs::read_to_string(&scene)
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
             let parsed = Scene::parse(&text, &set)

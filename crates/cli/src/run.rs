@@ -34,15 +34,87 @@ pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
         eprintln!("warning: {w}");
     }
     match scene.precision() {
-        Precision::F64 => run_in::<f64>(scene, out, quiet),
-        Precision::F32 => run_in::<f32>(scene, out, quiet),
+        Precision::F64 => run_in::<f64>(scene, out, quiet, None),
+        Precision::F32 => run_in::<f32>(scene, out, quiet, None),
     }
 }
 
-fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
+/// Continues the run in `dir` from its latest readable checkpoint to the end of its scene,
+/// with `set` overrides of `run.time` (to extend a finished run). Rows and frames at or
+/// after the checkpoint are written again, so the directory ends as one uninterrupted run
+/// would have left it. Returns the step it resumed from and what the run did.
+///
+/// # Errors
+/// No usable checkpoint, an override other than `run.time`, a run already at its end, or
+/// what [`run`] can fail with.
+pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<(u64, RunInfo)> {
+    for s in set {
+        let key = s.split('=').next().unwrap_or("");
+        anyhow::ensure!(
+            key.trim() == "run.time",
+            "--resume continues the run as it was: only --set run.time=T (to extend it) can change; {key} would make it another run (start a new scene instead)"
+        );
+    }
+    let all = rundir::checkpoint::checkpoints(dir);
+    anyhow::ensure!(
+        !all.is_empty(),
+        "{} has no checkpoints/ to resume from (runs write them every [run] checkpoint_every; this one was killed before the first, or was not run by monolayer run)",
+        dir.display()
+    );
+    let mut last_err = None;
+    for (step, path) in all.iter().rev() {
+        let attempt = || -> Result<(Scene, u64)> {
+            let text = rundir::checkpoint::checkpoint_scene(path)?;
+            let scene = Scene::parse(&text, set)
+                .with_context(|| format!("the scene in {}", path.display()))?;
+            Ok((scene, *step))
+        };
+        match attempt() {
+            Ok((scene, step)) => {
+                let total = scene.step_counts().total_steps();
+                anyhow::ensure!(
+                    step < total,
+                    "the run in {} is complete (step {step} of {total}); extend it with --set run.time=T, T above {}",
+                    dir.display(),
+                    scene.file().run.time
+                );
+                rundir::write_scene(dir, &scene)?;
+                let info = match scene.precision() {
+                    Precision::F64 => run_in::<f64>(&scene, dir, quiet, Some(path)),
+                    Precision::F32 => run_in::<f32>(&scene, dir, quiet, Some(path)),
+                }?;
+                return Ok((step, info));
+            }
+            Err(e) => {
+                if !quiet {
+                    eprintln!("note: skipping {}: {e:#}", path.display());
+                }
+                last_err = Some(e);
+            }
+        }
+    }
+    Err(last_err.expect("at least one checkpoint was tried"))
+}
+
+fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Option<&Path>) -> Result<RunInfo> {
     let counts = scene.step_counts();
-    let mut sim = scene.simulation::<T>();
-    let written = rundir::add_writers(&mut sim, out, &counts)?;
+    let (mut sim, written) = match from {
+        None => {
+            let mut sim = scene.simulation::<T>();
+            let w = rundir::add_writers(&mut sim, out, &counts)?;
+            (sim, w)
+        }
+        Some(path) => {
+            let tissue = rundir::checkpoint::read_checkpoint::<T>(path, scene)?;
+            let step = tissue.iteration();
+            let mut sim = mechanics::Simulation::new(tissue, scene.step_params())
+                .activity_from(counts.relax_steps, scene.zeta())
+                .stop_iteration(counts.total_steps());
+            let w = rundir::add_writers_resumed(&mut sim, out, &counts, step)?;
+            (sim, w)
+        }
+    };
+    rundir::add_checkpoints(&mut sim, out, counts.checkpoint_every, &scene.to_toml());
     sim.add_output_writer(
         "progress",
         Schedule::IterationInterval(counts.series_every.min(counts.frame_every)),

@@ -87,6 +87,47 @@ impl<T: Real> Tissue<T> {
         t
     }
 
+    /// A tissue restored exactly from a checkpoint: fields as stored, parameters, clock,
+    /// the centres as the run held them (not recomputed, so that the next step is the one the
+    /// run would have taken), and the identity of each slot.
+    ///
+    /// # Errors
+    /// A message when the centres or identities do not fit the cells.
+    pub fn restore(
+        cells: Cells<T>,
+        params: ModelParams,
+        time: f64,
+        iteration: u64,
+        centre: Vec<[f64; 2]>,
+        cell_id: Vec<usize>,
+    ) -> Result<Self, String> {
+        let n = cells.n_cells();
+        let mut seen = vec![false; n];
+        if centre.len() != n
+            || cell_id.len() != n
+            || !cell_id
+                .iter()
+                .all(|&i| i < n && !std::mem::replace(&mut seen[i], true))
+        {
+            return Err(format!(
+                "{} centres and identities {:?}… for {n} cells: not a permutation of 0..{n}",
+                centre.len(),
+                &cell_id[..cell_id.len().min(4)]
+            ));
+        }
+        if centre.iter().flatten().any(|c| !c.is_finite()) {
+            return Err("a centre is not finite".into());
+        }
+        Ok(Self {
+            cells,
+            params,
+            time,
+            iteration,
+            centre,
+            cell_id,
+        })
+    }
+
     /// The lattice.
     pub fn lattice(&self) -> Lattice {
         self.cells.lattice()

@@ -134,6 +134,57 @@ impl<T: Real> Cells<T> {
         }
     }
 
+    /// Cells exactly as they were stored: the field values in storage order (as
+    /// [`Cells::phi`] returns them) with each patch's origin and storage offset (as
+    /// [`Cells::map`] holds them). Rebuilds the tables, so a checkpoint restores the cells
+    /// bit for bit, including where each patch's data sits in its cyclic storage.
+    ///
+    /// # Errors
+    /// A message naming what does not fit: the length of `phi`, an origin off the lattice or
+    /// an offset outside the patch.
+    pub fn from_storage(
+        lattice: Lattice,
+        shape: PatchShape,
+        phi: Vec<T>,
+        origin: Vec<[usize; 2]>,
+        offset: Vec<[usize; 2]>,
+    ) -> Result<Self, String> {
+        let n_cells = origin.len();
+        if offset.len() != n_cells || phi.len() != n_cells * shape.len() {
+            return Err(format!(
+                "{} values, {} origins and {} offsets for patches of {}×{}",
+                phi.len(),
+                n_cells,
+                offset.len(),
+                shape.nx,
+                shape.ny
+            ));
+        }
+        for (i, (o, f)) in origin.iter().zip(&offset).enumerate() {
+            if o[0] >= lattice.lx || o[1] >= lattice.ly || f[0] >= shape.nx || f[1] >= shape.ny {
+                return Err(format!(
+                    "patch {i}: origin {o:?} or offset {f:?} out of range"
+                ));
+            }
+        }
+        let mut map = PatchMap {
+            origin,
+            offset,
+            lat_x: vec![0; n_cells * shape.nx],
+            lat_y: vec![0; n_cells * shape.ny],
+        };
+        for i in 0..n_cells {
+            map.refresh_tables(lattice, &shape, i);
+        }
+        Ok(Self {
+            lattice,
+            phi,
+            shape,
+            n_cells,
+            map,
+        })
+    }
+
     /// Reorders the cells: slot `j` receives the cell that was in slot `order[j]`. Field values
     /// move through `scratch` (resized to the field length once, then reused), so that a
     /// caller can reorder repeatedly without allocating the large buffer again.

@@ -7,6 +7,7 @@
 //! | `scene.toml` | [`prepare`] and [`write_scene`]: the resolved scene, every default filled in |
 //! | `series.csv` | [`SeriesWriter`], one row every `series_every` steps ([`SERIES_HEADER`]) |
 //! | `frames/frame_STEP.npz` | [`write_frame`], NumPy archives `numpy.load` reads as they are |
+//! | `checkpoints/checkpoint_STEP.npz` | [`add_checkpoints`]: the complete state, for `monolayer run --resume` ([`checkpoint`]) |
 //! | `run.json` | [`write_scene`]: version, precision, axes, the unit of every column |
 //! | `vtk/*.vti`, `*.vtp`, `*.pvd` | [`vtk`]: ParaView files (by `monolayer export vtk`) |
 //!
@@ -14,6 +15,7 @@
 //! [`read_npz`] reads frames back. Errors name the file ([`RunDirError`]).
 #![deny(missing_docs)]
 
+pub mod checkpoint;
 mod frame;
 mod series;
 mod sidecar;
@@ -25,7 +27,7 @@ use std::path::{Path, PathBuf};
 pub use frame::{npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
 pub use series::{SeriesWriter, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
-pub use writers::{add_writers, FinalToo, Written};
+pub use writers::{add_checkpoints, add_writers, add_writers_resumed, FinalToo, Written};
 
 /// A file of a run directory could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -90,7 +92,8 @@ impl RunDirError {
 pub type Result<T> = std::result::Result<T, RunDirError>;
 
 /// Makes `dir` ready for a new run: creates it, and makes sure it holds no earlier run. With
-/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml` and `frames/`; without,
+/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml`, `frames/` and
+/// `checkpoints/`; without,
 /// refuses.
 ///
 /// # Errors
@@ -106,9 +109,11 @@ pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
         std::fs::remove_file(&series).map_err(|e| RunDirError::io("remove", &series, e))?;
         let _ = std::fs::remove_file(dir.join("scene.toml"));
         let _ = std::fs::remove_file(dir.join("run.json"));
-        let frames = dir.join("frames");
-        if frames.exists() {
-            std::fs::remove_dir_all(&frames).map_err(|e| RunDirError::io("remove", &frames, e))?;
+        for sub in ["frames", "checkpoints"] {
+            let d = dir.join(sub);
+            if d.exists() {
+                std::fs::remove_dir_all(&d).map_err(|e| RunDirError::io("remove", &d, e))?;
+            }
         }
     }
     std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))

@@ -34,6 +34,47 @@ impl SeriesWriter {
         Ok(Self { path, out })
     }
 
+    /// Opens `dir/series.csv` of a resumed run: keeps its header and the rows before step
+    /// `from` and drops the rest (the resumed run writes them again), then appends.
+    ///
+    /// # Errors
+    /// A missing or foreign `series.csv`, or one that cannot be rewritten.
+    pub fn resume(dir: &Path, from: u64) -> Result<Self> {
+        let path = dir.join("series.csv");
+        let text = std::fs::read_to_string(&path).map_err(|e| RunDirError::io("read", &path, e))?;
+        let mut lines = text.lines();
+        if lines.next() != Some(SERIES_HEADER) {
+            return Err(RunDirError::BadArray {
+                path: path.clone(),
+                name: "header".into(),
+                reason: "not the header this version writes".into(),
+            });
+        }
+        let mut kept = format!("{SERIES_HEADER}\n");
+        for l in lines {
+            match l.split(',').next().and_then(|s| s.parse::<u64>().ok()) {
+                Some(step)
+                    if step < from && l.split(',').count() == SERIES_HEADER.split(',').count() =>
+                {
+                    kept.push_str(l);
+                    kept.push('\n');
+                }
+                _ => break,
+            }
+        }
+        let tmp = dir.join("series.csv.partial");
+        std::fs::write(&tmp, &kept).map_err(|e| RunDirError::io("write", &tmp, e))?;
+        std::fs::rename(&tmp, &path).map_err(|e| RunDirError::io("rename", &tmp, e))?;
+        let f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .map_err(|e| RunDirError::io("open", &path, e))?;
+        Ok(Self {
+            path,
+            out: BufWriter::new(f),
+        })
+    }
+
     /// Appends one row.
     ///
     /// # Errors

@@ -9,6 +9,7 @@ use mechanics::{Callback, CallbackError, Observation, Schedule, Simulation};
 use phasefield::Real;
 use scene::StepCounts;
 
+use crate::checkpoint::write_checkpoint;
 use crate::frame::write_frame;
 use crate::series::SeriesWriter;
 use crate::Result;
@@ -36,11 +37,49 @@ pub fn add_writers<T: Real>(
     dir: &Path,
     counts: &StepCounts,
 ) -> Result<Written> {
+    let series = SeriesWriter::create(dir)?;
+    Ok(add_with(sim, dir, counts, series))
+}
+
+/// [`add_writers`] for a run resumed at step `from`: the rows of `series.csv` and the frames
+/// at or after `from` are removed, since the resumed run writes them again.
+///
+/// # Errors
+/// When `series.csv` cannot be rewritten or a frame removed.
+pub fn add_writers_resumed<T: Real>(
+    sim: &mut Simulation<T>,
+    dir: &Path,
+    counts: &StepCounts,
+    from: u64,
+) -> Result<Written> {
+    let series = SeriesWriter::resume(dir, from)?;
+    let frames = dir.join("frames");
+    if let Ok(entries) = std::fs::read_dir(&frames) {
+        for p in entries.filter_map(|e| e.ok().map(|e| e.path())) {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            let step = name
+                .strip_prefix("frame_")
+                .and_then(|n| n.strip_suffix(".npz"))
+                .and_then(|n| n.parse::<u64>().ok());
+            if name.ends_with(".partial") || step.is_some_and(|s| s >= from) {
+                std::fs::remove_file(&p).map_err(|e| crate::RunDirError::io("remove", &p, e))?;
+            }
+        }
+    }
+    Ok(add_with(sim, dir, counts, series))
+}
+
+fn add_with<T: Real>(
+    sim: &mut Simulation<T>,
+    dir: &Path,
+    counts: &StepCounts,
+    series: SeriesWriter,
+) -> Written {
     let written = Written::default();
     sim.add_output_writer(
         "series.csv",
         Schedule::IterationInterval(counts.series_every),
-        FinalToo::new(SeriesRows(SeriesWriter::create(dir)?)),
+        FinalToo::new(SeriesRows(series)),
     );
     sim.add_output_writer(
         "frame writer",
@@ -50,7 +89,7 @@ pub fn add_writers<T: Real>(
             written: written.frames.clone(),
         }),
     );
-    Ok(written)
+    written
 }
 
 /// A writer that also writes the final state, unless its schedule just did.
@@ -103,6 +142,39 @@ impl<T: Real> Callback<T> for Frames {
         let ws = obs.workspace();
         write_frame(&self.dir, tissue, ws)?;
         self.written.set(self.written.get() + 1);
+        Ok(())
+    }
+}
+
+/// Adds checkpoints of the run to `sim` (see [`crate::checkpoint`]): every `every` steps,
+/// every 10 minutes of wall time, and at the end; `scene_toml` is the resolved scene they
+/// carry.
+pub fn add_checkpoints<T: Real>(sim: &mut Simulation<T>, dir: &Path, every: u64, scene_toml: &str) {
+    let writer = || Checkpoints {
+        dir: dir.to_path_buf(),
+        scene: scene_toml.to_string(),
+    };
+    sim.add_output_writer(
+        "checkpoint",
+        Schedule::IterationInterval(every.max(1)),
+        FinalToo::new(writer()),
+    );
+    sim.add_output_writer(
+        "checkpoint (wall time)",
+        Schedule::WallTimeInterval(std::time::Duration::from_secs(600)),
+        writer(),
+    );
+}
+
+/// Checkpoints in `checkpoints/`.
+struct Checkpoints {
+    dir: PathBuf,
+    scene: String,
+}
+
+impl<T: Real> Callback<T> for Checkpoints {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
+        write_checkpoint(&self.dir, obs.tissue(), &self.scene)?;
         Ok(())
     }
 }

@@ -156,6 +156,11 @@ pub struct Run {
     /// Interval between rows of `series.csv` (default: `output_every`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub series_every: Option<f64>,
+    /// Interval between checkpoints, from which `monolayer run --resume` continues (default:
+    /// a twentieth of the run, so a killed run loses at most about 5 %; a checkpoint is also
+    /// written every 10 minutes of wall time and at the end).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub checkpoint_every: Option<f64>,
 }
 
 impl Default for Run {
@@ -166,6 +171,7 @@ impl Default for Run {
             seed: 1,
             output_every: 10.0,
             series_every: None,
+            checkpoint_every: None,
         }
     }
 }

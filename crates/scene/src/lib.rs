@@ -63,6 +63,8 @@ pub struct StepCounts {
     pub frame_every: u64,
     /// Steps between series rows.
     pub series_every: u64,
+    /// Steps between checkpoints.
+    pub checkpoint_every: u64,
 }
 
 impl StepCounts {
@@ -151,11 +153,16 @@ impl Scene {
         let dt = self.file.integrator.dt;
         let steps = |t: f64| (t / dt).round() as u64;
         let r = &self.file.run;
+        let (relax_steps, active_steps) = (steps(r.relax_time), steps(r.time));
         StepCounts {
-            relax_steps: steps(r.relax_time),
-            active_steps: steps(r.time),
+            relax_steps,
+            active_steps,
             frame_every: steps(r.output_every).max(1),
             series_every: steps(r.series_every.unwrap_or(r.output_every)).max(1),
+            checkpoint_every: match r.checkpoint_every {
+                Some(c) => steps(c).max(1),
+                None => (relax_steps + active_steps).div_ceil(20).max(1),
+            },
         }
     }
 

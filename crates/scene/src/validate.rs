@@ -289,6 +289,7 @@ impl SceneFile {
         for (key, v) in [
             ("output_every", Some(r.output_every)),
             ("series_every", r.series_every),
+            ("checkpoint_every", r.checkpoint_every),
         ] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= it.dt) {

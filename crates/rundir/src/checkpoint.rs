@@ -1,0 +1,265 @@
+//! Checkpoints, `checkpoints/checkpoint_STEP.npz`: the complete state of a run, from which
+//! `monolayer run --resume` continues bit for bit.
+//!
+//! A checkpoint is a NumPy archive like a frame, but it holds the state as the simulation
+//! stores it rather than as one reads it: φ in storage order and precision, each patch's
+//! origin *and* storage offset, the centres as the step computed them, and the cells in
+//! memory order with their identities. Together with the clock, the step and the resolved
+//! scene (stored as text) that is everything a step depends on: the re-sort schedule and the
+//! activity switch follow from the step number.
+//!
+//! | array | shape | meaning |
+//! |---|---|---|
+//! | `format` | `()` int64 | [`CHECKPOINT_FORMAT`] |
+//! | `step`, `time`, `zeta` | `()` | clock and the activity in force |
+//! | `lattice`, `patch` | `(2,)` int64 | `[lx, ly]`, `[nx, ny]` |
+//! | `phi` | `(N·nx·ny,)` float32 or float64 | storage order of [`phasefield::Cells::phi`] |
+//! | `origin`, `offset` | `(N, 2)` int64 | [`phasefield::PatchMap`] |
+//! | `centre` | `(N, 2)` | [`mechanics::Tissue::centres`], slot order |
+//! | `cell_id` | `(N,)` int64 | identity of each slot |
+//! | `scene` | `(bytes,)` uint8 | the resolved scene (TOML) |
+//!
+//! Each is written under a temporary name, flushed to disk (`fsync`) and renamed, so a kill
+//! at any moment leaves the previous checkpoint intact; the newest [`KEEP`] are kept.
+
+use std::fs::File;
+use std::io::{BufReader, Read, Write};
+use std::path::{Path, PathBuf};
+
+use mechanics::Tissue;
+use phasefield::{Cells, Real};
+
+use crate::frame::{npy, read_npz};
+use crate::{Result, RunDirError};
+
+/// Version of the checkpoint layout.
+pub const CHECKPOINT_FORMAT: i64 = 1;
+
+/// How many checkpoints are kept.
+pub const KEEP: usize = 2;
+
+/// The checkpoints of `dir`, oldest first, as `(step, path)`.
+pub fn checkpoints(dir: &Path) -> Vec<(u64, PathBuf)> {
+    let Ok(entries) = std::fs::read_dir(dir.join("checkpoints")) else {
+        return Vec::new();
+    };
+    let mut v: Vec<(u64, PathBuf)> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter_map(|p| {
+            let step = p
+                .file_name()?
+                .to_str()?
+                .strip_prefix("checkpoint_")?
+                .strip_suffix(".npz")?
+                .parse()
+                .ok()?;
+            Some((step, p))
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+/// Writes a checkpoint of `tissue` with the resolved scene `scene_toml`, then removes all but
+/// the newest [`KEEP`].
+///
+/// # Errors
+/// I/O errors, naming the file.
+pub fn write_checkpoint<T: Real>(
+    dir: &Path,
+    tissue: &Tissue<T>,
+    scene_toml: &str,
+) -> Result<PathBuf> {
+    let cdir = dir.join("checkpoints");
+    std::fs::create_dir_all(&cdir).map_err(|e| RunDirError::io("create", &cdir, e))?;
+    let path = cdir.join(format!("checkpoint_{:012}.npz", tissue.iteration()));
+    let cells = tissue.cells();
+    let (shape, map, l) = (cells.shape(), cells.map(), tissue.lattice());
+    let n = tissue.n_cells() as u64;
+    let pairs = |v: &[[usize; 2]]| {
+        v.iter()
+            .flat_map(|p| [p[0] as i64, p[1] as i64])
+            .collect::<Vec<_>>()
+    };
+    let arrays = || -> std::io::Result<Vec<(&str, Vec<u8>)>> {
+        Ok(vec![
+            ("format", npy(&[], [CHECKPOINT_FORMAT])?),
+            ("step", npy(&[], [tissue.iteration() as i64])?),
+            ("time", npy(&[], [tissue.time()])?),
+            ("zeta", npy(&[], [tissue.params().zeta])?),
+            ("lattice", npy(&[2], [l.lx as i64, l.ly as i64])?),
+            ("patch", npy(&[2], [shape.nx as i64, shape.ny as i64])?),
+            (
+                "phi",
+                if T::NAME == "f32" {
+                    npy(
+                        &[cells.phi().len() as u64],
+                        cells.phi().iter().map(|v| v.to_f64() as f32),
+                    )?
+                } else {
+                    npy(
+                        &[cells.phi().len() as u64],
+                        cells.phi().iter().map(|v| v.to_f64()),
+                    )?
+                },
+            ),
+            ("origin", npy(&[n, 2], pairs(&map.origin))?),
+            ("offset", npy(&[n, 2], pairs(&map.offset))?),
+            (
+                "centre",
+                npy(&[n, 2], tissue.centres().iter().flatten().copied())?,
+            ),
+            (
+                "cell_id",
+                npy(&[n], tissue.cell_ids().iter().map(|&i| i as i64))?,
+            ),
+            (
+                "scene",
+                npy(&[scene_toml.len() as u64], scene_toml.bytes())?,
+            ),
+        ])
+    };
+    let arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
+    write_synced(&path, arrays)?;
+    let all = checkpoints(dir);
+    for (_, old) in all.iter().take(all.len().saturating_sub(KEEP)) {
+        let _ = std::fs::remove_file(old);
+    }
+    Ok(path)
+}
+
+/// Like [`crate::write_npz`], stored (no compression: the state is mostly noise in its low
+/// bits) and flushed to disk before the rename.
+fn write_synced(path: &Path, arrays: Vec<(&str, Vec<u8>)>) -> Result<()> {
+    let tmp = path.with_extension("npz.partial");
+    let write = || -> std::io::Result<()> {
+        let f = File::create(&tmp)?;
+        let mut zip = zip::ZipWriter::new(std::io::BufWriter::new(f));
+        let opts = zip::write::SimpleFileOptions::default()
+            .compression_method(zip::CompressionMethod::Stored)
+            .large_file(true);
+        for (name, bytes) in arrays {
+            zip.start_file(format!("{name}.npy"), opts)
+                .map_err(std::io::Error::other)?;
+            zip.write_all(&bytes)?;
+        }
+        let mut w = zip.finish().map_err(std::io::Error::other)?;
+        w.flush()?;
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()
+    };
+    write().map_err(|e| RunDirError::io("write", &tmp, e))?;
+    std::fs::rename(&tmp, path).map_err(|e| RunDirError::io("rename", &tmp, e))?;
+    if let Some(parent) = path.parent() {
+        if let Ok(d) = File::open(parent) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(())
+}
+
+/// The resolved scene a checkpoint was written with.
+///
+/// # Errors
+/// A file that is not a checkpoint of this format.
+pub fn checkpoint_scene(path: &Path) -> Result<String> {
+    let a = read_npz(path, &["format"])?;
+    if a[0].data != [CHECKPOINT_FORMAT as f64] {
+        return Err(RunDirError::BadArray {
+            path: path.to_path_buf(),
+            name: "format".into(),
+            reason: format!(
+                "format {:?}; this version reads {CHECKPOINT_FORMAT}",
+                a[0].data
+            ),
+        });
+    }
+    // The scene is a uint8 array: read its raw bytes (read_npz widens numbers).
+    let f = File::open(path).map_err(|e| RunDirError::io("open", path, e))?;
+    let mut zip = zip::ZipArchive::new(BufReader::new(f)).map_err(|e| RunDirError::Archive {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    let mut entry = zip
+        .by_name("scene.npy")
+        .map_err(|_| RunDirError::MissingArray {
+            path: path.to_path_buf(),
+            name: "scene".into(),
+        })?;
+    let mut bytes = Vec::new();
+    entry
+        .read_to_end(&mut bytes)
+        .map_err(|e| RunDirError::io("read", path, e))?;
+    let npy = npyz::NpyFile::new(&bytes[..]).map_err(|e| RunDirError::BadArray {
+        path: path.to_path_buf(),
+        name: "scene".into(),
+        reason: e.to_string(),
+    })?;
+    let raw: Vec<u8> = npy.into_vec().map_err(|e| RunDirError::BadArray {
+        path: path.to_path_buf(),
+        name: "scene".into(),
+        reason: e.to_string(),
+    })?;
+    String::from_utf8(raw).map_err(|e| RunDirError::BadArray {
+        path: path.to_path_buf(),
+        name: "scene".into(),
+        reason: e.to_string(),
+    })
+}
+
+/// The tissue a checkpoint holds, for `scene` (whose lattice, patch and precision must be the
+/// checkpoint's), exactly as it was.
+///
+/// # Errors
+/// A damaged checkpoint or one that does not fit the scene, naming the file and the array.
+pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tissue<T>> {
+    let names = [
+        "format", "step", "time", "zeta", "lattice", "patch", "phi", "origin", "offset", "centre",
+        "cell_id",
+    ];
+    let a = read_npz(path, &names)?;
+    let bad = |name: &str, reason: String| RunDirError::BadArray {
+        path: path.to_path_buf(),
+        name: name.into(),
+        reason,
+    };
+    if a[0].data != [CHECKPOINT_FORMAT as f64] {
+        return Err(bad(
+            "format",
+            format!("{:?}; this version reads {CHECKPOINT_FORMAT}", a[0].data),
+        ));
+    }
+    let one = |k: usize| -> Result<f64> {
+        match a[k].data[..] {
+            [v] if v.is_finite() => Ok(v),
+            _ => Err(bad(names[k], "must hold one finite number".into())),
+        }
+    };
+    let (step, time, zeta) = (one(1)? as u64, one(2)?, one(3)?);
+    let l = scene.lattice();
+    let shape = scene.patch_shape();
+    if a[4].data != [l.lx as f64, l.ly as f64] || a[5].data != [shape.nx as f64, shape.ny as f64] {
+        return Err(bad(
+            "lattice",
+            format!(
+                "lattice {:?} and patch {:?} do not match the scene's {}×{} and {}×{}",
+                a[4].data, a[5].data, l.lx, l.ly, shape.nx, shape.ny
+            ),
+        ));
+    }
+    let pairs = |k: usize| -> Vec<[usize; 2]> {
+        a[k].data
+            .chunks_exact(2)
+            .map(|p| [p[0] as usize, p[1] as usize])
+            .collect()
+    };
+    let phi: Vec<T> = a[6].data.iter().map(|&v| T::from_f64(v)).collect();
+    if phi.iter().any(|v| !v.to_f64().is_finite()) {
+        return Err(bad("phi", "holds non-finite values".into()));
+    }
+    let cells =
+        Cells::from_storage(l, shape, phi, pairs(7), pairs(8)).map_err(|r| bad("phi", r))?;
+    let centre: Vec<[f64; 2]> = a[9].data.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+    let ids: Vec<usize> = a[10].data.iter().map(|&v| v as usize).collect();
+    Tissue::restore(cells, scene.model_params(zeta), time, step, centre, ids)
+        .map_err(|r| bad("cell_id", r))
+}
