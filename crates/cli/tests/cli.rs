@@ -1045,3 +1045,124 @@ fn analyze_validates_frames_and_orders_them_by_step() {
         assert!(!rd.join("analysis").join(t).exists(), "{t} left behind");
     }
 }
+
+/// The files of a run directory that a resumed run must reproduce: `series.csv` and every
+/// frame, by name and bytes.
+fn run_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v = vec![(
+        "series.csv".to_string(),
+        std::fs::read(dir.join("series.csv")).unwrap(),
+    )];
+    let mut frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    frames.sort();
+    for f in frames {
+        v.push((
+            f.file_name().unwrap().to_string_lossy().into_owned(),
+            std::fs::read(&f).unwrap(),
+        ));
+    }
+    v
+}
+
+/// Killed with SIGKILL at three points of its run and resumed with `--resume` (on another
+/// thread count), a run directory ends byte-identical to an uninterrupted run: `series.csv`
+/// and every frame. A finished run extended with `--set run.time=T` equals a run of T from the
+/// start. Resuming a complete run, a directory without checkpoints, or with another override,
+/// is refused with what to do.
+#[test]
+fn a_run_killed_at_random_points_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "--set",
+        "run.relax_time=20",
+        "--set",
+        "run.time=300",
+        "--set",
+        "run.output_every=20",
+        "--set",
+        "run.series_every=5",
+        "--set",
+        "run.checkpoint_every=10",
+        "--threads",
+        "1",
+    ];
+    let full = dir.path().join("full");
+    let o = run(&scene_path("paper.toml"), &full, &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let want = run_files(&full);
+    // Kill points spread over the run (it takes about a second).
+    let mut resumed = 0;
+    for (k, ms) in [150u64, 400, 700].into_iter().enumerate() {
+        let out = dir.path().join(format!("killed{k}"));
+        let mut child = bin()
+            .arg("run")
+            .arg(scene_path("paper.toml"))
+            .arg("--out")
+            .arg(&out)
+            .arg("--quiet")
+            .args(args)
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+        let _ = child.kill(); // SIGKILL
+        child.wait().unwrap();
+        if !out.join("checkpoints").exists() {
+            continue; // killed before the first checkpoint: nothing to resume
+        }
+        let o = bin()
+            .args(["run", "--resume"])
+            .arg(&out)
+            .args(["--quiet", "--threads", "2"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let got = run_files(&out);
+        assert_eq!(got.len(), want.len(), "kill at {ms} ms: file count");
+        for (g, w) in got.iter().zip(&want) {
+            assert!(g == w, "kill at {ms} ms: {} differs", w.0);
+        }
+        resumed += 1;
+    }
+    assert!(resumed >= 2, "only {resumed} of the kills left a checkpoint to resume from");
+    // Extension of a finished run.
+    let short = dir.path().join("short");
+    let mut a: Vec<&str> = args.to_vec();
+    a.extend(["--set", "run.time=100"]);
+    assert!(run(&scene_path("paper.toml"), &short, &a).status.success());
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&short)
+        .args(["--quiet", "--set", "run.time=300"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        run_files(&short) == want,
+        "the extended run differs from the full one"
+    );
+    // Refusals.
+    let refuse = |d: &Path, extra: &[&str], needle: &str| {
+        let o = bin()
+            .args(["run", "--resume"])
+            .arg(d)
+            .args(extra)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert!(!o.status.success() && e.contains(needle), "{e}");
+    };
+    refuse(
+        &full,
+        &[],
+        "is complete (step 1600 of 1600); extend it with --set run.time=T",
+    );
+    refuse(
+        &full,
+        &["--set", "model.zeta=0.01"],
+        "only --set run.time=T",
+    );
+    refuse(dir.path(), &[], "has no checkpoints/ to resume from");
+}
