@@ -460,7 +460,7 @@ fn real_main() -> Result<()> {
             let info =
                 pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
             if !quiet {
-                note_skipped(info.partial, &info.stray);
+                note_skipped(info.partial, &info.stray, info.complete, &run_dir);
                 match &opts.movie {
                     Some(m) => eprintln!(
                         "drew {} frames into {} and {}",
@@ -489,7 +489,7 @@ fn real_main() -> Result<()> {
             let info =
                 pool(threads)?.install(|| export_vtk(&run_dir, &out, &frames, &mut progress))?;
             if !quiet {
-                note_skipped(info.partial, &info.stray);
+                note_skipped(info.partial, &info.stray, info.complete, &run_dir);
                 eprintln!(
                     "exported {} frames; open {} (and cells.pvd) in ParaView",
                     info.frames,
@@ -517,7 +517,7 @@ fn real_main() -> Result<()> {
                 s_rms_baseline,
             };
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
-            note_skipped(info.partial, &info.stray);
+            note_skipped(info.partial, &info.stray, info.complete, &run_dir);
             eprintln!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,
@@ -530,7 +530,13 @@ fn real_main() -> Result<()> {
     }
 }
 
-fn note_skipped(partial: usize, stray: &[String]) {
+fn note_skipped(partial: usize, stray: &[String], complete: bool, run_dir: &std::path::Path) {
+    if !complete {
+        eprintln!(
+            "note: {} is not marked complete: the run is still being written or was killed (continue it with monolayer run --resume {0})",
+            run_dir.display()
+        );
+    }
     if partial > 0 {
         eprintln!("note: skipped {partial} partially written frame(s)");
     }

@@ -128,6 +128,7 @@ fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Option<&Path>) 
             out.display()
         )
     })?;
+    rundir::mark_complete(out, scene)?;
     Ok(RunInfo {
         steps: info.iterations,
         wall_s: info.wall_time.as_secs_f64(),

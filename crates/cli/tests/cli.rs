@@ -1112,6 +1112,21 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
         if !out.join("checkpoints").exists() {
             continue; // killed before the first checkpoint: nothing to resume
         }
+        assert!(
+            !rundir::is_complete(&out),
+            "a killed run is not marked complete"
+        );
+        let a = bin()
+            .arg("analyze")
+            .arg(&out)
+            .args(["--from", "0"])
+            .output()
+            .unwrap();
+        assert!(
+            stderr(&a).contains("is not marked complete"),
+            "{}",
+            stderr(&a)
+        );
         let o = bin()
             .args(["run", "--resume"])
             .arg(&out)
@@ -1124,9 +1139,16 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
         for (g, w) in got.iter().zip(&want) {
             assert!(g == w, "kill at {ms} ms: {} differs", w.0);
         }
+        assert!(
+            rundir::is_complete(&out),
+            "the resumed run is marked complete"
+        );
         resumed += 1;
     }
-    assert!(resumed >= 2, "only {resumed} of the kills left a checkpoint to resume from");
+    assert!(
+        resumed >= 2,
+        "only {resumed} of the kills left a checkpoint to resume from"
+    );
     // Extension of a finished run.
     let short = dir.path().join("short");
     let mut a: Vec<&str> = args.to_vec();

@@ -119,12 +119,38 @@ pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))
 }
 
-/// Writes the resolved scene as `dir/scene.toml`, and `dir/run.json` (what the files mean:
+/// The file that marks a finished run: a copy of its resolved `scene.toml`, written after
+/// the last output, so a directory without it (or with another scene in it) is still being
+/// written, was killed, or was extended.
+pub const COMPLETE: &str = "complete";
+
+/// Marks the run in `dir` complete ([`COMPLETE`]) with its resolved scene.
+///
+/// # Errors
+/// When the mark cannot be written.
+pub fn mark_complete(dir: &Path, scene: &scene::Scene) -> Result<()> {
+    let path = dir.join(COMPLETE);
+    std::fs::write(&path, scene.to_toml()).map_err(|e| RunDirError::io("write", &path, e))
+}
+
+/// Whether the run in `dir` is marked complete for the scene in its `scene.toml`.
+pub fn is_complete(dir: &Path) -> bool {
+    match (
+        std::fs::read_to_string(dir.join(COMPLETE)),
+        std::fs::read_to_string(dir.join("scene.toml")),
+    ) {
+        (Ok(mark), Ok(scene)) => mark == scene,
+        _ => false,
+    }
+}
+
+/// Writes the resolved scene as `dir/scene.toml` (removing a [`COMPLETE`] mark), and `dir/run.json` (what the files mean:
 /// version, precision, lattice, axes, the unit of every column).
 ///
 /// # Errors
 /// When the file cannot be written.
 pub fn write_scene(dir: &Path, scene: &scene::Scene) -> Result<()> {
+    let _ = std::fs::remove_file(dir.join(COMPLETE));
     let path = dir.join("scene.toml");
     std::fs::write(&path, scene.to_toml()).map_err(|e| RunDirError::io("write", &path, e))?;
     sidecar::write_run_json(dir, scene)

@@ -114,6 +114,9 @@ pub struct AnalyzeInfo {
     pub partial: usize,
     /// Other files in `frames/` that were skipped (names that are not `frame_STEP.npz`).
     pub stray: Vec<String>,
+    /// Whether the run is marked complete ([`rundir::is_complete`]); if not, it is still
+    /// being written, was killed, or was written by a version before the mark.
+    pub complete: bool,
 }
 
 /// A frame file of a run, with the clock it holds.
@@ -521,6 +524,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         events: 0,
         partial,
         stray,
+        complete: rundir::is_complete(run_dir),
     };
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;

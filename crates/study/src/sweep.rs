@@ -13,8 +13,9 @@ use crate::plan::Point;
 use crate::summary::{analysis_columns, summarise, window, ANALYSIS_COLUMNS, SUMMARY_COLUMNS};
 use crate::SweepError;
 
-/// The file that marks a finished run; it holds the run's resolved scene.
-pub const COMPLETE: &str = "complete";
+/// The file that marks a finished run; it holds the run's resolved scene
+/// ([`rundir::COMPLETE`]).
+pub use rundir::COMPLETE;
 
 /// How a sweep shares the machine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -165,9 +166,10 @@ fn run_point(
         Precision::F64 => run_in::<f64>(point, &out, progress),
         Precision::F32 => run_in::<f32>(point, &out, progress),
     }?;
-    let mark = out.join(COMPLETE);
-    std::fs::write(&mark, point.scene.to_toml())
-        .map_err(|source| SweepError::write(&point.name, &mark, source))
+    rundir::mark_complete(&out, &point.scene).map_err(|source| SweepError::RunDir {
+        point: point.name.clone(),
+        source,
+    })
 }
 
 fn run_in<T: Real>(

@@ -170,6 +170,8 @@ pub struct ViewInfo {
     pub partial: usize,
     /// Other files in `frames/` that were skipped.
     pub stray: Vec<String>,
+    /// Whether the run is marked complete ([`rundir::is_complete`]).
+    pub complete: bool,
     /// The files written (PNGs, the movie; or the `.pvd` collections).
     pub files: Vec<PathBuf>,
 }
@@ -440,6 +442,7 @@ pub fn render_run(
         frames: total,
         partial: run.partial,
         stray: run.stray.clone(),
+        complete: rundir::is_complete(run_dir),
         files,
     })
 }
@@ -598,6 +601,7 @@ pub fn export_vtk(
         frames: total,
         partial: run.partial,
         stray: run.stray.clone(),
+        complete: rundir::is_complete(run_dir),
         files: vec![a, b],
     })
 }
