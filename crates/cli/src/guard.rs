@@ -46,6 +46,14 @@ fn gib(b: f64) -> String {
 /// # Errors
 /// The refusal, or a `--max-memory` that does not parse.
 pub fn memory(scene: &Scene, max_memory: Option<&str>) -> Result<()> {
+    memory_of(scene, 1, max_memory)
+}
+
+/// [`memory`] for `runs` such scenes at once (a sweep's `--jobs`).
+///
+/// # Errors
+/// As [`memory`].
+pub fn memory_of(scene: &Scene, runs: usize, max_memory: Option<&str>) -> Result<()> {
     let (limit, what) = match max_memory {
         Some(m) => (parse_bytes(m)?, format!("--max-memory {m}")),
         None => match available_memory() {
@@ -53,7 +61,7 @@ pub fn memory(scene: &Scene, max_memory: Option<&str>) -> Result<()> {
             None => return Ok(()),
         },
     };
-    let est = scene.memory_estimate();
+    let est = scene.memory_estimate() * runs.max(1) as f64;
     if est > limit {
         let f = scene.file();
         let shape = scene.patch_shape();
@@ -63,8 +71,13 @@ pub fn memory(scene: &Scene, max_memory: Option<&str>) -> Result<()> {
             }
             mechanics::Precision::F32 => "",
         };
+        let at_once = if runs > 1 {
+            format!(", {runs} runs at a time (use a smaller --jobs)")
+        } else {
+            String::new()
+        };
         bail!(
-            "the run needs about {} ({} cell(s) of {}×{} patch nodes on a {}×{} lattice), more than {} ({what}); reduce [cells] count, [domain] lx and ly or [integrator] margin{f32_hint}, or give a larger --max-memory",
+            "the run needs about {} ({} cell(s) of {}×{} patch nodes on a {}×{} lattice{at_once}), more than {} ({what}); reduce [cells] count, [domain] lx and ly or [integrator] margin{f32_hint}, or give a larger --max-memory",
             gib(est),
             f.cells.count,
             shape.nx,

@@ -100,6 +100,10 @@ enum Command {
         /// With `--analyze`: the first time analysed (default: the end of relaxation).
         #[arg(long, requires = "analyze")]
         from: Option<f64>,
+        /// Refuse a local sweep whose largest point, times --jobs, has a memory estimate above
+        /// this, e.g. `8G` (default: the memory available on this machine).
+        #[arg(long, value_name = "BYTES")]
+        max_memory: Option<String>,
     },
     /// The activity threshold of a sweep: for every combination of its other axes, the
     /// activity where the late growth rate of ln v_rms first exceeds that of zeta = 0 from the
@@ -313,6 +317,7 @@ fn real_main() -> Result<()> {
             threads,
             analyze,
             from,
+            max_memory,
         } => {
             anyhow::ensure!(
                 !(analyze && backend == "slurm" && !collect),
@@ -346,6 +351,7 @@ fn real_main() -> Result<()> {
                 threads: threads.unwrap_or(default_threads),
                 quiet,
                 action,
+                max_memory: max_memory.as_deref(),
                 analyze: analyze.then(|| AnalyzeOptions {
                     from,
                     ..AnalyzeOptions::default()

@@ -33,6 +33,8 @@ pub struct SweepArgs<'a> {
     pub quiet: bool,
     /// What to do.
     pub action: SweepAction,
+    /// `--max-memory`.
+    pub max_memory: Option<&'a str>,
     /// `--analyze`: analyse every run (as `monolayer analyze`, from `--from`) and add the
     /// lengths and defect statistics to the summary.
     pub analyze: Option<AnalyzeOptions>,
@@ -94,7 +96,18 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
     }
     let keys = spec.keys();
     match a.action {
-        SweepAction::Local => {}
+        SweepAction::Local => {
+            // The largest point, as many at once as --jobs runs.
+            let biggest = points.iter().max_by(|p, q| {
+                p.scene
+                    .memory_estimate()
+                    .total_cmp(&q.scene.memory_estimate())
+            });
+            if let Some(p) = biggest {
+                crate::guard::memory_of(&p.scene, a.jobs.min(points.len()), a.max_memory)
+                    .with_context(|| format!("in sweep point {}", p.name))?;
+            }
+        }
         SweepAction::Collect => {
             if let Some(opts) = &a.analyze {
                 study::analyze_points(&points, a.out, opts, SweepParams::new(a.jobs, a.threads))?;

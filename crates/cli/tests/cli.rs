@@ -1188,3 +1188,54 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
     );
     refuse(dir.path(), &[], "has no checkpoints/ to resume from");
 }
+
+/// A local sweep checks memory for its largest point times `--jobs` before anything runs,
+/// and names the point and `--jobs` in the refusal.
+#[test]
+fn a_sweep_too_large_for_memory_is_refused_before_it_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bin()
+        .arg("sweep")
+        .arg(scene_path("paper.toml"))
+        .args(["--vary", "model.zeta=0,0.005", "--jobs", "2", "--quiet"])
+        .args([
+            "--set",
+            "run.relax_time=0",
+            "--set",
+            "run.time=1",
+            "--max-memory",
+            "30M",
+        ])
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    for n in [
+        "in sweep point",
+        "2 runs at a time (use a smaller --jobs)",
+        "--max-memory 30M",
+    ] {
+        assert!(e.contains(n), "{e:?} lacks {n:?}");
+    }
+    assert!(!dir.path().join("runs").exists(), "nothing ran");
+    // One at a time fits.
+    let o = bin()
+        .arg("sweep")
+        .arg(scene_path("paper.toml"))
+        .args(["--vary", "model.zeta=0,0.005", "--jobs", "1", "--quiet"])
+        .args([
+            "--set",
+            "run.relax_time=0",
+            "--set",
+            "run.time=1",
+            "--max-memory",
+            "30M",
+        ])
+        .arg("--out")
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}
