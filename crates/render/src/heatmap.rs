@@ -64,18 +64,11 @@ impl Heatmap {
     }
 }
 
-/// Blue (negative) through white (0) to red (positive), for `t` in [−1, 1].
+/// Blue (negative) through white (0) to red (positive), for `t` in [−1, 1]: the map of
+/// [`crate::raster`], as a plotters colour.
 fn diverging(t: f64) -> RGBColor {
-    let t = t.clamp(-1.0, 1.0);
-    let (r0, g0, b0) = (247.0, 247.0, 247.0);
-    let (r1, g1, b1) = if t >= 0.0 {
-        (178.0, 24.0, 43.0)
-    } else {
-        (33.0, 102.0, 172.0)
-    };
-    let a = t.abs();
-    let mix = |p: f64, q: f64| (p + (q - p) * a).round() as u8;
-    RGBColor(mix(r0, r1), mix(g0, g1), mix(b0, b1))
+    let [r, g, b] = crate::raster::diverging(t);
+    RGBColor(r, g, b)
 }
 
 /// Draws `panels` into one PNG at `path`, `cols` to a row, each `panel_px` pixels wide, with
