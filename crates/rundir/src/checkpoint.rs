@@ -229,10 +229,9 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
         ));
     }
     let one = |k: usize| -> Result<f64> {
-        match a[k].data[..] {
-            [v] if v.is_finite() => Ok(v),
-            _ => Err(bad(names[k], "must hold one finite number".into())),
-        }
+        a[k].scalar()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(names[k], "must hold one finite number".into()))
     };
     let (step, time, zeta) = (one(1)? as u64, one(2)?, one(3)?);
     let l = scene.lattice();

@@ -159,6 +159,16 @@ pub struct Array {
     pub data: Vec<f64>,
 }
 
+impl Array {
+    /// The value of an array that holds exactly one, as a scalar (`()`) array does.
+    pub fn scalar(&self) -> Option<f64> {
+        match self.data[..] {
+            [v] => Some(v),
+            _ => None,
+        }
+    }
+}
+
 /// Reads the arrays `names` (and only those) from an `.npz` archive. Integer and float32
 /// arrays are converted to `f64` (exactly).
 ///

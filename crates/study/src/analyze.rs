@@ -193,6 +193,12 @@ pub(crate) fn list_frames(run_dir: &Path) -> Result<FrameList> {
     })
 }
 
+/// The default smoothing box of a scene: the odd side nearest 3R, at most the lattice's.
+pub(crate) fn default_box(scene: &Scene) -> usize {
+    let l = scene.lattice();
+    paper_box_side(scene.file().cells.radius).min(l.lx.min(l.ly) | 1)
+}
+
 /// Reads the run's resolved scene.
 pub(crate) fn read_scene(run_dir: &Path) -> Result<Scene> {
     if !run_dir.is_dir() {
@@ -266,13 +272,12 @@ pub(crate) fn load_frame(
             .try_into()
             .expect("read_npz returns one array per name");
     let one = |a: &Array, name: &str| -> Result<f64> {
-        match a.data[..] {
-            [v] => Ok(v),
-            _ => Err(input(
+        a.scalar().ok_or_else(|| {
+            input(
                 path,
                 format!("array '{name}' must hold one number, not {}", a.data.len()),
-            )),
-        }
+            )
+        })
     };
     let (step, time, zeta) = (
         one(&step, "step")? as u64,
@@ -374,16 +379,15 @@ fn frame_clock(path: &Path) -> Result<(u64, f64)> {
         )
     })?;
     let scalar = |k: usize, name: &str| -> Result<f64> {
-        match a[k].data[..] {
-            [v] if v.is_finite() => Ok(v),
-            _ => Err(input(
+        a[k].scalar().filter(|v| v.is_finite()).ok_or_else(|| {
+            input(
                 path,
                 format!(
                     "array '{name}' must hold one finite number, not {:?}",
                     a[k].data
                 ),
-            )),
-        }
+            )
+        })
     };
     let format = scalar(0, "format")? as i64;
     if !FRAME_FORMATS_READ.contains(&format) {
@@ -439,9 +443,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     } = list_frames(run_dir)?;
     let from = opts.from.unwrap_or(scene.file().run.relax_time);
     let radius = scene.file().cells.radius;
-    let box_side = opts
-        .box_side
-        .unwrap_or_else(|| paper_box_side(radius).min(lattice.lx.min(lattice.ly) | 1));
+    let box_side = opts.box_side.unwrap_or_else(|| default_box(&scene));
     box_smooth(lattice, &vec![0.0; lattice.len()], box_side)
         .map_err(|e| AnalyzeError::Options(format!("--box {box_side}: {e}")))?;
     if opts.crop_side % 2 != 1 {

@@ -16,14 +16,16 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 use analysis::defects::detect;
-use analysis::smooth::{box_smooth, paper_box_side};
+use analysis::smooth::box_smooth;
 use mechanics::{TissueFields, Workspace};
 use render::{CellAxes, Fill, LatticeVectors, Movie, Patches, RenderError, TissuePicture};
 use rundir::vtk::{write_pvd, write_vti, write_vtp, VtkArray, VtkValues};
 use rundir::RunDirError;
 use scene::Scene;
 
-use crate::analyze::{list_frames, load_frame, read_scene, AnalyzeError, FrameList, LoadedFrame};
+use crate::analyze::{
+    default_box, list_frames, load_frame, read_scene, AnalyzeError, FrameList, LoadedFrame,
+};
 
 /// What stops a render or an export.
 #[derive(Debug, thiserror::Error)]
@@ -228,11 +230,6 @@ impl Run {
             self.scene.lattice(),
         )?)
     }
-
-    fn smoothing_box(&self) -> usize {
-        let l = self.scene.lattice();
-        paper_box_side(self.scene.file().cells.radius).min(l.lx.min(l.ly) | 1)
-    }
 }
 
 fn create_dir(dir: &Path) -> Result<()> {
@@ -323,7 +320,7 @@ fn picture(
     p.range = opts.range;
     if let Some(f) = &f {
         if opts.director || opts.defects {
-            let side = run.smoothing_box();
+            let side = default_box(&run.scene);
             let smooth = |v: &[f64]| box_smooth(l, v, side).expect("the box fits the lattice");
             let (qxx, qxy) = (smooth(&f.qxx), smooth(&f.qxy));
             if opts.defects {
