@@ -20,7 +20,7 @@ use study::analyze::crop_fields;
 fn frame() -> (Lattice, mechanics::Tissue, Workspace) {
     let path = format!("{}/../scenes/large.toml", env!("CARGO_MANIFEST_DIR"));
     let s = Scene::parse(&std::fs::read_to_string(path).unwrap(), &[]).unwrap();
-    let mut t = s.tissue::<f64>();
+    let mut t = s.tissue::<f64>().expect("a scene of discs builds");
     let mut ws = Workspace::new(t.cells());
     for k in 0..300 {
         t.params_mut().zeta = if k < 200 { 0.0 } else { 0.005 };

@@ -30,7 +30,7 @@ pub fn relaxed_scene<T: Real>(
 ) -> (Tissue<T>, Workspace<T>, Scene) {
     let path = format!("{}/../scenes/{name}", env!("CARGO_MANIFEST_DIR"));
     let s = Scene::parse(&std::fs::read_to_string(path).unwrap(), overrides).unwrap();
-    let mut t = s.tissue::<T>();
+    let mut t = s.tissue::<T>().expect("a scene of discs builds");
     let mut ws = Workspace::new(t.cells());
     t.params_mut().zeta = 0.0;
     for _ in 0..relax_steps {

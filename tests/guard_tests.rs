@@ -11,7 +11,7 @@ fn scene(text: &str, set: &[&str]) -> Scene {
 }
 
 fn held<T: Real>(s: &Scene) -> f64 {
-    let t = s.tissue::<T>();
+    let t = s.tissue::<T>().expect("a scene of discs builds");
     let ws = Workspace::new(t.cells());
     (t.heap_bytes() + ws.heap_bytes()) as f64
 }
@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 24] = [
+const KEYS: [&str; 25] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -126,6 +126,7 @@ const KEYS: [&str; 24] = [
     "cells.init_radius",
     "cells.init",
     "cells.positions",
+    "cells.from",
     "model.gamma",
     "model.mu",
     "model.lambda",
@@ -144,7 +145,7 @@ const KEYS: [&str; 24] = [
     "run.output_every",
     "run.series_every",
 ];
-const VALUES: [&str; 30] = [
+const VALUES: [&str; 32] = [
     "0",
     "-1",
     "1",
@@ -170,12 +171,38 @@ const VALUES: [&str; 30] = [
     "\"random\"",
     "\"hexagonal\"",
     "\"positions\"",
+    "\"frame\"",
+    FRAME,
     "\"paper\"",
     "\"interaction\"",
     "\"f32\"",
     "\"f64\"",
     "{ a = 1 }",
 ];
+
+/// Stands for the path of a real frame of the base scene (`frame_path`) among [`VALUES`].
+const FRAME: &str = "FRAME";
+
+/// A frame of the fuzz corpus's base scene (48², 4 cells), written once, as a TOML string.
+fn frame_path() -> &'static str {
+    static PATH: std::sync::OnceLock<(tempfile::TempDir, String)> = std::sync::OnceLock::new();
+    &PATH
+        .get_or_init(|| {
+            let dir = tempfile::tempdir().unwrap();
+            let s = Scene::parse(FUZZ_BASE, &[]).unwrap();
+            let t = s.tissue::<f32>().unwrap();
+            let mut ws = Workspace::new(t.cells());
+            t.observe(&mut ws);
+            let path = rundir::write_frame(dir.path(), &t, &ws).unwrap();
+            let quoted = format!("{:?}", path.display().to_string());
+            (dir, quoted)
+        })
+        .1
+}
+
+/// The base scene the fuzz corpus overrides.
+const FUZZ_BASE: &str =
+    "[domain]\nlx = 48\nly = 48\n[cells]\ncount = 4\nradius = 6.0\n[run]\ntime = 1\nrelax_time = 0\n";
 
 /// What a fuzzed scene ended in.
 #[derive(Debug, Default)]
@@ -185,14 +212,14 @@ struct Tally {
     runs: usize,
     run_errors: usize,
     too_big: usize,
+    runs_from_frame: usize,
 }
 
 /// One fuzzed scene: parse and validate it; if valid and small, build it and take two steps.
 /// Returns a message for a panic or an error without a key; records the outcome.
 fn fuzz_one(overrides: &[String], tally: &mut Tally) -> Result<(), String> {
-    let base = "[domain]\nlx = 48\nly = 48\n[cells]\ncount = 4\nradius = 6.0\n[run]\ntime = 1\nrelax_time = 0\n";
     tally.cases += 1;
-    let parsed = std::panic::catch_unwind(|| Scene::parse(base, overrides))
+    let parsed = std::panic::catch_unwind(|| Scene::parse(FUZZ_BASE, overrides))
         .map_err(|_| format!("{overrides:?}: Scene::parse panicked"))?;
     let s = match parsed {
         Err(e) => {
@@ -211,15 +238,23 @@ fn fuzz_one(overrides: &[String], tally: &mut Tally) -> Result<(), String> {
         return Ok(());
     }
     let stepped = std::panic::catch_unwind(|| {
-        let mut t = s.tissue::<f32>();
+        // A saved state that cannot be read or does not fit is a clean error too.
+        let mut t = rundir::initial_tissue::<f32>(&s).map_err(|e| e.to_string())?;
         let mut ws = Workspace::new(t.cells());
         let p = s.step_params();
-        (0..2).try_for_each(|_| t.step(&mut ws, &p))
+        Ok::<_, String>((0..2).try_for_each(|_| t.step(&mut ws, &p)))
     })
     .map_err(|_| format!("{overrides:?}: building or stepping the valid scene panicked"))?;
-    tally.runs += 1;
-    if stepped.is_err() {
-        tally.run_errors += 1;
+    match stepped {
+        Err(msg) if msg.contains("[cells] from") || msg.contains(".npz") => tally.errors += 1,
+        Err(msg) => return Err(format!("{overrides:?}: unhelpful message {msg:?}")),
+        Ok(stepped) => {
+            tally.runs += 1;
+            tally.runs_from_frame += usize::from(s.init_from().is_some());
+            if stepped.is_err() {
+                tally.run_errors += 1;
+            }
+        }
     }
     Ok(())
 }
@@ -244,11 +279,28 @@ fn fuzzed_scenes_end_in_a_clean_error_or_a_valid_run() {
     };
     let rng = TestRng::deterministic_rng(config.rng_algorithm);
     let mut runner = TestRunner::new_with_rng(config, rng);
-    let overrides = prop::collection::vec((0..KEYS.len(), 0..VALUES.len()), 1..=3).prop_map(|v| {
-        v.into_iter()
-            .map(|(k, x)| format!("{}={}", KEYS[k], VALUES[x]))
-            .collect::<Vec<_>>()
-    });
+    // A third of the cases start from a saved frame of the base scene, so that overrides meet
+    // `init = "frame"` too.
+    let overrides = (
+        prop::collection::vec((0..KEYS.len(), 0..VALUES.len()), 1..=3),
+        0..3,
+    )
+        .prop_map(|(v, base)| {
+            let from_frame = (base == 0).then(|| {
+                [
+                    "cells.init=\"frame\"".to_string(),
+                    format!("cells.from={}", frame_path()),
+                ]
+            });
+            from_frame
+                .into_iter()
+                .flatten()
+                .chain(v.into_iter().map(|(k, x)| match VALUES[x] {
+                    FRAME => format!("{}={}", KEYS[k], frame_path()),
+                    v => format!("{}={v}", KEYS[k]),
+                }))
+                .collect::<Vec<_>>()
+        });
     let tally = std::cell::RefCell::new(Tally::default());
     // Silence the default panic message of caught panics; they are reported as failures.
     let hook = std::panic::take_hook();
@@ -259,12 +311,12 @@ fn fuzzed_scenes_end_in_a_clean_error_or_a_valid_run() {
     std::panic::set_hook(hook);
     let t = tally.into_inner();
     eprintln!(
-        "scene fuzz: {} cases, {} clean errors, {} valid runs ({} stopped by a step error), {} valid but too large to run here",
-        t.cases, t.errors, t.runs, t.run_errors, t.too_big
+        "scene fuzz: {} cases, {} clean errors, {} valid runs ({} from a saved frame, {} stopped by a step error), {} valid but too large to run here",
+        t.cases, t.errors, t.runs, t.runs_from_frame, t.run_errors, t.too_big
     );
     result.unwrap();
     assert!(
-        t.errors > 0 && t.runs > 0,
+        t.errors > 0 && t.runs > 0 && t.runs_from_frame > 0,
         "{t:?}: the corpus must reach both outcomes"
     );
 }

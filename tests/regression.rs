@@ -16,7 +16,7 @@ fn paper_scene(overrides: &[&str]) -> Scene {
 /// Runs `scene` (relaxation, then activity) in f64 and returns `(time, observables)` every
 /// `every` steps.
 fn run(scene: &Scene, every: u64) -> Vec<(f64, Observables)> {
-    let mut sim = scene.simulation::<f64>();
+    let mut sim = scene.simulation::<f64>().expect("a scene of discs builds");
     let samples = Arc::new(Mutex::new(Vec::new()));
     let sink = samples.clone();
     sim.add_callback(

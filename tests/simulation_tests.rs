@@ -25,7 +25,10 @@ fn observed_run(schedule: Schedule, margin: usize, sort_every: u64) -> Vec<Recor
         .chain([format!("integrator.margin={margin}")])
         .collect::<Vec<_>>();
     let scene = Scene::parse(&text, &overrides).unwrap();
-    let mut sim = scene.simulation::<f32>().sort_every(Some(sort_every));
+    let mut sim = scene
+        .simulation::<f32>()
+        .expect("a scene of discs builds")
+        .sort_every(Some(sort_every));
     let out = Arc::new(Mutex::new(Vec::new()));
     let sink = out.clone();
     sim.add_output_writer("recorder", schedule, move |o: &mut Observation<f32>| {
@@ -198,7 +201,7 @@ fn heap_bytes_count_the_patch_buffers() {
             "[domain]\nlx = 96\nly = 96\n[cells]\ncount = {count}\nradius = 8.0\n[integrator]\nmargin = 12\n[run]\ntime = 1\n"
         );
         let s = scene::Scene::parse(&text, &[]).unwrap();
-        let sim = s.simulation::<f32>();
+        let sim = s.simulation::<f32>().expect("a scene of discs builds");
         let patch = s.patch_shape().len();
         (
             sim.tissue().heap_bytes(),

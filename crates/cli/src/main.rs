@@ -285,13 +285,17 @@ fn real_main() -> Result<()> {
             };
             let text = std::fs::read_to_string(&scene)
                 .with_context(|| format!("cannot read scene file {}", scene.display()))?;
+            let set = run::absolute_from(&scene, &text, &set)?;
             let parsed = Scene::parse(&text, &set)
                 .with_context(|| format!("in scene {}", scene.display()))?;
             monolayer_cli::guard::memory(&parsed, max_memory.as_deref())
                 .with_context(|| format!("in scene {}", scene.display()))?;
+            // Read before --out is prepared: --overwrite may remove the frame it names.
+            let state = rundir::initial_state(&parsed)
+                .with_context(|| format!("in scene {}", scene.display()))?;
             rundir::prepare(&out, overwrite)?;
             let pool = pool(threads)?;
-            let info = pool.install(|| run::run(&parsed, &out, quiet))?;
+            let info = pool.install(|| run::run(&parsed, state.as_ref(), &out, quiet))?;
             if !quiet {
                 eprintln!(
                     "done: {} steps in {:.2} s, {} frames in {}",
@@ -466,7 +470,7 @@ fn real_main() -> Result<()> {
             let info =
                 pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
             if !quiet {
-                note_skipped(info.partial, &info.stray, info.complete, &run_dir);
+                note_skipped(&info.notes, &run_dir);
                 match &opts.movie {
                     Some(m) => eprintln!(
                         "drew {} frames into {} and {}",
@@ -495,7 +499,7 @@ fn real_main() -> Result<()> {
             let info =
                 pool(threads)?.install(|| export_vtk(&run_dir, &out, &frames, &mut progress))?;
             if !quiet {
-                note_skipped(info.partial, &info.stray, info.complete, &run_dir);
+                note_skipped(&info.notes, &run_dir);
                 eprintln!(
                     "exported {} frames; open {} (and cells.pvd) in ParaView",
                     info.frames,
@@ -523,7 +527,7 @@ fn real_main() -> Result<()> {
                 s_rms_baseline,
             };
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
-            note_skipped(info.partial, &info.stray, info.complete, &run_dir);
+            note_skipped(&info.notes, &run_dir);
             eprintln!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,
@@ -536,15 +540,27 @@ fn real_main() -> Result<()> {
     }
 }
 
-fn note_skipped(partial: usize, stray: &[String], complete: bool, run_dir: &std::path::Path) {
+fn note_skipped(notes: &study::analyze::FrameNotes, run_dir: &std::path::Path) {
+    let study::analyze::FrameNotes {
+        partial,
+        stray,
+        missing,
+        complete,
+    } = notes;
     if !complete {
         eprintln!(
             "note: {} is not marked complete: the run is still being written or was killed (continue it with monolayer run --resume {0})",
             run_dir.display()
         );
     }
-    if partial > 0 {
+    if *partial > 0 {
         eprintln!("note: skipped {partial} partially written frame(s)");
+    }
+    if let Some(first) = missing.first() {
+        eprintln!(
+            "note: {} frame(s) of the run's schedule are missing, the first at step {first}: time differences and rates span the gap",
+            missing.len()
+        );
     }
     if let Some(first) = stray.first() {
         eprintln!(

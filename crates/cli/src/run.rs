@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
-use phasefield::Real;
+use phasefield::{Cells, Real};
 use scene::Scene;
 
 use rundir::FinalToo;
@@ -23,20 +23,72 @@ pub struct RunInfo {
     pub frames: usize,
 }
 
-/// Runs a valid scene, writing into `out`. On a step error the output written so far is
-/// kept and the error is returned.
+/// Runs a valid scene, writing into `out`, from `state` when the scene starts from a saved
+/// one (`rundir::initial_state`, read before `out` is prepared). On a step error the output
+/// written so far is kept and the error is returned.
 ///
 /// # Errors
 /// When the directory cannot be written or the run stops early.
-pub fn run(scene: &Scene, out: &Path, quiet: bool) -> Result<RunInfo> {
+pub fn run(scene: &Scene, state: Option<&Cells<f64>>, out: &Path, quiet: bool) -> Result<RunInfo> {
     rundir::write_scene(out, scene)?;
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
+    let from = match state {
+        Some(s) => Start::State(s),
+        None => Start::Scene,
+    };
     match scene.precision() {
-        Precision::F64 => run_in::<f64>(scene, out, quiet, None),
-        Precision::F32 => run_in::<f32>(scene, out, quiet, None),
+        Precision::F64 => run_in::<f64>(scene, out, quiet, from),
+        Precision::F32 => run_in::<f32>(scene, out, quiet, from),
     }
+}
+
+/// `[cells] from` made absolute, as an override appended to `set`: a relative path given with
+/// `--set cells.from=P` is taken from the current directory, one in the scene file from the
+/// scene file's directory, so that the resolved scene (`DIR/scene.toml`, a sweep's points, a
+/// SLURM task) names the same file from anywhere.
+///
+/// # Errors
+/// A scene that does not parse (the caller's validation reports it with its context).
+pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Vec<String>> {
+    let mut set = set.to_vec();
+    let cwd = std::env::current_dir().context("cannot read the current directory")?;
+    let quoted = |p: &Path| {
+        let s = p.to_string_lossy();
+        let escaped = s.replace('\\', "\\\\").replace('"', "\\\"");
+        format!("cells.from=\"{escaped}\"")
+    };
+    for o in &mut set {
+        if let Some((k, v)) = o.split_once('=') {
+            if k.trim() == "cells.from" {
+                let v = v.trim().trim_matches('"');
+                if Path::new(v).is_relative() {
+                    *o = quoted(&cwd.join(v));
+                }
+            }
+        }
+    }
+    if let Ok(file) = scene::SceneFile::parse(text, &set) {
+        if let Some(from) = file.cells.from.as_deref() {
+            if Path::new(from).is_relative() {
+                let base = scene_path.parent().unwrap_or(Path::new(""));
+                set.push(quoted(&cwd.join(base).join(from)));
+            }
+        }
+    }
+    Ok(set)
+}
+
+/// Where a run's state comes from.
+#[derive(Clone, Copy)]
+enum Start<'a> {
+    /// The scene's initial discs.
+    Scene,
+    /// A saved state (`init = "frame"`).
+    State(&'a Cells<f64>),
+    /// A checkpoint of this run (`--resume`).
+    Checkpoint(&'a Path),
 }
 
 /// Continues the run in `dir` from its latest readable checkpoint to the end of its scene,
@@ -79,9 +131,10 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<(u64, RunInfo)>
                     scene.file().run.time
                 );
                 rundir::write_scene(dir, &scene)?;
+                let from = Start::Checkpoint(path);
                 let info = match scene.precision() {
-                    Precision::F64 => run_in::<f64>(&scene, dir, quiet, Some(path)),
-                    Precision::F32 => run_in::<f32>(&scene, dir, quiet, Some(path)),
+                    Precision::F64 => run_in::<f64>(&scene, dir, quiet, from),
+                    Precision::F32 => run_in::<f32>(&scene, dir, quiet, from),
                 }?;
                 return Ok((step, info));
             }
@@ -96,15 +149,19 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<(u64, RunInfo)>
     Err(last_err.expect("at least one checkpoint was tried"))
 }
 
-fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Option<&Path>) -> Result<RunInfo> {
+fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Start<'_>) -> Result<RunInfo> {
     let counts = scene.step_counts();
     let (mut sim, written) = match from {
-        None => {
-            let mut sim = scene.simulation::<T>();
+        Start::Scene | Start::State(_) => {
+            let tissue = match from {
+                Start::State(state) => scene.tissue_from_state::<T>(state)?,
+                _ => scene.tissue::<T>()?,
+            };
+            let mut sim = scene.simulation_from(tissue);
             let w = rundir::add_writers(&mut sim, out, &counts)?;
             (sim, w)
         }
-        Some(path) => {
+        Start::Checkpoint(path) => {
             let tissue = rundir::checkpoint::read_checkpoint::<T>(path, scene)?;
             let step = tissue.iteration();
             let mut sim = mechanics::Simulation::new(tissue, scene.step_params())
@@ -121,12 +178,9 @@ fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Option<&Path>) 
         FinalToo::new(Progress::new(counts.total_steps(), quiet)),
     );
     let result = sim.run();
-    let info = result.with_context(|| {
-        format!(
-            "the run stopped; output up to step {} is kept in {}",
-            sim.tissue().iteration(),
-            out.display()
-        )
+    let info = result.map_err(|e| {
+        let kept = stopped(out, sim.tissue().iteration(), &e);
+        anyhow::Error::new(e).context(kept)
     })?;
     rundir::mark_complete(out, scene)?;
     Ok(RunInfo {
@@ -134,6 +188,29 @@ fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Option<&Path>) 
         wall_s: info.wall_time.as_secs_f64(),
         frames: written.frames(),
     })
+}
+
+/// What a run that stopped at `step` with `error` has kept in `out`, and how to go on.
+fn stopped(out: &Path, step: u64, error: &mechanics::SimulationError) -> String {
+    let frames = match rundir::last_frame(out) {
+        Some(f) => format!("frames up to step {f}"),
+        None => "no frame".into(),
+    };
+    let mut msg = format!(
+        "the run stopped at step {step}; {} keeps {frames} and series.csv up to its last whole row",
+        out.display()
+    );
+    // A step error would happen again; a failed write (a full disk) can be resumed.
+    if matches!(error, mechanics::SimulationError::Callback { .. }) {
+        match rundir::checkpoint::checkpoints(out).last() {
+            Some((c, _)) => msg.push_str(&format!(
+                "; once the cause is fixed, monolayer run --resume {} continues from the checkpoint at step {c}",
+                out.display()
+            )),
+            None => msg.push_str("; there is no checkpoint to resume from"),
+        }
+    }
+    msg
 }
 
 /// A progress bar on a terminal, plain lines (about every 10 %) otherwise.

@@ -73,23 +73,37 @@ pub enum SweepOutcome {
 pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
     let spec = match a.scene {
         None => SweepSpec::load(a.out)?,
-        Some(path) => SweepSpec {
-            scene_text: std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read scene file {}", path.display()))?,
-            sets: a.set.to_vec(),
-            varies: a
-                .vary
-                .iter()
-                .map(|v| v.parse::<Vary>())
-                .collect::<Result<Vec<_>, _>>()?,
-            seeds: a.seeds.map(|s| s.parse::<Seeds>()).transpose()?,
-        },
+        Some(path) => {
+            let scene_text = std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read scene file {}", path.display()))?;
+            SweepSpec {
+                sets: crate::run::absolute_from(path, &scene_text, a.set)?,
+                scene_text,
+                varies: a
+                    .vary
+                    .iter()
+                    .map(|v| v.parse::<Vary>())
+                    .collect::<Result<Vec<_>, _>>()?,
+                seeds: a.seeds.map(|s| s.parse::<Seeds>()).transpose()?,
+            }
+        }
     };
     let points = spec.plan().with_context(|| match a.scene {
         Some(p) => format!("in scene {}", p.display()),
         None => format!("in the sweep recorded in {}", a.out.display()),
     })?;
     if a.action != SweepAction::Collect {
+        // The saved states the points start from (init = "frame"), each read once and
+        // checked against its points before anything runs.
+        let mut checked = std::collections::HashSet::new();
+        for p in &points {
+            let s = p.scene.file();
+            let key = (p.scene.init_from(), s.domain.lx, s.domain.ly, s.cells.count);
+            if key.0.is_some() && checked.insert(key) {
+                rundir::initial_state(&p.scene)
+                    .with_context(|| format!("in sweep point {}", p.name))?;
+            }
+        }
         std::fs::create_dir_all(a.out)
             .with_context(|| format!("cannot create {}", a.out.display()))?;
         spec.save(a.out)?;

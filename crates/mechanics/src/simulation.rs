@@ -113,7 +113,7 @@ pub enum SimulationError {
     #[error(transparent)]
     Step(#[from] StepError),
     /// A callback or writer failed.
-    #[error("{name} failed at step {iteration}: {source}")]
+    #[error("{name} failed at step {iteration}")]
     Callback {
         /// The name it was added under.
         name: String,

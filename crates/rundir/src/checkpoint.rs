@@ -23,13 +23,13 @@
 //! at any moment leaves the previous checkpoint intact; the newest [`KEEP`] are kept.
 
 use std::fs::File;
-use std::io::{BufReader, Read, Write};
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
 use mechanics::Tissue;
 use phasefield::{Cells, Real};
 
-use crate::frame::{npy, read_npz};
+use crate::frame::{npy, read_npz, write_zip};
 use crate::{Result, RunDirError};
 
 /// Version of the checkpoint layout.
@@ -120,41 +120,13 @@ pub fn write_checkpoint<T: Real>(
         ])
     };
     let arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
-    write_synced(&path, arrays)?;
+    // Stored, not deflated: the state is mostly noise in its low bits.
+    write_zip(&path, arrays, zip::CompressionMethod::Stored, true)?;
     let all = checkpoints(dir);
     for (_, old) in all.iter().take(all.len().saturating_sub(KEEP)) {
         let _ = std::fs::remove_file(old);
     }
     Ok(path)
-}
-
-/// Like [`crate::write_npz`], stored (no compression: the state is mostly noise in its low
-/// bits) and flushed to disk before the rename.
-fn write_synced(path: &Path, arrays: Vec<(&str, Vec<u8>)>) -> Result<()> {
-    let tmp = path.with_extension("npz.partial");
-    let write = || -> std::io::Result<()> {
-        let f = File::create(&tmp)?;
-        let mut zip = zip::ZipWriter::new(std::io::BufWriter::new(f));
-        let opts = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Stored)
-            .large_file(true);
-        for (name, bytes) in arrays {
-            zip.start_file(format!("{name}.npy"), opts)
-                .map_err(std::io::Error::other)?;
-            zip.write_all(&bytes)?;
-        }
-        let mut w = zip.finish().map_err(std::io::Error::other)?;
-        w.flush()?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()
-    };
-    write().map_err(|e| RunDirError::io("write", &tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| RunDirError::io("rename", &tmp, e))?;
-    if let Some(parent) = path.parent() {
-        if let Ok(d) = File::open(parent) {
-            let _ = d.sync_all();
-        }
-    }
-    Ok(())
 }
 
 /// The resolved scene a checkpoint was written with.

@@ -21,7 +21,7 @@
 //! the same layout with `phi` always float64; [`read_npz`] reads both.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::io::{BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 
 use mechanics::{Tissue, Workspace};
@@ -128,25 +128,83 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
     Ok(path)
 }
 
+/// The step of a frame file named `frame_STEP.npz`.
+pub(crate) fn frame_step(name: &str) -> Option<u64> {
+    name.strip_prefix("frame_")?
+        .strip_suffix(".npz")?
+        .parse()
+        .ok()
+}
+
+/// The step of the last whole frame in `dir/frames/` (by name; a `.partial` file is not a
+/// frame), if any.
+pub fn last_frame(dir: &Path) -> Option<u64> {
+    std::fs::read_dir(dir.join("frames"))
+        .ok()?
+        .filter_map(|e| frame_step(e.ok()?.file_name().to_str()?))
+        .max()
+}
+
 /// Writes named `.npy` arrays (from [`npy`]) as a deflated `.npz` archive, through a
 /// temporary name so that a reader never sees a half-written file.
+///
+/// # Errors
+/// I/O errors (a full disk among them), naming the file; the temporary file is removed.
 pub fn write_npz<S: AsRef<str>>(path: &Path, arrays: Vec<(S, Vec<u8>)>) -> Result<()> {
+    write_zip(path, arrays, zip::CompressionMethod::Deflated, false)
+}
+
+/// Writes an `.npz` archive of `arrays` under `PATH.partial`, with `method` (deflate at
+/// level 1, or stored), flushed to disk first when `sync`, then renames it to `path` (and
+/// syncs the directory). On an error the partial file is removed.
+///
+/// The archive is built in memory (each array is freed once it is in), then written in one
+/// go: a write error (a full disk) then reaches the caller alone, where a zip writer on the
+/// file would meet it again in its `Drop` and print it, or trip an assertion.
+pub(crate) fn write_zip<S: AsRef<str>>(
+    path: &Path,
+    arrays: Vec<(S, Vec<u8>)>,
+    method: zip::CompressionMethod,
+    sync: bool,
+) -> Result<()> {
     let tmp = path.with_extension("npz.partial");
-    let write = || -> std::io::Result<()> {
-        let f = File::create(&tmp)?;
-        let mut zip = zip::ZipWriter::new(BufWriter::new(f));
-        let opts = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Deflated)
-            .compression_level(Some(1));
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let level = (method == zip::CompressionMethod::Deflated).then_some(1);
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(method)
+        .compression_level(level)
+        .large_file(true);
+    let encode = || -> std::io::Result<()> {
         for (name, bytes) in arrays {
             zip.start_file(format!("{}.npy", name.as_ref()), opts)
                 .map_err(std::io::Error::other)?;
             zip.write_all(&bytes)?;
         }
-        zip.finish().map_err(std::io::Error::other)?.flush()
+        Ok(())
     };
-    write().map_err(|e| RunDirError::io("write", &tmp, e))?;
+    encode().map_err(|e| RunDirError::io("encode", path, e))?;
+    let bytes = zip
+        .finish()
+        .map_err(|e| RunDirError::io("encode", path, std::io::Error::other(e)))?
+        .into_inner();
+    let write = || -> std::io::Result<()> {
+        let mut f = File::create(&tmp)?;
+        f.write_all(&bytes)?;
+        if sync {
+            f.sync_all()?;
+        }
+        Ok(())
+    };
+    if let Err(e) = write() {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(RunDirError::io("write", &tmp, e));
+    }
     std::fs::rename(&tmp, path).map_err(|e| RunDirError::io("rename", &tmp, e))?;
+    if sync {
+        if let Some(d) = path.parent().and_then(|p| File::open(p).ok()) {
+            let _ = d.sync_all();
+        }
+    }
     Ok(())
 }
 
@@ -236,7 +294,7 @@ mod tests {
         let scene = scene::Scene::parse(text, &[]).unwrap();
         let dir = tempfile::tempdir().unwrap();
         fn check<T: Real>(scene: &scene::Scene, dir: &Path, dtype: &str) {
-            let tissue = scene.tissue::<T>();
+            let tissue = scene.tissue::<T>().expect("a scene of discs builds");
             let mut ws = Workspace::new(tissue.cells());
             tissue.observe(&mut ws);
             let path = write_frame(dir, &tissue, &ws).unwrap();

@@ -12,21 +12,26 @@
 //! | `vtk/*.vti`, `*.vtp`, `*.pvd` | [`vtk`]: ParaView files (by `monolayer export vtk`) |
 //!
 //! [`add_writers`] adds the series and frame writers to a [`mechanics::Simulation`];
-//! [`read_npz`] reads frames back. Errors name the file ([`RunDirError`]).
+//! [`read_npz`] reads frames back; [`initial_tissue`] builds a scene's initial tissue, from a
+//! saved frame or checkpoint when it has `init = "frame"` ([`state`]). Errors name the file ([`RunDirError`]).
 #![deny(missing_docs)]
 
 pub mod checkpoint;
 mod frame;
 mod series;
 mod sidecar;
+pub mod state;
 pub mod vtk;
 mod writers;
 
 use std::path::{Path, PathBuf};
 
-pub use frame::{npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
+pub use frame::{
+    last_frame, npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ,
+};
 pub use series::{SeriesWriter, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
+pub use state::{initial_state, initial_tissue, read_state, StateError};
 pub use writers::{add_checkpoints, add_writers, add_writers_resumed, FinalToo, Written};
 
 /// A file of a run directory could not be read or written.

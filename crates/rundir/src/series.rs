@@ -1,7 +1,7 @@
 //! `series.csv`: one row of observables every `series_every` steps.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 
 use mechanics::{Observables, Tissue};
@@ -13,10 +13,14 @@ use crate::{Result, RunDirError};
 pub const SERIES_HEADER: &str =
     "step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max,cell_speed_rms,phi_min,phi_max";
 
-/// Writes `series.csv` row by row, flushing each row so that a run that stops keeps them.
+/// Writes `series.csv` row by row, each row in one write, so that a run that stops keeps
+/// them; a row that fails (a full disk) is cut off again, so the file always ends with a
+/// whole row.
 pub struct SeriesWriter {
     path: PathBuf,
-    out: BufWriter<File>,
+    out: File,
+    /// Bytes of whole rows (and the header).
+    len: u64,
 }
 
 impl SeriesWriter {
@@ -26,12 +30,10 @@ impl SeriesWriter {
     /// When the file cannot be created or written.
     pub fn create(dir: &Path) -> Result<Self> {
         let path = dir.join("series.csv");
-        let f = File::create(&path).map_err(|e| RunDirError::io("create", &path, e))?;
-        let mut out = BufWriter::new(f);
-        writeln!(out, "{SERIES_HEADER}")
-            .and_then(|_| out.flush())
-            .map_err(|e| RunDirError::io("write", &path, e))?;
-        Ok(Self { path, out })
+        let out = File::create(&path).map_err(|e| RunDirError::io("create", &path, e))?;
+        let mut w = Self { path, out, len: 0 };
+        w.append(&format!("{SERIES_HEADER}\n"))?;
+        Ok(w)
     }
 
     /// Opens `dir/series.csv` of a resumed run: keeps its header and the rows before step
@@ -65,14 +67,14 @@ impl SeriesWriter {
         let tmp = dir.join("series.csv.partial");
         std::fs::write(&tmp, &kept).map_err(|e| RunDirError::io("write", &tmp, e))?;
         std::fs::rename(&tmp, &path).map_err(|e| RunDirError::io("rename", &tmp, e))?;
-        let f = std::fs::OpenOptions::new()
-            .append(true)
+        let mut out = std::fs::OpenOptions::new()
+            .write(true)
             .open(&path)
             .map_err(|e| RunDirError::io("open", &path, e))?;
-        Ok(Self {
-            path,
-            out: BufWriter::new(f),
-        })
+        let len = kept.len() as u64;
+        out.seek(SeekFrom::Start(len))
+            .map_err(|e| RunDirError::io("open", &path, e))?;
+        Ok(Self { path, out, len })
     }
 
     /// Appends one row.
@@ -80,9 +82,8 @@ impl SeriesWriter {
     /// # Errors
     /// When the row cannot be written.
     pub fn row<T: Real>(&mut self, tissue: &Tissue<T>, o: &Observables) -> Result<()> {
-        writeln!(
-            self.out,
-            "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}",
+        self.append(&format!(
+            "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}\n",
             tissue.iteration(),
             tissue.time(),
             tissue.params().zeta,
@@ -94,8 +95,21 @@ impl SeriesWriter {
             o.cell_speed_rms,
             o.phi_min,
             o.phi_max
-        )
-        .and_then(|_| self.out.flush())
-        .map_err(|e| RunDirError::io("write", &self.path, e))
+        ))
+    }
+
+    /// Writes `text` after the last whole row; on an error, cuts the file back to it.
+    fn append(&mut self, text: &str) -> Result<()> {
+        match self.out.write_all(text.as_bytes()) {
+            Ok(()) => {
+                self.len += text.len() as u64;
+                Ok(())
+            }
+            Err(e) => {
+                let _ = self.out.set_len(self.len);
+                let _ = self.out.seek(SeekFrom::Start(self.len));
+                Err(RunDirError::io("write", &self.path, e))
+            }
+        }
     }
 }

@@ -57,10 +57,7 @@ pub fn add_writers_resumed<T: Real>(
     if let Ok(entries) = std::fs::read_dir(&frames) {
         for p in entries.filter_map(|e| e.ok().map(|e| e.path())) {
             let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            let step = name
-                .strip_prefix("frame_")
-                .and_then(|n| n.strip_suffix(".npz"))
-                .and_then(|n| n.parse::<u64>().ok());
+            let step = crate::frame::frame_step(name);
             if name.ends_with(".partial") || step.is_some_and(|s| s >= from) {
                 std::fs::remove_file(&p).map_err(|e| crate::RunDirError::io("remove", &p, e))?;
             }

@@ -29,6 +29,10 @@ pub enum InitKind {
     Hexagonal,
     /// The centres in `[cells] positions`.
     Positions,
+    /// The state saved in `[cells] from`: a frame (`RUN/frames/frame_STEP.npz`) or a
+    /// checkpoint (`RUN/checkpoints/checkpoint_STEP.npz`) of a run on the same lattice with
+    /// the same number of cells.
+    Frame,
 }
 
 /// `[cells]`.
@@ -46,6 +50,10 @@ pub struct CellsSpec {
     /// Centres for `init = "positions"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub positions: Option<Vec<[f64; 2]>>,
+    /// The saved state for `init = "frame"`: a frame or checkpoint file (a relative path is
+    /// taken from the scene file's directory by `monolayer run`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from: Option<String>,
     /// Radius of the initial discs (default R/2: cells start smaller than their target and
     /// grow during relaxation, MODEL.md §6).
     #[serde(default, skip_serializing_if = "Option::is_none")]

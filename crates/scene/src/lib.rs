@@ -22,7 +22,7 @@
 //! let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/paper.toml"))?;
 //! // The paper's scene, shortened: 20 TU of relaxation, then 10 TU at its ζ.
 //! let scene = Scene::parse(&text, &["run.relax_time=20".into(), "run.time=10".into()])?;
-//! let mut sim = scene.simulation::<f32>();
+//! let mut sim = scene.simulation::<f32>()?;
 //! sim.add_callback("print", Schedule::TimeInterval(10.0), |o: &mut Observation<f32>| {
 //!     println!("t = {:5.1}  v_rms = {:.3e}", o.time(), o.observables().v_rms);
 //!     Ok(())
@@ -40,7 +40,7 @@ pub use file::{CellsSpec, Domain, InitKind, Integrator, Model, Run, SceneFile};
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
 use mechanics::{ModelParams, Precision, Simulation, StepParams, Tissue};
-use phasefield::{init, Lattice, PatchShape, Real};
+use phasefield::{init, Cells, Lattice, PatchShape, Real};
 
 /// A valid scene: only [`SceneFile::validate`] (or [`Scene::parse`]) makes one, so every
 /// value in it has been checked, and building from it cannot fail.
@@ -173,41 +173,136 @@ impl Scene {
             .dt_above_estimate()
             .map(|dt_max| {
                 format!(
-                    "[integrator] dt = {} is above the stability estimate {dt_max:.3}; the run stops if it blows up",
-                    self.file.integrator.dt
+                    "[integrator] dt = {} is above the stability estimate {}; the run stops if it blows up",
+                    self.file.integrator.dt,
+                    validate::sig3(dt_max)
                 )
             })
             .into_iter()
             .collect()
     }
 
+    /// The saved state the scene starts from (`[cells] from`, with `init = "frame"`), as
+    /// the scene gives it; `None` for the other layouts.
+    pub fn init_from(&self) -> Option<&str> {
+        match self.file.cells.init {
+            InitKind::Frame => self.file.cells.from.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// The activity at step 0: ζ = 0 when there is a relaxation phase.
+    fn initial_params(&self) -> ModelParams {
+        let zeta = if self.step_counts().relax_steps > 0 {
+            0.0
+        } else {
+            self.file.model.zeta
+        };
+        self.model_params(zeta)
+    }
+
     /// The initial tissue (at ζ = 0 when there is a relaxation phase), with its fields stored
     /// in precision `T`: the initial discs are computed in `f64` and rounded once.
-    pub fn tissue<T: Real>(&self) -> Tissue<T> {
+    ///
+    /// # Errors
+    /// [`SceneError::State`] for a scene that starts from a saved state (`init = "frame"`):
+    /// read the state and use [`Scene::tissue_from_state`] (`rundir::initial_tissue` does
+    /// both).
+    pub fn tissue<T: Real>(&self) -> Result<Tissue<T>, SceneError> {
+        if let Some(from) = self.init_from() {
+            return Err(SceneError::State {
+                from: from.to_string(),
+                problem: "the scene starts from a saved state, which has not been read".into(),
+                fix: "read it and build the tissue with Scene::tissue_from_state (rundir::initial_tissue does both)".into(),
+            });
+        }
         let f = &self.file;
-        let r0 = f.init_radius();
         let cells = init::discs(
             self.lattice(),
             self.patch_shape(),
             &self.centres,
-            r0,
+            f.init_radius(),
             f.model.lambda,
         );
-        let zeta = if self.step_counts().relax_steps > 0 {
-            0.0
-        } else {
-            f.model.zeta
-        };
-        Tissue::new(cells.into_precision::<T>(), self.model_params(zeta))
+        Ok(Tissue::new(
+            cells.into_precision::<T>(),
+            self.initial_params(),
+        ))
+    }
+
+    /// The initial tissue from a saved state `state` (the fields of a frame or a checkpoint,
+    /// cells in identity order, on any patch size): each cell's field is copied node for node
+    /// onto a patch of the scene's margin centred on the cell's centre of mass (what lies
+    /// outside the saved patch is zero, what lies outside the new one is dropped), rounded
+    /// once to `T`. The clock starts at 0 with the scene's parameters; the cells' shapes,
+    /// positions and identities are the state's.
+    ///
+    /// # Errors
+    /// [`SceneError::State`] when the state's lattice or cell count is not the scene's.
+    pub fn tissue_from_state<T: Real>(&self, state: &Cells<f64>) -> Result<Tissue<T>, SceneError> {
+        self.check_state(state)?;
+        let ids = (0..state.n_cells()).collect();
+        let placed = Tissue::from_state(state.clone(), self.initial_params(), 0.0, 0, ids);
+        let cells = state.resampled(self.patch_shape(), placed.centres());
+        Ok(Tissue::new(
+            cells.into_precision::<T>(),
+            self.initial_params(),
+        ))
+    }
+
+    /// Checks that a saved state fits the scene: the same lattice and the same number of
+    /// cells (the patch size and precision may differ).
+    ///
+    /// # Errors
+    /// [`SceneError::State`] naming what differs and the key to change.
+    pub fn check_state(&self, state: &Cells<f64>) -> Result<(), SceneError> {
+        let from = self.file.cells.from.clone().unwrap_or_default();
+        let (l, sl) = (self.lattice(), state.lattice());
+        if (l.lx, l.ly) != (sl.lx, sl.ly) {
+            return Err(SceneError::State {
+                from,
+                problem: format!(
+                    "the state is on a {}×{} lattice, the scene's [domain] is {}×{}",
+                    sl.lx, sl.ly, l.lx, l.ly
+                ),
+                fix: format!(
+                    "set [domain] lx = {}, ly = {} (a state cannot be moved to another lattice)",
+                    sl.lx, sl.ly
+                ),
+            });
+        }
+        let n = self.file.cells.count;
+        if state.n_cells() != n {
+            return Err(SceneError::State {
+                from,
+                problem: format!(
+                    "the state holds {} cells, the scene's [cells] count is {n}",
+                    state.n_cells()
+                ),
+                fix: format!("set [cells] count = {}", state.n_cells()),
+            });
+        }
+        Ok(())
     }
 
     /// A simulation of the scene with fields stored in precision `T` (choose it from
     /// [`Scene::precision`]): the initial tissue, the integrator, ζ = 0 for `relax_time` and
     /// the scene's ζ after, stopping after `relax_time + time`. Add callbacks and writers,
     /// then [`Simulation::run`] it.
-    pub fn simulation<T: Real>(&self) -> Simulation<T> {
+    ///
+    /// # Errors
+    /// As [`Scene::tissue`]: a scene that starts from a saved state needs
+    /// [`Scene::simulation_from`].
+    pub fn simulation<T: Real>(&self) -> Result<Simulation<T>, SceneError> {
+        Ok(self.simulation_from(self.tissue::<T>()?))
+    }
+
+    /// A simulation of the scene from the initial tissue `tissue` (from [`Scene::tissue`] or
+    /// [`Scene::tissue_from_state`]): the scene's integrator, ζ = 0 for `relax_time` and the
+    /// scene's ζ after, stopping after `relax_time + time` counted from the tissue's step.
+    pub fn simulation_from<T: Real>(&self, tissue: Tissue<T>) -> Simulation<T> {
         let counts = self.step_counts();
-        Simulation::new(self.tissue::<T>(), self.step_params())
+        Simulation::new(tissue, self.step_params())
             .activity_from(counts.relax_steps, self.zeta())
             .stop_iteration(counts.total_steps())
     }

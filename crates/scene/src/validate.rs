@@ -27,6 +27,17 @@ pub enum SceneError {
         /// What to do.
         fix: String,
     },
+    /// A saved state does not fit the scene (`init = "frame"`), or the scene was asked to
+    /// build its tissue without the state it starts from.
+    #[error("[cells] from = {from:?}: {problem}; {fix}")]
+    State {
+        /// The path of the saved state, as the scene gives it.
+        from: String,
+        /// What is wrong.
+        problem: String,
+        /// What to do.
+        fix: String,
+    },
 }
 
 /// The longest lattice side [`SceneFile::validate`] accepts.
@@ -37,7 +48,7 @@ pub const MAX_SIDE: usize = 65536;
 pub const MAX_STEPS: f64 = 1e9;
 
 /// `v` with three significant digits, never rounded to 0.
-fn sig3(v: f64) -> String {
+pub(crate) fn sig3(v: f64) -> String {
     if v != 0.0 && !(0.01..1e4).contains(&v.abs()) {
         format!("{v:.2e}")
     } else {
@@ -151,13 +162,43 @@ impl SceneFile {
                     "add positions = [[x, y], ...] with one pair per cell",
                 ));
             }
-            (InitKind::Random | InitKind::Hexagonal, Some(_)) => {
+            (InitKind::Random | InitKind::Hexagonal | InitKind::Frame, Some(_)) => {
                 return Err(invalid(
                     "cells",
                     "positions",
                     "[...]",
                     "positions are only read with init = \"positions\"",
                     "set init = \"positions\" or remove positions",
+                ));
+            }
+            _ => {}
+        }
+        match (c.init, c.from.as_deref()) {
+            (InitKind::Frame, None) => {
+                return Err(invalid(
+                    "cells",
+                    "init",
+                    "\"frame\"",
+                    "no saved state is given",
+                    "add from = \"RUN/frames/frame_STEP.npz\" (or a checkpoint, RUN/checkpoints/checkpoint_STEP.npz)",
+                ));
+            }
+            (InitKind::Frame, Some(f)) if f.trim().is_empty() => {
+                return Err(invalid(
+                    "cells",
+                    "from",
+                    "\"\"",
+                    "the path is empty",
+                    "give the frame or checkpoint to start from, e.g. from = \"out/relaxed/frames/frame_00001000.npz\"",
+                ));
+            }
+            (InitKind::Random | InitKind::Hexagonal | InitKind::Positions, Some(f)) => {
+                return Err(invalid(
+                    "cells",
+                    "from",
+                    format!("{f:?}"),
+                    "a saved state is only read with init = \"frame\"",
+                    "set init = \"frame\" or remove from",
                 ));
             }
             _ => {}
@@ -303,7 +344,13 @@ impl SceneFile {
                 }
             }
         }
-        let layout = self.layout();
+        let Some(layout) = self.layout() else {
+            // The state is read when the tissue is built (`Scene::tissue_from_state`).
+            return Ok(Scene {
+                file: self,
+                centres: Vec::new(),
+            });
+        };
         let centres = match init::positions(lattice, c.count, r0, &layout) {
             Ok(centres) => centres,
             Err(e) => {
@@ -331,8 +378,9 @@ impl SceneFile {
         })
     }
 
-    fn layout(&self) -> init::Layout {
-        match self.cells.init {
+    /// The layout of the initial discs, or `None` when the scene starts from a saved state.
+    fn layout(&self) -> Option<init::Layout> {
+        Some(match self.cells.init {
             InitKind::Random => init::Layout::Random {
                 seed: self.run.seed,
             },
@@ -340,7 +388,8 @@ impl SceneFile {
             InitKind::Positions => {
                 init::Layout::Positions(self.cells.positions.clone().unwrap_or_default())
             }
-        }
+            InitKind::Frame => return None,
+        })
     }
 
     /// The stability estimate `ModelParams::max_stable_dt` of the active phase, when the

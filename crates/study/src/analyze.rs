@@ -110,10 +110,20 @@ pub struct AnalyzeInfo {
     pub defects: usize,
     /// Creation and annihilation events.
     pub events: usize,
+    /// What reading the frames noticed.
+    pub notes: FrameNotes,
+}
+
+/// What reading the frames of a run directory noticed, for the caller to report.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FrameNotes {
     /// Partially written frames (`*.partial`) that were skipped.
     pub partial: usize,
     /// Other files in `frames/` that were skipped (names that are not `frame_STEP.npz`).
     pub stray: Vec<String>,
+    /// Steps of the frame schedule (multiples of the scene's frame interval) between the
+    /// first and the last frame that have no frame: removed, or lost to a full disk.
+    pub missing: Vec<u64>,
     /// Whether the run is marked complete ([`rundir::is_complete`]); if not, it is still
     /// being written, was killed, or was written by a version before the mark.
     pub complete: bool,
@@ -131,16 +141,14 @@ pub(crate) struct FrameFile {
 pub(crate) struct FrameList {
     /// In the order of their `step` arrays.
     pub frames: Vec<FrameFile>,
-    /// Partially written frames (`*.partial`) skipped.
-    pub partial: usize,
-    /// Other files in `frames/` skipped (a name that is not `frame_STEP.npz`).
-    pub stray: Vec<String>,
+    /// Files skipped, frames missing, completeness.
+    pub notes: FrameNotes,
 }
 
-/// The frames of a run directory in the order of their `step` arrays (not of their names),
-/// each checked to be of a format this version reads; partial and stray files are counted
-/// and skipped.
-pub(crate) fn list_frames(run_dir: &Path) -> Result<FrameList> {
+/// The frames of a run directory of `scene` in the order of their `step` arrays (not of their
+/// names), each checked to be of a format this version reads; partial and stray files are
+/// counted and skipped, and the steps of the scene's frame schedule without a frame noted.
+pub(crate) fn list_frames(run_dir: &Path, scene: &Scene) -> Result<FrameList> {
     let dir = run_dir.join("frames");
     let entries = std::fs::read_dir(&dir)
         .map_err(|_| input(run_dir, "no frames/ directory: the run wrote no frame yet"))?;
@@ -186,10 +194,24 @@ pub(crate) fn list_frames(run_dir: &Path) -> Result<FrameList> {
         ));
     }
     stray.sort();
+    let every = scene.step_counts().frame_every;
+    let (first, last) = (frames[0].step, frames[frames.len() - 1].step);
+    let mut have = frames.iter().map(|f| f.step).peekable();
+    let mut missing = Vec::new();
+    for step in (first.div_ceil(every)..=last / every).map(|k| k * every) {
+        while have.next_if(|&s| s < step).is_some() {}
+        if have.peek() != Some(&step) {
+            missing.push(step);
+        }
+    }
     Ok(FrameList {
         frames,
-        partial,
-        stray,
+        notes: FrameNotes {
+            partial,
+            stray,
+            missing,
+            complete: rundir::is_complete(run_dir),
+        },
     })
 }
 
@@ -436,11 +458,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let scene = read_scene(run_dir)?;
     let lattice = scene.lattice();
     let shape = scene.patch_shape();
-    let FrameList {
-        frames,
-        partial,
-        stray,
-    } = list_frames(run_dir)?;
+    let FrameList { frames, notes } = list_frames(run_dir, &scene)?;
     let from = opts.from.unwrap_or(scene.file().run.relax_time);
     let radius = scene.file().cells.radius;
     let box_side = opts.box_side.unwrap_or_else(|| default_box(&scene));
@@ -524,9 +542,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         frames: 0,
         defects: 0,
         events: 0,
-        partial,
-        stray,
-        complete: rundir::is_complete(run_dir),
+        notes,
     };
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;

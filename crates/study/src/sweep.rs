@@ -178,7 +178,11 @@ fn run_in<T: Real>(
     progress: Arc<dyn Fn(u64) + Send + Sync>,
 ) -> Result<(), SweepError> {
     let counts = point.scene.step_counts();
-    let mut sim = point.scene.simulation::<T>();
+    let tissue = rundir::initial_tissue::<T>(&point.scene).map_err(|source| SweepError::State {
+        point: point.name.clone(),
+        source: Box::new(source),
+    })?;
+    let mut sim = point.scene.simulation_from(tissue);
     rundir::add_writers(&mut sim, out, &counts).map_err(|source| SweepError::RunDir {
         point: point.name.clone(),
         source,

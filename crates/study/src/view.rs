@@ -24,7 +24,8 @@ use rundir::RunDirError;
 use scene::Scene;
 
 use crate::analyze::{
-    default_box, list_frames, load_frame, read_scene, AnalyzeError, FrameList, LoadedFrame,
+    default_box, list_frames, load_frame, read_scene, AnalyzeError, FrameList, FrameNotes,
+    LoadedFrame,
 };
 
 /// What stops a render or an export.
@@ -168,12 +169,8 @@ impl Default for RenderOptions {
 pub struct ViewInfo {
     /// Frames drawn or exported.
     pub frames: usize,
-    /// Partially written frames that were skipped.
-    pub partial: usize,
-    /// Other files in `frames/` that were skipped.
-    pub stray: Vec<String>,
-    /// Whether the run is marked complete ([`rundir::is_complete`]).
-    pub complete: bool,
+    /// What reading the frames noticed.
+    pub notes: FrameNotes,
     /// The files written (PNGs, the movie; or the `.pvd` collections).
     pub files: Vec<PathBuf>,
 }
@@ -182,18 +179,13 @@ pub struct ViewInfo {
 struct Run {
     scene: Scene,
     frames: Vec<PathBuf>,
-    partial: usize,
-    stray: Vec<String>,
+    notes: FrameNotes,
 }
 
 impl Run {
     fn open(run_dir: &Path, which: &Frames) -> Result<Self> {
         let scene = read_scene(run_dir)?;
-        let FrameList {
-            frames: all,
-            partial,
-            stray,
-        } = list_frames(run_dir)?;
+        let FrameList { frames: all, notes } = list_frames(run_dir, &scene)?;
         let frames = match which {
             Frames::All => all.into_iter().map(|f| f.path).collect(),
             Frames::Steps(steps) => {
@@ -217,8 +209,7 @@ impl Run {
         Ok(Self {
             scene,
             frames,
-            partial,
-            stray,
+            notes,
         })
     }
 
@@ -437,9 +428,7 @@ pub fn render_run(
     }
     Ok(ViewInfo {
         frames: total,
-        partial: run.partial,
-        stray: run.stray.clone(),
-        complete: rundir::is_complete(run_dir),
+        notes: run.notes.clone(),
         files,
     })
 }
@@ -596,9 +585,7 @@ pub fn export_vtk(
     write_pvd(&b, &cells_pvd)?;
     Ok(ViewInfo {
         frames: total,
-        partial: run.partial,
-        stray: run.stray.clone(),
-        complete: rundir::is_complete(run_dir),
+        notes: run.notes.clone(),
         files: vec![a, b],
     })
 }

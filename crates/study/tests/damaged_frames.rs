@@ -32,7 +32,7 @@ fn run_dir(dir: &Path) {
     let s = scene::Scene::parse(text, &[]).unwrap();
     rundir::prepare(dir, false).unwrap();
     rundir::write_scene(dir, &s).unwrap();
-    let mut t = s.tissue::<f32>();
+    let mut t = s.tissue::<f32>().expect("a scene of discs builds");
     let mut ws = Workspace::new(t.cells());
     for _ in 0..3 {
         t.observe(&mut ws);

@@ -32,7 +32,10 @@ fn measure(lx: usize, margin: usize, steps: u64, repeats: usize) -> Result<(f64,
     let mut times = Vec::new();
     let mut mem = f64::NAN;
     for _ in 0..repeats {
-        let mut sim = scene.simulation::<f32>();
+        let mut sim = scene.simulation::<f32>().map_err(|e| SweepError::Scene {
+            point: format!("scaling L = {lx}, margin {margin}"),
+            source: Box::new(e),
+        })?;
         let start = Instant::now();
         sim.run().map_err(|source| SweepError::Run {
             point: format!("scaling L = {lx}, margin {margin}"),

@@ -1,0 +1,261 @@
+//! Saved states to start a new scene from (`[cells] init = "frame"`): the fields of a frame
+//! (`frames/frame_STEP.npz`) or of a checkpoint (`checkpoints/checkpoint_STEP.npz`), read into
+//! [`Cells`] in identity order on the patches they were saved on, and the initial tissue of a
+//! scene built from them ([`initial_tissue`]).
+
+use std::path::Path;
+
+use mechanics::Tissue;
+use phasefield::{Cells, Lattice, PatchShape, Real};
+use scene::{Scene, SceneError, MAX_SIDE};
+
+use crate::checkpoint::CHECKPOINT_FORMAT;
+use crate::frame::{read_npz, Array, FRAME_FORMATS_READ};
+use crate::{Result, RunDirError};
+
+/// The fields saved in `path`, a frame or a checkpoint (told apart by their arrays), as
+/// [`Cells`] in identity order (cell `i` of the frame's arrays, `cell_id = i` of the
+/// checkpoint's slots) on the patches they were saved on, widened exactly to `f64`.
+///
+/// # Errors
+/// A missing or damaged file, or arrays that do not describe a state (wrong shapes,
+/// non-finite values, origins off the lattice), naming the file and the array.
+pub fn read_state(path: &Path) -> Result<Cells<f64>> {
+    match read_npz(path, &["offset"]) {
+        Ok(_) => read_checkpoint_state(path),
+        Err(RunDirError::MissingArray { .. }) => read_frame_state(path),
+        Err(e) => Err(e),
+    }
+}
+
+/// The initial tissue of `scene`: from the saved state of `[cells] from` (a relative path is
+/// taken from the current directory) when the scene has `init = "frame"`, otherwise from its
+/// initial discs.
+///
+/// # Errors
+/// The state cannot be read, or does not fit the scene (lattice, cell count).
+pub fn initial_tissue<T: Real>(scene: &Scene) -> std::result::Result<Tissue<T>, StateError> {
+    match initial_state(scene)? {
+        None => Ok(scene.tissue::<T>()?),
+        Some(state) => Ok(scene.tissue_from_state::<T>(&state)?),
+    }
+}
+
+/// The saved state `scene` starts from (`init = "frame"`; `None` for the other layouts),
+/// read and checked against the scene, so that a caller can refuse a scene before it writes
+/// anything.
+///
+/// # Errors
+/// The state cannot be read, or does not fit the scene (lattice, cell count).
+pub fn initial_state(scene: &Scene) -> std::result::Result<Option<Cells<f64>>, StateError> {
+    let Some(from) = scene.init_from() else {
+        return Ok(None);
+    };
+    let state = read_state(Path::new(from)).map_err(|error| StateError::Read {
+        from: from.to_string(),
+        error,
+    })?;
+    scene.check_state(&state)?;
+    Ok(Some(state))
+}
+
+/// Why the initial tissue of a scene could not be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum StateError {
+    /// The saved state cannot be read.
+    #[error("[cells] from = {from:?}: {error}{}; give a frame (RUN/frames/frame_STEP.npz) or a checkpoint (RUN/checkpoints/checkpoint_STEP.npz) of a run on the scene's lattice", reason(error))]
+    Read {
+        /// The path, as the scene gives it.
+        from: String,
+        /// What went wrong (in the message, not repeated as a source).
+        error: RunDirError,
+    },
+    /// The state does not fit the scene.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+/// The operating system's reason for an I/O error, which [`RunDirError`]'s message leaves to
+/// its source.
+fn reason(e: &RunDirError) -> String {
+    match e {
+        RunDirError::Io { source, .. } => format!(" ({source})"),
+        _ => String::new(),
+    }
+}
+
+fn bad(path: &Path, name: &str, reason: impl Into<String>) -> RunDirError {
+    RunDirError::BadArray {
+        path: path.to_path_buf(),
+        name: name.into(),
+        reason: reason.into(),
+    }
+}
+
+/// The format number of a state file, checked against those this version reads.
+fn check_format(path: &Path, a: &Array, known: std::ops::RangeInclusive<i64>) -> Result<()> {
+    match a.scalar() {
+        Some(f) if known.clone().any(|k| k as f64 == f) => Ok(()),
+        _ => Err(bad(
+            path,
+            "format",
+            format!("{:?}; this version reads {known:?}", a.data),
+        )),
+    }
+}
+
+/// The lattice of `[lx, ly]`.
+fn lattice(path: &Path, a: &Array) -> Result<Lattice> {
+    match a.data[..] {
+        [lx, ly]
+            if [lx, ly]
+                .iter()
+                .all(|&v| v.fract() == 0.0 && (8.0..=MAX_SIDE as f64).contains(&v)) =>
+        {
+            Ok(Lattice::new(lx as usize, ly as usize))
+        }
+        _ => Err(bad(
+            path,
+            "lattice",
+            format!("{:?} is not [lx, ly] with sides in [8, {MAX_SIDE}]", a.data),
+        )),
+    }
+}
+
+/// The patch shape of `nx × ny` patches on `l`: `2m + 1` square, or the full domain.
+fn patch_shape(path: &Path, l: Lattice, nx: u64, ny: u64) -> Result<PatchShape> {
+    let square_odd = nx == ny && nx % 2 == 1 && nx >= 3;
+    let margin = if square_odd && nx as usize <= l.lx.min(l.ly) {
+        (nx as usize - 1) / 2
+    } else if (nx as usize, ny as usize) == (l.lx, l.ly) {
+        0
+    } else {
+        return Err(bad(
+            path,
+            "phi",
+            format!(
+                "patches of {nx}×{ny} are neither 2m+1 square nor the {}×{} lattice",
+                l.lx, l.ly
+            ),
+        ));
+    };
+    PatchShape::new(l, margin).map_err(|e| bad(path, "phi", e.to_string()))
+}
+
+/// `n × 2` non-negative integers below the lattice sides, as node pairs.
+fn nodes(
+    path: &Path,
+    name: &str,
+    a: &Array,
+    n: usize,
+    below: [usize; 2],
+) -> Result<Vec<[usize; 2]>> {
+    if a.data.len() != 2 * n {
+        return Err(bad(
+            path,
+            name,
+            format!("{} values for {n} cells (want {n}×2)", a.data.len()),
+        ));
+    }
+    a.data
+        .chunks_exact(2)
+        .enumerate()
+        .map(|(i, p)| {
+            let ok = |v: f64, l: usize| v >= 0.0 && v.fract() == 0.0 && v < l as f64;
+            if ok(p[0], below[0]) && ok(p[1], below[1]) {
+                Ok([p[0] as usize, p[1] as usize])
+            } else {
+                Err(bad(
+                    path,
+                    name,
+                    format!(
+                        "cell {i}: {p:?} is outside [0, {}) × [0, {})",
+                        below[0], below[1]
+                    ),
+                ))
+            }
+        })
+        .collect()
+}
+
+fn finite(path: &Path, name: &str, v: &[f64]) -> Result<()> {
+    match v.iter().filter(|x| !x.is_finite()).count() {
+        0 => Ok(()),
+        k => Err(bad(
+            path,
+            name,
+            format!("{k} non-finite values: the state is not one the model can have"),
+        )),
+    }
+}
+
+fn read_frame_state(path: &Path) -> Result<Cells<f64>> {
+    let a = read_npz(path, &["format", "lattice", "origin", "phi"])?;
+    check_format(path, &a[0], FRAME_FORMATS_READ)?;
+    let l = lattice(path, &a[1])?;
+    let phi = &a[3];
+    let [n, nx, ny] = phi.shape[..] else {
+        return Err(bad(
+            path,
+            "phi",
+            format!("shape {:?}, want (cells, nx, ny)", phi.shape),
+        ));
+    };
+    if n == 0 {
+        return Err(bad(path, "phi", "the frame holds no cells"));
+    }
+    let shape = patch_shape(path, l, nx, ny)?;
+    let origins = nodes(path, "origin", &a[2], n as usize, [l.lx, l.ly])?;
+    finite(path, "phi", &phi.data)?;
+    Ok(Cells::from_unrolled(l, shape, &origins, &phi.data))
+}
+
+fn read_checkpoint_state(path: &Path) -> Result<Cells<f64>> {
+    let names = [
+        "format", "lattice", "patch", "phi", "origin", "offset", "cell_id",
+    ];
+    let a = read_npz(path, &names)?;
+    check_format(path, &a[0], CHECKPOINT_FORMAT..=CHECKPOINT_FORMAT)?;
+    let l = lattice(path, &a[1])?;
+    let (nx, ny) = match a[2].data[..] {
+        [nx, ny] if nx >= 1.0 && ny >= 1.0 => (nx as u64, ny as u64),
+        _ => {
+            return Err(bad(
+                path,
+                "patch",
+                format!("{:?} is not [nx, ny]", a[2].data),
+            ))
+        }
+    };
+    let shape = patch_shape(path, l, nx, ny)?;
+    let n = a[6].data.len();
+    if n == 0 || a[3].data.len() != n * shape.len() {
+        return Err(bad(
+            path,
+            "phi",
+            format!("{} values for {n} cells of {nx}×{ny}", a[3].data.len()),
+        ));
+    }
+    finite(path, "phi", &a[3].data)?;
+    let origin = nodes(path, "origin", &a[4], n, [l.lx, l.ly])?;
+    let offset = nodes(path, "offset", &a[5], n, [shape.nx, shape.ny])?;
+    // Slot `s` holds the cell whose identity is `cell_id[s]`; identity order takes, for each
+    // identity `j`, the slot that holds it.
+    let mut order = vec![usize::MAX; n];
+    for (slot, &id) in a[6].data.iter().enumerate() {
+        let ok = id >= 0.0 && id.fract() == 0.0 && id < n as f64;
+        if !ok || order[id as usize] != usize::MAX {
+            return Err(bad(
+                path,
+                "cell_id",
+                format!("slot {slot} holds {id}: not a permutation of 0..{n}"),
+            ));
+        }
+        order[id as usize] = slot;
+    }
+    let mut cells = Cells::from_storage(l, shape, a[3].data.clone(), origin, offset)
+        .map_err(|r| bad(path, "phi", r))?;
+    cells.permute(&order, &mut Vec::new());
+    Ok(cells)
+}
