@@ -16,7 +16,9 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use mechanics::{ModelParams, StepParams, Tissue, Workspace};
+use mechanics::{
+    AdaptiveParams, Controller, ModelParams, StateCheck, StepParams, Tissue, Workspace,
+};
 use phasefield::{Cells, PatchShape, Real};
 
 const T_ACTIVE: f64 = 20.0;
@@ -29,9 +31,13 @@ struct Config {
     npc: usize,
     /// Single-precision storage.
     f32: bool,
+    /// An adaptive step with this local error tolerance (`dt` is the first attempt; the
+    /// largest step is the scene's stability estimate).
+    adaptive: Option<f64>,
 }
 
-fn run<T: Real>(start: &Cells, centres: &[[f64; 2]], c: &Config) -> (Tissue<T>, f64) {
+/// A run's final state, its best wall time and its evaluations of the right-hand side.
+fn run<T: Real>(start: &Cells, centres: &[[f64; 2]], c: &Config) -> (Tissue<T>, f64, u64) {
     let lattice = start.lattice();
     let cells = start
         .resampled(PatchShape::new(lattice, c.margin).unwrap(), centres)
@@ -40,12 +46,26 @@ fn run<T: Real>(start: &Cells, centres: &[[f64; 2]], c: &Config) -> (Tissue<T>, 
     let sp = StepParams::new(c.dt, c.npc);
     let mut best = f64::INFINITY;
     let mut last = None;
+    let mut evaluations = (steps * (1 + c.npc)) as u64;
     for rep in 0..3 {
         let mut t = Tissue::new(cells.clone(), ModelParams::paper(ZETA));
         let mut ws = Workspace::new(t.cells());
         let t0 = Instant::now();
-        for _ in 0..steps {
-            t.step(&mut ws, &sp).expect("stable");
+        match c.adaptive {
+            None => {
+                for _ in 0..steps {
+                    t.step(&mut ws, &sp).expect("stable");
+                }
+            }
+            Some(tol) => {
+                let p = AdaptiveParams::new(tol, ModelParams::paper(ZETA).max_stable_dt());
+                let mut ctrl = Controller::new(c.dt);
+                while t.time() < T_ACTIVE {
+                    t.step_adaptive(&mut ws, &p, &mut ctrl, T_ACTIVE, &mut StateCheck::default())
+                        .expect("stable");
+                }
+                evaluations = ctrl.evaluations();
+            }
         }
         let wall = t0.elapsed().as_secs_f64();
         best = best.min(wall);
@@ -54,7 +74,7 @@ fn run<T: Real>(start: &Cells, centres: &[[f64; 2]], c: &Config) -> (Tissue<T>, 
             break;
         }
     }
-    (last.unwrap(), best)
+    (last.unwrap(), best, evaluations)
 }
 
 fn errors<T: Real>(reference: &Tissue, t: &Tissue<T>) -> (f64, f64) {
@@ -90,8 +110,9 @@ fn study() {
         dt: 0.01,
         npc: 1,
         f32: false,
+        adaptive: None,
     };
-    let (reference, ref_wall) = run::<f64>(&start, &centres, &reference_cfg);
+    let (reference, ref_wall, _) = run::<f64>(&start, &centres, &reference_cfg);
     eprintln!("reference: {ref_wall:.1} s");
 
     let mut configs = Vec::new();
@@ -102,6 +123,7 @@ fn study() {
             dt: 0.05,
             npc: 1,
             f32: false,
+            adaptive: None,
         });
     }
     for dt in [1.0, 0.5, 0.2, 0.1, 0.05, 0.02] {
@@ -115,6 +137,7 @@ fn study() {
                 dt,
                 npc,
                 f32: false,
+                adaptive: None,
             });
         }
     }
@@ -126,6 +149,7 @@ fn study() {
                 dt,
                 npc: 1,
                 f32: false,
+                adaptive: None,
             });
         }
     }
@@ -135,6 +159,7 @@ fn study() {
         dt: 0.2,
         npc: 0,
         f32: false,
+        adaptive: None,
     });
     for (m, dts) in [
         (0, &[0.5, 0.1, 0.02][..]),
@@ -154,32 +179,62 @@ fn study() {
                 dt,
                 npc: 1,
                 f32: true,
+                adaptive: None,
             });
         }
     }
 
-    let mut csv = String::from("config,margin,dt,npc,precision,wall_s,centre_error,phi_error\n");
+    // The adaptive step (Heun–Euler pair, PI controller) at several tolerances, from dt 0.5.
+    for m in [16, 25, 0] {
+        for tol in [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5] {
+            let place = if m == 0 {
+                "full".to_string()
+            } else {
+                format!("margin {m}")
+            };
+            configs.push(Config {
+                name: format!("{place}, adaptive, tol {tol:.0e}"),
+                margin: m,
+                dt: 0.5,
+                npc: 1,
+                f32: false,
+                adaptive: Some(tol),
+            });
+        }
+    }
+    // Only the configurations whose name contains WORK_PRECISION_ONLY (all without it).
+    if let Ok(only) = std::env::var("WORK_PRECISION_ONLY") {
+        configs.retain(|c| c.name.contains(&only));
+    }
+
+    let mut csv = String::from(
+        "config,margin,dt,npc,precision,adaptive_tolerance,evaluations,wall_s,centre_error,phi_error\n",
+    );
     let mut table = String::from(
         "| configuration | wall s (20 TU) | centre error | max φ error |\n|---|---|---|---|\n",
     );
     writeln!(table, "| {} | {ref_wall:.2} | 0 | 0 |", reference_cfg.name).unwrap();
     for c in &configs {
-        let (wall, (e_c, e_phi)) = if c.f32 {
-            let (t, wall) = run::<f32>(&start, &centres, c);
-            (wall, errors(&reference, &t))
+        let (wall, evals, (e_c, e_phi)) = if c.f32 {
+            let (t, wall, evals) = run::<f32>(&start, &centres, c);
+            (wall, evals, errors(&reference, &t))
         } else {
-            let (t, wall) = run::<f64>(&start, &centres, c);
-            (wall, errors(&reference, &t))
+            let (t, wall, evals) = run::<f64>(&start, &centres, c);
+            (wall, evals, errors(&reference, &t))
         };
-        eprintln!("{}: {wall:.3} s, centre {e_c:.2e}, phi {e_phi:.2e}", c.name);
+        eprintln!(
+            "{}: {wall:.3} s, {evals} evaluations, centre {e_c:.2e}, phi {e_phi:.2e}",
+            c.name
+        );
         writeln!(
             csv,
-            "\"{}\",{},{},{},{},{wall:.4},{e_c:.3e},{e_phi:.3e}",
+            "\"{}\",{},{},{},{},{},{evals},{wall:.4},{e_c:.3e},{e_phi:.3e}",
             c.name,
             c.margin,
             c.dt,
             c.npc,
-            if c.f32 { "f32" } else { "f64" }
+            if c.f32 { "f32" } else { "f64" },
+            c.adaptive.map_or(String::new(), |t| format!("{t:e}")),
         )
         .unwrap();
         writeln!(
@@ -191,6 +246,8 @@ fn study() {
     }
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs");
     std::fs::create_dir_all(dir).unwrap();
-    std::fs::write(format!("{dir}/work_precision.csv"), csv).unwrap();
+    if std::env::var("WORK_PRECISION_ONLY").is_err() {
+        std::fs::write(format!("{dir}/work_precision.csv"), csv).unwrap();
+    }
     println!("{table}");
 }

@@ -53,6 +53,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod adaptive;
 pub mod equations;
 mod fields;
 mod geometry;
@@ -65,6 +66,7 @@ mod step;
 mod tissue;
 mod workspace;
 
+pub use adaptive::{AdaptiveParams, Controller};
 pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
 pub use nalgebra::Vector2;
@@ -114,5 +116,17 @@ pub enum StepError {
         phi: f64,
         /// The time step in use.
         dt: f64,
+    },
+    /// The adaptive step cannot meet its tolerance with a step of at least its minimum.
+    #[error("at step {step} (t = {time:.3}) the adaptive time step fell to {dt:.2e}, below its minimum, to keep the local error under {tolerance:.1e}: the flow is too fast for the tolerance or the run is blowing up; raise [integrator] tolerance or lower dt_max")]
+    StepTooSmall {
+        /// Step at which it happened.
+        step: u64,
+        /// Model time at which it happened.
+        time: f64,
+        /// The step the controller asked for.
+        dt: f64,
+        /// The tolerance.
+        tolerance: f64,
     },
 }
