@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 25] = [
+const KEYS: [&str; 28] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -139,6 +139,9 @@ const KEYS: [&str; 25] = [
     "integrator.margin",
     "integrator.precision",
     "integrator.stability_check",
+    "integrator.adaptive",
+    "integrator.tolerance",
+    "integrator.dt_max",
     "run.relax_time",
     "run.time",
     "run.seed",
@@ -242,7 +245,15 @@ fn fuzz_one(overrides: &[String], tally: &mut Tally) -> Result<(), String> {
         let mut t = rundir::initial_tissue::<f32>(&s).map_err(|e| e.to_string())?;
         let mut ws = Workspace::new(t.cells());
         let p = s.step_params();
-        Ok::<_, String>((0..2).try_for_each(|_| t.step(&mut ws, &p)))
+        Ok::<_, String>((0..2).try_for_each(|_| match s.adaptive() {
+            None => t.step(&mut ws, &p),
+            Some(a) => {
+                let mut c = mechanics::Controller::new(p.dt);
+                let check = &mut mechanics::StateCheck::default();
+                t.step_adaptive(&mut ws, &a, &mut c, s.end_time(), check)
+                    .map(|_| ())
+            }
+        }))
     })
     .map_err(|_| format!("{overrides:?}: building or stepping the valid scene panicked"))?;
     match stepped {

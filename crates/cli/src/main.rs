@@ -558,7 +558,7 @@ fn note_skipped(notes: &study::analyze::FrameNotes, run_dir: &std::path::Path) {
     }
     if let Some(first) = missing.first() {
         eprintln!(
-            "note: {} frame(s) of the run's schedule are missing, the first at step {first}: time differences and rates span the gap",
+            "note: {} frame(s) of the run's schedule are missing, the first at t ≈ {first:.3}: time differences and rates span the gap",
             missing.len()
         );
     }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
+use mechanics::{Callback, CallbackError, Observation, Precision};
 use phasefield::{Cells, Real};
 use scene::Scene;
 
@@ -123,10 +123,20 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<(u64, RunInfo)>
         };
         match attempt() {
             Ok((scene, step)) => {
+                let time = rundir::read_npz(path, &["time"])?[0]
+                    .scalar()
+                    .unwrap_or(f64::NAN);
                 let total = scene.step_counts().total_steps();
+                let (complete, at) = match scene.adaptive() {
+                    Some(_) => (
+                        time >= scene.end_time() * (1.0 - 1e-12),
+                        format!("t = {time} of {}", scene.end_time()),
+                    ),
+                    None => (step >= total, format!("step {step} of {total}")),
+                };
                 anyhow::ensure!(
-                    step < total,
-                    "the run in {} is complete (step {step} of {total}); extend it with --set run.time=T, T above {}",
+                    !complete,
+                    "the run in {} is complete ({at}); extend it with --set run.time=T, T above {}",
                     dir.display(),
                     scene.file().run.time
                 );
@@ -150,7 +160,7 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<(u64, RunInfo)>
 }
 
 fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Start<'_>) -> Result<RunInfo> {
-    let counts = scene.step_counts();
+    let schedules = scene.output_schedules();
     let (mut sim, written) = match from {
         Start::Scene | Start::State(_) => {
             let tissue = match from {
@@ -158,24 +168,25 @@ fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Start<'_>) -> R
                 _ => scene.tissue::<T>()?,
             };
             let mut sim = scene.simulation_from(tissue);
-            let w = rundir::add_writers(&mut sim, out, &counts)?;
+            let w = rundir::add_writers(&mut sim, out, &schedules)?;
             (sim, w)
         }
         Start::Checkpoint(path) => {
             let tissue = rundir::checkpoint::read_checkpoint::<T>(path, scene)?;
             let step = tissue.iteration();
-            let mut sim = mechanics::Simulation::new(tissue, scene.step_params())
-                .activity_from(counts.relax_steps, scene.zeta())
-                .stop_iteration(counts.total_steps());
-            let w = rundir::add_writers_resumed(&mut sim, out, &counts, step)?;
+            let mut sim = scene.simulation_from(tissue);
+            if let Some(c) = rundir::checkpoint::read_controller(path)? {
+                sim.set_controller(c);
+            }
+            let w = rundir::add_writers_resumed(&mut sim, out, &schedules, step)?;
             (sim, w)
         }
     };
-    rundir::add_checkpoints(&mut sim, out, counts.checkpoint_every, &scene.to_toml());
+    rundir::add_checkpoints(&mut sim, out, schedules.checkpoints, &scene.to_toml());
     sim.add_output_writer(
         "progress",
-        Schedule::IterationInterval(counts.series_every.min(counts.frame_every)),
-        FinalToo::new(Progress::new(counts.total_steps(), quiet)),
+        schedules.series,
+        FinalToo::new(Progress::new(scene.end_time(), quiet)),
     );
     let result = sim.run();
     let info = result.map_err(|e| {
@@ -213,21 +224,25 @@ fn stopped(out: &Path, step: u64, error: &mechanics::SimulationError) -> String 
     msg
 }
 
-/// A progress bar on a terminal, plain lines (about every 10 %) otherwise.
+/// A progress bar on a terminal, plain lines (about every 10 %) otherwise, in model time
+/// (an adaptive run does not know its number of steps in advance).
 struct Progress {
     bar: Option<ProgressBar>,
-    total: u64,
+    end: f64,
     quiet: bool,
-    next_line: u64,
+    next_line: f64,
 }
 
+/// Bar positions per run.
+const PROGRESS_TICKS: u64 = 1000;
+
 impl Progress {
-    fn new(total: u64, quiet: bool) -> Self {
+    fn new(end: f64, quiet: bool) -> Self {
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
-            let b = ProgressBar::new(total);
+            let b = ProgressBar::new(PROGRESS_TICKS);
             b.set_style(
                 ProgressStyle::with_template(
-                    "{bar:40} {pos}/{len} steps  {msg}  [{elapsed_precise} < {eta_precise}]",
+                    "{bar:40} {percent:>3}%  {msg}  [{elapsed_precise} < {eta_precise}]",
                 )
                 .expect("valid template"),
             );
@@ -235,9 +250,9 @@ impl Progress {
         });
         Self {
             bar,
-            total,
+            end,
             quiet,
-            next_line: 0,
+            next_line: 0.0,
         }
     }
 }
@@ -245,15 +260,18 @@ impl Progress {
 impl<T: Real> Callback<T> for Progress {
     fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
         let (step, time, v_rms) = (obs.iteration(), obs.time(), obs.observables().v_rms);
+        let end = self.end;
         if let Some(b) = &self.bar {
-            b.set_position(step);
-            b.set_message(format!("t = {time:.1}  v_rms = {v_rms:.3e}"));
-        } else if !self.quiet && (step >= self.next_line || step == self.total) {
-            eprintln!(
-                "step {step}/{}  t = {time:.1}  v_rms = {v_rms:.3e}",
-                self.total
-            );
-            self.next_line = step + self.total.div_ceil(10).max(1);
+            let done = if end > 0.0 {
+                (time / end).min(1.0)
+            } else {
+                1.0
+            };
+            b.set_position((done * PROGRESS_TICKS as f64) as u64);
+            b.set_message(format!("step {step}  t = {time:.1}  v_rms = {v_rms:.3e}"));
+        } else if !self.quiet && (time >= self.next_line || time >= end) {
+            eprintln!("step {step}  t = {time:.1}/{end}  v_rms = {v_rms:.3e}");
+            self.next_line = time + end / 10.0;
         }
         Ok(())
     }

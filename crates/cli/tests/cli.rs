@@ -209,6 +209,45 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
             &["physics"],
         ),
         (
+            "adaptive tolerance out of range",
+            &[
+                "--set",
+                "integrator.adaptive=true",
+                "--set",
+                "integrator.tolerance=2",
+            ],
+            &["[integrator] tolerance = 2", "between 0 and 1", "use 1e-3"],
+        ),
+        (
+            "dt_max without adaptive",
+            &["--set", "integrator.dt_max=1"],
+            &["[integrator] dt_max", "only read with adaptive = true"],
+        ),
+        (
+            "adaptive dt_max above the stability estimate",
+            &[
+                "--set",
+                "integrator.adaptive=true",
+                "--set",
+                "integrator.dt_max=50",
+            ],
+            &[
+                "[integrator] dt_max = 50",
+                "leave dt_max out",
+                "stability_check = false",
+            ],
+        ),
+        (
+            "adaptive Euler",
+            &[
+                "--set",
+                "integrator.adaptive=true",
+                "--set",
+                "integrator.npc=0",
+            ],
+            &["[integrator] npc = 0", "Heun with one corrector"],
+        ),
+        (
             "negative radius",
             &["--set", "cells.radius=-3"],
             &["[cells] radius", "must be positive"],
@@ -1032,7 +1071,7 @@ fn analyze_validates_frames_and_orders_them_by_step() {
     let (ok, err) = analyze();
     assert!(ok, "{err}");
     assert!(
-        err.contains("1 frame(s) of the run's schedule are missing, the first at step 30"),
+        err.contains("1 frame(s) of the run's schedule are missing, the first at t ≈ 6.000"),
         "{err}"
     );
     std::fs::write(&gone, kept).unwrap();

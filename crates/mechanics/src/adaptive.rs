@@ -90,6 +90,29 @@ impl Controller {
         }
     }
 
+    /// A controller as a checkpoint kept it ([`Controller::to_array`]).
+    pub fn from_array(a: [f64; 5]) -> Self {
+        Self {
+            dt: a[0],
+            err_prev: a[1],
+            accepted: a[2] as u64,
+            rejected: a[3] as u64,
+            last_rejected: a[4] != 0.0,
+        }
+    }
+
+    /// The controller as five numbers, `[dt, err_prev, accepted, rejected, last_rejected]`,
+    /// exact in f64 (the counts below 2⁵³).
+    pub fn to_array(&self) -> [f64; 5] {
+        [
+            self.dt,
+            self.err_prev,
+            self.accepted as f64,
+            self.rejected as f64,
+            f64::from(u8::from(self.last_rejected)),
+        ]
+    }
+
     /// Evaluations of the right-hand side so far: two per attempt, one fewer per rejection
     /// (a retry reuses `k1`).
     pub fn evaluations(&self) -> u64 {

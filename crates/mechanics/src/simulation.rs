@@ -28,6 +28,7 @@ use std::time::{Duration, Instant};
 
 use phasefield::Real;
 
+use crate::adaptive::{AdaptiveParams, Controller};
 use crate::fields::TissueFields;
 use crate::observables::Observables;
 use crate::params::StepParams;
@@ -47,13 +48,23 @@ pub const DEFAULT_SORT_EVERY: u64 = 250;
 pub enum Schedule {
     /// At every iteration that is a multiple of `n` (the starting state included).
     IterationInterval(u64),
-    /// At the starting state and at the first iteration at or after each multiple of the
-    /// interval, in model time (to within 10⁻⁹ of the interval).
+    /// At the first iteration at or after each multiple of the interval, in model time (to
+    /// within 10⁻⁹ of the interval), the starting state included when its time is a multiple
+    /// (a run resumed between two multiples waits for the next).
     TimeInterval(f64),
     /// At the first iteration after each interval of wall-clock time since the last firing
     /// (not at the starting state). Wall time never affects the results, only when an
     /// observation happens.
     WallTimeInterval(Duration),
+}
+
+/// Where the activity switches on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Switch {
+    /// At this iteration.
+    Iteration(u64),
+    /// At this model time.
+    Time(f64),
 }
 
 /// The running state of a [`Schedule`].
@@ -78,6 +89,10 @@ impl Timer {
             Schedule::IterationInterval(n) => iteration.is_multiple_of(n.max(1)),
             Schedule::TimeInterval(dt) => {
                 let tol = 1e-9 * dt;
+                if initial {
+                    // The first multiple at or after the start (a resumed run starts between).
+                    self.next_time = ((time - tol) / dt).ceil() * dt;
+                }
                 if time >= self.next_time - tol {
                     self.next_time = (((time + tol) / dt).floor() + 1.0) * dt;
                     true
@@ -173,6 +188,7 @@ pub struct Observation<'a, T: Real> {
     observables: &'a mut Option<Observables>,
     wall_time: Duration,
     stop: &'a mut bool,
+    controller: Option<Controller>,
 }
 
 impl<'a, T: Real> Observation<'a, T> {
@@ -195,6 +211,12 @@ impl<'a, T: Real> Observation<'a, T> {
     /// Wall time since [`Simulation::run`] was called.
     pub fn wall_time(&self) -> Duration {
         self.wall_time
+    }
+
+    /// The state of the step-size controller of an adaptive run ([`Simulation::adaptive`]),
+    /// which a checkpoint keeps; `None` with fixed steps.
+    pub fn controller(&self) -> Option<Controller> {
+        self.controller
     }
 
     /// The observables of the current state, computed at the first call in this iteration
@@ -279,7 +301,8 @@ pub struct Simulation<T: Real = f64> {
     stop_iteration: Option<u64>,
     stop_time: Option<f64>,
     wall_time_limit: Option<Duration>,
-    activity: Option<(u64, f64)>,
+    activity: Option<(Switch, f64)>,
+    adaptive: Option<(AdaptiveParams, Controller)>,
     sort_every: Option<u64>,
     check: (Timer, Box<dyn StepCheck>),
     callbacks: Vec<Entry<T>>,
@@ -302,6 +325,7 @@ impl<T: Real> Simulation<T> {
             stop_time: None,
             wall_time_limit: None,
             activity: None,
+            adaptive: None,
             sort_every: Some(DEFAULT_SORT_EVERY),
             check: (
                 Timer::new(Schedule::IterationInterval(1)),
@@ -336,9 +360,41 @@ impl<T: Real> Simulation<T> {
     /// relaxation protocol of MODEL.md §6). With `iteration = 0` the activity is on from the
     /// start.
     pub fn activity_from(mut self, iteration: u64, zeta: f64) -> Self {
-        self.activity = Some((iteration, zeta));
+        self.activity = Some((Switch::Iteration(iteration), zeta));
         self.apply_activity();
         self
+    }
+
+    /// Holds ζ = 0 until model time `time` and switches to activity `zeta` there; an
+    /// adaptive run lands a step on `time` exactly.
+    pub fn activity_from_time(mut self, time: f64, zeta: f64) -> Self {
+        self.activity = Some((Switch::Time(time), zeta));
+        self.apply_activity();
+        self
+    }
+
+    /// Steps with the error-controlled time step of [`crate::adaptive`] instead of the fixed
+    /// `dt` of the [`StepParams`] (of which only `npc = 1` is used), from the controller
+    /// state `controller` ([`Controller::new`] with the first step, or the state a
+    /// checkpoint kept). Every step lands exactly on the next firing time of each
+    /// [`Schedule::TimeInterval`], on the activity switch and on the stop time, so outputs
+    /// happen at their scheduled times; give an adaptive run a [`Simulation::stop_time`].
+    pub fn adaptive(mut self, params: AdaptiveParams, controller: Controller) -> Self {
+        self.adaptive = Some((params, controller));
+        self
+    }
+
+    /// The controller state of an adaptive run.
+    pub fn controller(&self) -> Option<Controller> {
+        self.adaptive.map(|(_, c)| c)
+    }
+
+    /// Replaces the controller state of an adaptive run (a resumed run continues with the
+    /// state its checkpoint kept); no effect with fixed steps.
+    pub fn set_controller(&mut self, controller: Controller) {
+        if let Some((_, c)) = &mut self.adaptive {
+            *c = controller;
+        }
     }
 
     /// Re-sorts the cells in memory every `n` iterations (`None`: never). Sorting changes
@@ -409,12 +465,38 @@ impl<T: Real> Simulation<T> {
 
     fn apply_activity(&mut self) {
         if let Some((at, zeta)) = self.activity {
-            self.tissue.params.zeta = if self.tissue.iteration() >= at {
-                zeta
-            } else {
-                0.0
+            let on = match at {
+                Switch::Iteration(n) => self.tissue.iteration() >= n,
+                Switch::Time(t) => self.tissue.time() >= t,
             };
+            self.tissue.params.zeta = if on { zeta } else { 0.0 };
         }
+    }
+
+    /// The time the next adaptive step must not pass: the stop time, the activity switch
+    /// ahead, and the next firing of every time schedule.
+    fn next_landing(&self) -> f64 {
+        let now = self.tissue.time();
+        let mut t = self.stop_time.unwrap_or(f64::INFINITY);
+        if let Some((Switch::Time(s), _)) = self.activity {
+            if s > now {
+                t = t.min(s);
+            }
+        }
+        let timers = self
+            .callbacks
+            .iter()
+            .chain(&self.writers)
+            .map(|e| &e.timer)
+            .chain(std::iter::once(&self.check.0));
+        for timer in timers {
+            if let Schedule::TimeInterval(_) = timer.schedule {
+                if timer.next_time > now {
+                    t = t.min(timer.next_time);
+                }
+            }
+        }
+        t
     }
 
     fn done(&self, start: Instant) -> bool {
@@ -445,6 +527,7 @@ impl<T: Real> Simulation<T> {
                 observables: &mut observables,
                 wall_time: start.elapsed(),
                 stop,
+                controller: self.adaptive.map(|(_, c)| c),
             };
             let r = match hook {
                 Hook::Initialize => entry.callback.initialize(&mut obs),
@@ -501,11 +584,22 @@ impl<T: Real> Simulation<T> {
             if self.sort_every.is_some_and(|k| it.is_multiple_of(k)) {
                 self.tissue.sort_cells(&mut self.sort_scratch);
             }
+            let t_end = match self.adaptive {
+                Some(_) => self.next_landing(),
+                None => f64::INFINITY,
+            };
             let (timer, check) = &mut self.check;
             let checked = timer.fires(it, self.tissue.time(), false);
             let check: &mut dyn StepCheck = if checked { check.as_mut() } else { &mut none };
-            self.tissue
-                .step_checked(&mut self.workspace, &self.step_params, check)?;
+            match &mut self.adaptive {
+                None => self
+                    .tissue
+                    .step_checked(&mut self.workspace, &self.step_params, check)?,
+                Some((params, ctrl)) => {
+                    self.tissue
+                        .step_adaptive(&mut self.workspace, params, ctrl, t_end, check)?;
+                }
+            }
             self.apply_activity();
             self.fire(start, Hook::Call, stop)?;
         }

@@ -18,6 +18,7 @@
 //! | `centre` | `(N, 2)` | [`mechanics::Tissue::centres`], slot order |
 //! | `cell_id` | `(N,)` int64 | identity of each slot |
 //! | `scene` | `(bytes,)` uint8 | the resolved scene (TOML) |
+//! | `controller` | `(5,)` | adaptive runs only: [`mechanics::Controller::to_array`] |
 //!
 //! Each is written under a temporary name, flushed to disk (`fsync`) and renamed, so a kill
 //! at any moment leaves the previous checkpoint intact; the newest [`KEEP`] are kept.
@@ -26,7 +27,7 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use mechanics::Tissue;
+use mechanics::{Controller, Tissue};
 use phasefield::{Cells, Real};
 
 use crate::frame::{npy, read_npz, write_zip};
@@ -68,6 +69,7 @@ pub fn checkpoints(dir: &Path) -> Vec<(u64, PathBuf)> {
 pub fn write_checkpoint<T: Real>(
     dir: &Path,
     tissue: &Tissue<T>,
+    controller: Option<Controller>,
     scene_toml: &str,
 ) -> Result<PathBuf> {
     let cdir = dir.join("checkpoints");
@@ -119,7 +121,11 @@ pub fn write_checkpoint<T: Real>(
             ),
         ])
     };
-    let arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
+    let mut arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
+    if let Some(c) = controller {
+        let a = npy(&[5], c.to_array()).map_err(|e| RunDirError::io("encode", &path, e))?;
+        arrays.push(("controller", a));
+    }
     // Stored, not deflated: the state is mostly noise in its low bits.
     write_zip(&path, arrays, zip::CompressionMethod::Stored, true)?;
     let all = checkpoints(dir);
@@ -176,6 +182,31 @@ pub fn checkpoint_scene(path: &Path) -> Result<String> {
         name: "scene".into(),
         reason: e.to_string(),
     })
+}
+
+/// The controller state of an adaptive run's checkpoint (`None` when the run had fixed
+/// steps).
+///
+/// # Errors
+/// A damaged `controller` array.
+pub fn read_controller(path: &Path) -> Result<Option<Controller>> {
+    match read_npz(path, &["controller"]) {
+        Err(RunDirError::MissingArray { .. }) => Ok(None),
+        Err(e) => Err(e),
+        Ok(a) => match a[0].data[..] {
+            [dt, e, n, r, l] if [dt, e, n, r, l].iter().all(|v| v.is_finite()) && dt > 0.0 => {
+                Ok(Some(Controller::from_array([dt, e, n, r, l])))
+            }
+            _ => Err(RunDirError::BadArray {
+                path: path.to_path_buf(),
+                name: "controller".into(),
+                reason: format!(
+                    "{:?} is not [dt, err_prev, accepted, rejected, last_rejected]",
+                    a[0].data
+                ),
+            }),
+        },
+    }
 }
 
 /// The tissue a checkpoint holds, for `scene` (whose lattice, patch and precision must be the

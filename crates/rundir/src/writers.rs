@@ -7,7 +7,7 @@ use std::rc::Rc;
 
 use mechanics::{Callback, CallbackError, Observation, Schedule, Simulation};
 use phasefield::Real;
-use scene::StepCounts;
+use scene::OutputSchedules;
 
 use crate::checkpoint::write_checkpoint;
 use crate::frame::write_frame;
@@ -35,10 +35,10 @@ impl Written {
 pub fn add_writers<T: Real>(
     sim: &mut Simulation<T>,
     dir: &Path,
-    counts: &StepCounts,
+    schedules: &OutputSchedules,
 ) -> Result<Written> {
     let series = SeriesWriter::create(dir)?;
-    Ok(add_with(sim, dir, counts, series))
+    Ok(add_with(sim, dir, schedules, series))
 }
 
 /// [`add_writers`] for a run resumed at step `from`: the rows of `series.csv` and the frames
@@ -49,7 +49,7 @@ pub fn add_writers<T: Real>(
 pub fn add_writers_resumed<T: Real>(
     sim: &mut Simulation<T>,
     dir: &Path,
-    counts: &StepCounts,
+    schedules: &OutputSchedules,
     from: u64,
 ) -> Result<Written> {
     let series = SeriesWriter::resume(dir, from)?;
@@ -63,24 +63,24 @@ pub fn add_writers_resumed<T: Real>(
             }
         }
     }
-    Ok(add_with(sim, dir, counts, series))
+    Ok(add_with(sim, dir, schedules, series))
 }
 
 fn add_with<T: Real>(
     sim: &mut Simulation<T>,
     dir: &Path,
-    counts: &StepCounts,
+    schedules: &OutputSchedules,
     series: SeriesWriter,
 ) -> Written {
     let written = Written::default();
     sim.add_output_writer(
         "series.csv",
-        Schedule::IterationInterval(counts.series_every),
+        schedules.series,
         FinalToo::new(SeriesRows(series)),
     );
     sim.add_output_writer(
         "frame writer",
-        Schedule::IterationInterval(counts.frame_every),
+        schedules.frames,
         FinalToo::new(Frames {
             dir: dir.to_path_buf(),
             written: written.frames.clone(),
@@ -143,19 +143,19 @@ impl<T: Real> Callback<T> for Frames {
     }
 }
 
-/// Adds checkpoints of the run to `sim` (see [`crate::checkpoint`]): every `every` steps,
-/// every 10 minutes of wall time, and at the end; `scene_toml` is the resolved scene they
-/// carry.
-pub fn add_checkpoints<T: Real>(sim: &mut Simulation<T>, dir: &Path, every: u64, scene_toml: &str) {
+/// Adds checkpoints of the run to `sim` (see [`crate::checkpoint`]): on `schedule`, every
+/// 10 minutes of wall time, and at the end; `scene_toml` is the resolved scene they carry.
+pub fn add_checkpoints<T: Real>(
+    sim: &mut Simulation<T>,
+    dir: &Path,
+    schedule: Schedule,
+    scene_toml: &str,
+) {
     let writer = || Checkpoints {
         dir: dir.to_path_buf(),
         scene: scene_toml.to_string(),
     };
-    sim.add_output_writer(
-        "checkpoint",
-        Schedule::IterationInterval(every.max(1)),
-        FinalToo::new(writer()),
-    );
+    sim.add_output_writer("checkpoint", schedule, FinalToo::new(writer()));
     sim.add_output_writer(
         "checkpoint (wall time)",
         Schedule::WallTimeInterval(std::time::Duration::from_secs(600)),
@@ -171,7 +171,7 @@ struct Checkpoints {
 
 impl<T: Real> Callback<T> for Checkpoints {
     fn call(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
-        write_checkpoint(&self.dir, obs.tissue(), &self.scene)?;
+        write_checkpoint(&self.dir, obs.tissue(), obs.controller(), &self.scene)?;
         Ok(())
     }
 }

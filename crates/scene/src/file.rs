@@ -132,6 +132,18 @@ pub struct Integrator {
     /// below the measured limits (`docs/stability.csv`); with `false` a run may go above it,
     /// and the step check still stops it, with its output kept, if it blows up.
     pub stability_check: bool,
+    /// An error-controlled time step (`mechanics::adaptive`: Heun with its Euler predictor
+    /// as the error estimate, a PI controller) instead of the fixed `dt`, which is then the
+    /// first step (default false). Frames, rows and checkpoints land on their times.
+    pub adaptive: bool,
+    /// With `adaptive`: the largest local error per step, max over cells and nodes of
+    /// |φ_Heun − φ_Euler| (default 1e-3; the global error after 20 TU is about 0.1 × this at
+    /// the paper's parameters, `docs/performance.md`).
+    pub tolerance: f64,
+    /// With `adaptive`: the largest step (default: the stability estimate of the active
+    /// phase, as for a fixed `dt`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dt_max: Option<f64>,
 }
 
 impl Default for Integrator {
@@ -145,6 +157,9 @@ impl Default for Integrator {
             margin: PatchShape::DEFAULT_MARGIN,
             precision: Precision::default(),
             stability_check: true,
+            adaptive: false,
+            tolerance: 1e-3,
+            dt_max: None,
         }
     }
 }

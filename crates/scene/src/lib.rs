@@ -39,7 +39,9 @@ mod validate;
 pub use file::{CellsSpec, Domain, InitKind, Integrator, Model, Run, SceneFile};
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
-use mechanics::{ModelParams, Precision, Simulation, StepParams, Tissue};
+use mechanics::{
+    AdaptiveParams, Controller, ModelParams, Precision, Schedule, Simulation, StepParams, Tissue,
+};
 use phasefield::{init, Cells, Lattice, PatchShape, Real};
 
 /// A valid scene: only [`SceneFile::validate`] (or [`Scene::parse`]) makes one, so every
@@ -51,7 +53,19 @@ pub struct Scene {
     pub(crate) centres: Vec<[f64; 2]>,
 }
 
-/// A scene's durations in steps.
+/// When the writers of a run directory fire ([`Scene::output_schedules`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct OutputSchedules {
+    /// Frames.
+    pub frames: Schedule,
+    /// Rows of `series.csv`.
+    pub series: Schedule,
+    /// Checkpoints (besides the wall-time ones and the one at the end).
+    pub checkpoints: Schedule,
+}
+
+/// A scene's durations in steps (with the adaptive step, estimates from its first step).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub struct StepCounts {
@@ -166,15 +180,65 @@ impl Scene {
         }
     }
 
+    /// The settings of the adaptive time step (`[integrator] adaptive = true`), or `None` for
+    /// fixed steps: the tolerance, the largest step (`dt_max`, by default the stability
+    /// estimate) and the smallest, `(relax_time + time) / MAX_STEPS` (at least 1e-9), so that
+    /// a run takes at most [`MAX_STEPS`] steps.
+    pub fn adaptive(&self) -> Option<AdaptiveParams> {
+        let it = &self.file.integrator;
+        if !it.adaptive {
+            return None;
+        }
+        let dt_max = it.dt_max.unwrap_or_else(|| self.file.stability_estimate());
+        let mut p = AdaptiveParams::new(it.tolerance, dt_max);
+        let r = &self.file.run;
+        p.dt_min = ((r.relax_time + r.time) / MAX_STEPS).max(1e-9).min(dt_max);
+        Some(p)
+    }
+
+    /// When the run directory's writers fire: frames, rows of `series.csv` and checkpoints
+    /// every so many steps ([`Scene::step_counts`]), or with the adaptive step at their times
+    /// (which the steps land on).
+    pub fn output_schedules(&self) -> OutputSchedules {
+        let r = &self.file.run;
+        if self.file.integrator.adaptive {
+            let total = r.relax_time + r.time;
+            OutputSchedules {
+                frames: Schedule::TimeInterval(r.output_every),
+                series: Schedule::TimeInterval(r.series_every.unwrap_or(r.output_every)),
+                checkpoints: Schedule::TimeInterval(
+                    r.checkpoint_every.unwrap_or((total / 20.0).max(1e-6)),
+                ),
+            }
+        } else {
+            let c = self.step_counts();
+            OutputSchedules {
+                frames: Schedule::IterationInterval(c.frame_every),
+                series: Schedule::IterationInterval(c.series_every),
+                checkpoints: Schedule::IterationInterval(c.checkpoint_every),
+            }
+        }
+    }
+
+    /// The model time at the end of the run, `relax_time + time`.
+    pub fn end_time(&self) -> f64 {
+        let r = &self.file.run;
+        r.relax_time + r.time
+    }
+
     /// Warnings about the scene: a time step above the stability estimate, allowed by
     /// `[integrator] stability_check = false`.
     pub fn warnings(&self) -> Vec<String> {
         self.file
             .dt_above_estimate()
             .map(|dt_max| {
+                let it = &self.file.integrator;
+                let (key, v) = match it.dt_max {
+                    Some(v) if it.adaptive => ("dt_max", v),
+                    _ => ("dt", it.dt),
+                };
                 format!(
-                    "[integrator] dt = {} is above the stability estimate {}; the run stops if it blows up",
-                    self.file.integrator.dt,
+                    "[integrator] {key} = {v} is above the stability estimate {}; the run stops if it blows up",
                     validate::sig3(dt_max)
                 )
             })
@@ -300,10 +364,22 @@ impl Scene {
     /// A simulation of the scene from the initial tissue `tissue` (from [`Scene::tissue`] or
     /// [`Scene::tissue_from_state`]): the scene's integrator, ζ = 0 for `relax_time` and the
     /// scene's ζ after, stopping after `relax_time + time` counted from the tissue's step.
+    ///
+    /// With `[integrator] adaptive = true` the steps are error-controlled
+    /// ([`Simulation::adaptive`], from `dt`), the activity switches on at `relax_time` and the
+    /// run stops at `relax_time + time`, each landed on exactly.
     pub fn simulation_from<T: Real>(&self, tissue: Tissue<T>) -> Simulation<T> {
-        let counts = self.step_counts();
-        Simulation::new(tissue, self.step_params())
-            .activity_from(counts.relax_steps, self.zeta())
-            .stop_iteration(counts.total_steps())
+        let sim = Simulation::new(tissue, self.step_params());
+        match self.adaptive() {
+            Some(p) => sim
+                .adaptive(p, Controller::new(self.file.integrator.dt))
+                .activity_from_time(self.file.run.relax_time, self.zeta())
+                .stop_time(self.end_time()),
+            None => {
+                let counts = self.step_counts();
+                sim.activity_from(counts.relax_steps, self.zeta())
+                    .stop_iteration(counts.total_steps())
+            }
+        }
     }
 }

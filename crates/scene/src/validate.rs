@@ -257,7 +257,49 @@ impl SceneFile {
                 // γ = 0 with activity: nothing damps the advected interfaces at any dt.
                 return Err(invalid("model", "gamma", m.gamma, format!("with zeta = {} and no line tension the explicit scheme is unstable at any dt (the activity limit of docs/stability.csv is proportional to gamma)", m.zeta), "use gamma > 0 (the paper uses 0.01), set zeta = 0, or set [integrator] stability_check = false to run at your own risk"));
             }
+            if it.adaptive {
+                return Err(invalid("integrator", "dt_max", it.dt_max.unwrap_or_default(), format!("the explicit scheme is unstable above dt ≈ {} for these parameters (a conservative estimate; docs/stability.csv), and the error estimate sees an instability only once it grows", sig3(dt_max)), format!("leave dt_max out (it is then {}) or set [integrator] stability_check = false to run above the estimate at your own risk", sig3(dt_max))));
+            }
             return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {} for these parameters (a conservative estimate; docs/stability.csv)", sig3(dt_max)), format!("use dt ≤ {} (the paper uses 0.2), or set [integrator] stability_check = false to run above the estimate at your own risk", sig3(dt_max))));
+        }
+        if it.adaptive {
+            if !(it.tolerance.is_finite() && it.tolerance > 0.0 && it.tolerance < 1.0) {
+                return Err(invalid(
+                    "integrator",
+                    "tolerance",
+                    it.tolerance,
+                    "the local error tolerance must lie between 0 and 1 (φ itself is of order 1)",
+                    "use 1e-3 (about the default fixed step's error) or 1e-4 for more accuracy",
+                ));
+            }
+            if let Some(v) = it.dt_max {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(invalid(
+                        "integrator",
+                        "dt_max",
+                        v,
+                        "the largest step must be positive",
+                        "leave it out (the stability estimate) or give a positive step",
+                    ));
+                }
+            }
+            if it.npc != 1 {
+                return Err(invalid(
+                    "integrator",
+                    "npc",
+                    it.npc,
+                    "the adaptive step is Heun with one corrector (its Euler predictor is the error estimate)",
+                    "set npc = 1 or adaptive = false",
+                ));
+            }
+        } else if let Some(v) = it.dt_max {
+            return Err(invalid(
+                "integrator",
+                "dt_max",
+                v,
+                "dt_max is only read with adaptive = true",
+                "set adaptive = true or remove dt_max",
+            ));
         }
         if it.npc > 16 {
             return Err(invalid(
@@ -393,9 +435,21 @@ impl SceneFile {
     }
 
     /// The stability estimate `ModelParams::max_stable_dt` of the active phase, when the
-    /// scene's dt is above it.
+    /// scene's largest step is above it: `dt`, or with `adaptive` the given `dt_max` (the
+    /// first step is cut to the estimate).
     pub(crate) fn dt_above_estimate(&self) -> Option<f64> {
-        let dt_max = self.model_params(self.model.zeta).max_stable_dt();
-        (self.integrator.dt > dt_max).then_some(dt_max)
+        let dt_max = self.stability_estimate();
+        let it = &self.integrator;
+        let largest = if it.adaptive {
+            it.dt_max.unwrap_or(0.0)
+        } else {
+            it.dt
+        };
+        (largest > dt_max).then_some(dt_max)
+    }
+
+    /// The stability estimate of the active phase.
+    pub(crate) fn stability_estimate(&self) -> f64 {
+        self.model_params(self.model.zeta).max_stable_dt()
     }
 }

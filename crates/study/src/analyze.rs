@@ -121,9 +121,9 @@ pub struct FrameNotes {
     pub partial: usize,
     /// Other files in `frames/` that were skipped (names that are not `frame_STEP.npz`).
     pub stray: Vec<String>,
-    /// Steps of the frame schedule (multiples of the scene's frame interval) between the
+    /// Times of the frame schedule (multiples of the scene's frame interval) between the
     /// first and the last frame that have no frame: removed, or lost to a full disk.
-    pub missing: Vec<u64>,
+    pub missing: Vec<f64>,
     /// Whether the run is marked complete ([`rundir::is_complete`]); if not, it is still
     /// being written, was killed, or was written by a version before the mark.
     pub complete: bool,
@@ -194,16 +194,7 @@ pub(crate) fn list_frames(run_dir: &Path, scene: &Scene) -> Result<FrameList> {
         ));
     }
     stray.sort();
-    let every = scene.step_counts().frame_every;
-    let (first, last) = (frames[0].step, frames[frames.len() - 1].step);
-    let mut have = frames.iter().map(|f| f.step).peekable();
-    let mut missing = Vec::new();
-    for step in (first.div_ceil(every)..=last / every).map(|k| k * every) {
-        while have.next_if(|&s| s < step).is_some() {}
-        if have.peek() != Some(&step) {
-            missing.push(step);
-        }
-    }
+    let missing = missing_frames(scene, &frames);
     Ok(FrameList {
         frames,
         notes: FrameNotes {
@@ -213,6 +204,38 @@ pub(crate) fn list_frames(run_dir: &Path, scene: &Scene) -> Result<FrameList> {
             complete: rundir::is_complete(run_dir),
         },
     })
+}
+
+/// The times of the scene's frame schedule between the first and the last of `frames` (in
+/// step order) that have no frame: multiples of the frame interval in steps with fixed steps,
+/// in model time with the adaptive step (whose frames land on those times).
+fn missing_frames(scene: &Scene, frames: &[FrameFile]) -> Vec<f64> {
+    let (first, last) = (&frames[0], &frames[frames.len() - 1]);
+    let mut missing = Vec::new();
+    if scene.adaptive().is_some() {
+        let every = scene.file().run.output_every;
+        let tol = 1e-9 * every;
+        let mut have = frames.iter().map(|f| f.time).peekable();
+        let k0 = ((first.time - tol) / every).ceil() as u64;
+        let k1 = ((last.time + tol) / every).floor() as u64;
+        for t in (k0..=k1).map(|k| k as f64 * every) {
+            while have.next_if(|&s| s < t - tol).is_some() {}
+            if !have.peek().is_some_and(|&s| (s - t).abs() <= tol) {
+                missing.push(t);
+            }
+        }
+    } else {
+        let every = scene.step_counts().frame_every;
+        let dt = scene.step_params().dt;
+        let mut have = frames.iter().map(|f| f.step).peekable();
+        for step in (first.step.div_ceil(every)..=last.step / every).map(|k| k * every) {
+            while have.next_if(|&s| s < step).is_some() {}
+            if have.peek() != Some(&step) {
+                missing.push(step as f64 * dt);
+            }
+        }
+    }
+    missing
 }
 
 /// The default smoothing box of a scene: the odd side nearest 3R, at most the lattice's.

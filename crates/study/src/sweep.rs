@@ -177,15 +177,16 @@ fn run_in<T: Real>(
     out: &Path,
     progress: Arc<dyn Fn(u64) + Send + Sync>,
 ) -> Result<(), SweepError> {
-    let counts = point.scene.step_counts();
     let tissue = rundir::initial_tissue::<T>(&point.scene).map_err(|source| SweepError::State {
         point: point.name.clone(),
         source: Box::new(source),
     })?;
     let mut sim = point.scene.simulation_from(tissue);
-    rundir::add_writers(&mut sim, out, &counts).map_err(|source| SweepError::RunDir {
-        point: point.name.clone(),
-        source,
+    rundir::add_writers(&mut sim, out, &point.scene.output_schedules()).map_err(|source| {
+        SweepError::RunDir {
+            point: point.name.clone(),
+            source,
+        }
     })?;
     sim.add_callback(
         "progress",
