@@ -5,6 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod common;
+use common::run_files;
+
 fn paper() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")
 }
@@ -51,24 +54,6 @@ fn run(out: &Path, threads: &str) {
     ok(&run_paper(out, &args));
 }
 
-/// `series.csv` and every frame, by name.
-fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v = vec![(
-        "series.csv".to_string(),
-        std::fs::read(dir.join("series.csv")).unwrap(),
-    )];
-    let mut frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    frames.sort();
-    for f in frames {
-        let name = f.file_name().unwrap().to_string_lossy().into_owned();
-        v.push((name, std::fs::read(&f).unwrap()));
-    }
-    v
-}
-
 /// Rows land on every multiple of `series_every` and frames on every multiple of
 /// `output_every`, exactly (the clock is set to the landing time, not summed); the activity
 /// switches on at `relax_time`; the run takes fewer steps than the fixed dt 0.5 would (400);
@@ -79,7 +64,7 @@ fn an_adaptive_run_lands_on_its_output_times_and_is_thread_independent() {
     let (a, b) = (dir.path().join("a"), dir.path().join("b"));
     run(&a, "1");
     run(&b, "2");
-    assert!(files(&a) == files(&b), "1 and 2 threads differ");
+    assert!(run_files(&a) == run_files(&b), "1 and 2 threads differ");
     let series = std::fs::read_to_string(a.join("series.csv")).unwrap();
     let rows: Vec<Vec<f64>> = series
         .lines()
@@ -99,7 +84,7 @@ fn an_adaptive_run_lands_on_its_output_times_and_is_thread_independent() {
     let steps = rows.last().unwrap()[0];
     assert!(steps < 400.0, "{steps} steps, no fewer than fixed dt 0.5");
     let mut times = Vec::new();
-    for (name, _) in files(&a).iter().skip(1) {
+    for (name, _) in run_files(&a).iter().skip(1) {
         let t = rundir::read_npz(&a.join("frames").join(name), &["time"]).unwrap()[0].data[0];
         times.push(t);
     }
@@ -122,7 +107,7 @@ fn an_adaptive_run_resumes_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let full = dir.path().join("full");
     run(&full, "2");
-    let want = files(&full);
+    let want = run_files(&full);
     let cut = dir.path().join("cut");
     run(&cut, "2");
     let all = rundir::checkpoint::checkpoints(&cut);
@@ -140,7 +125,7 @@ fn an_adaptive_run_resumes_bit_for_bit() {
         &["run", "--quiet", "--threads", "1", "--resume"],
         &[&cut],
     ));
-    assert!(files(&cut) == want, "the resumed run differs");
+    assert!(run_files(&cut) == want, "the resumed run differs");
 
     let short = dir.path().join("short");
     let mut args = ADAPTIVE.to_vec();
@@ -150,5 +135,5 @@ fn an_adaptive_run_resumes_bit_for_bit() {
         &["run", "--quiet", "--set", "run.time=160", "--resume"],
         &[&short],
     ));
-    assert!(files(&short) == want, "the extended run differs");
+    assert!(run_files(&short) == want, "the extended run differs");
 }

@@ -4,6 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+mod common;
+use common::run_files;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_monolayer"))
 }
@@ -1105,27 +1108,6 @@ fn analyze_validates_frames_and_orders_them_by_step() {
     for t in ["observables.csv", "defects.csv", "defect_events.csv"] {
         assert!(!rd.join("analysis").join(t).exists(), "{t} left behind");
     }
-}
-
-/// The files of a run directory that a resumed run must reproduce: `series.csv` and every
-/// frame, by name and bytes.
-fn run_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v = vec![(
-        "series.csv".to_string(),
-        std::fs::read(dir.join("series.csv")).unwrap(),
-    )];
-    let mut frames: Vec<_> = std::fs::read_dir(dir.join("frames"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    frames.sort();
-    for f in frames {
-        v.push((
-            f.file_name().unwrap().to_string_lossy().into_owned(),
-            std::fs::read(&f).unwrap(),
-        ));
-    }
-    v
 }
 
 /// Killed with SIGKILL at three points of its run and resumed with `--resume` (on another

@@ -25,9 +25,9 @@
 use phasefield::Real;
 use rayon::prelude::*;
 
-use crate::equations::{heun_corrector, heun_predictor};
+use crate::equations::heun_corrector;
 use crate::kernels::evaluate;
-use crate::step::{CheckPoint, StepCheck};
+use crate::step::StepCheck;
 use crate::tissue::Tissue;
 use crate::workspace::Workspace;
 use crate::StepError;
@@ -139,44 +139,24 @@ impl<T: Real> Tissue<T> {
         t_end: f64,
         check: &mut (impl StepCheck + ?Sized),
     ) -> Result<f64, StepError> {
-        let shapes = self.params.zeta != 0.0;
-        let Workspace {
-            phi_old,
-            k1,
-            k2,
-            sums,
-            cell_state,
-            com,
-            ..
-        } = ws;
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
-            shapes,
-            k1,
-            sums,
-            cell_state,
-        );
         ctrl.dt = ctrl.dt.clamp(params.dt_min, params.dt_max);
-        let at = CheckPoint {
-            iteration: self.iteration,
-            time: self.time,
-            dt: ctrl.dt,
-        };
-        check.check(at, cell_state)?;
-        self.cells.swap_phi(phi_old);
+        self.start_step(ws, ctrl.dt, check)?;
+        let shapes = self.params.zeta != 0.0;
         let remaining = t_end - self.time;
         loop {
             // Land exactly on t_end when the proposal reaches it (or nearly).
             let lands = ctrl.dt >= remaining * (1.0 - 1e-12);
             let h = if lands { remaining } else { ctrl.dt };
-            let phi = self.cells.phi_mut();
-            phi.par_iter_mut()
-                .zip(phi_old.par_iter().zip(k1.par_iter()))
-                .for_each(|(p, (o, r))| {
-                    *p = T::from_f64(heun_predictor(o.to_f64(), h, r.to_f64()))
-                });
+            self.predict(ws, h);
+            let Workspace {
+                phi_old,
+                k1,
+                k2,
+                sums,
+                cell_state,
+                com,
+                ..
+            } = &mut *ws;
             evaluate(
                 &self.params,
                 &self.cells,

@@ -122,6 +122,8 @@ impl<T: Real> Tissue<T> {
         check: &mut (impl StepCheck + ?Sized),
     ) -> Result<(), StepError> {
         let dt = step_params.dt;
+        self.start_step(ws, dt, check)?;
+        self.predict(ws, dt);
         let shapes = self.params.zeta != 0.0;
         let Workspace {
             phi_old,
@@ -132,28 +134,6 @@ impl<T: Real> Tissue<T> {
             com,
             ..
         } = ws;
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
-            shapes,
-            k1,
-            sums,
-            cell_state,
-        );
-        let at = CheckPoint {
-            iteration: self.iteration,
-            time: self.time,
-            dt,
-        };
-        check.check(at, cell_state)?;
-        // The state moves into `phi_old` without a copy; the predictor overwrites the buffer
-        // that held the previous step's `phi_old`.
-        self.cells.swap_phi(phi_old);
-        let phi = self.cells.phi_mut();
-        phi.par_iter_mut()
-            .zip(phi_old.par_iter().zip(k1.par_iter()))
-            .for_each(|(p, (o, r))| *p = T::from_f64(heun_predictor(o.to_f64(), dt, r.to_f64())));
         for _ in 0..step_params.npc {
             evaluate(
                 &self.params,
@@ -176,6 +156,54 @@ impl<T: Real> Tissue<T> {
         self.time += dt;
         self.update_centres(com);
         Ok(())
+    }
+
+    /// The start of a step of size `dt`: `k1 = R(φ)` of the current state into `ws.k1`, the
+    /// check at the chokepoint, then the state moved into `ws.phi_old` without a copy (the
+    /// next write to the fields overwrites the buffer that held the previous `phi_old`).
+    ///
+    /// # Errors
+    /// Whatever `check` returns; the tissue is then unchanged.
+    pub(crate) fn start_step(
+        &mut self,
+        ws: &mut Workspace<T>,
+        dt: f64,
+        check: &mut (impl StepCheck + ?Sized),
+    ) -> Result<(), StepError> {
+        let shapes = self.params.zeta != 0.0;
+        let Workspace {
+            phi_old,
+            k1,
+            sums,
+            cell_state,
+            ..
+        } = ws;
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            shapes,
+            k1,
+            sums,
+            cell_state,
+        );
+        let at = CheckPoint {
+            iteration: self.iteration,
+            time: self.time,
+            dt,
+        };
+        check.check(at, cell_state)?;
+        self.cells.swap_phi(phi_old);
+        Ok(())
+    }
+
+    /// The predictor `φ = φ_old + h k1` (forward Euler) from what [`Tissue::start_step`]
+    /// left in `ws`.
+    pub(crate) fn predict(&mut self, ws: &Workspace<T>, h: f64) {
+        let phi = self.cells.phi_mut();
+        phi.par_iter_mut()
+            .zip(ws.phi_old.par_iter().zip(ws.k1.par_iter()))
+            .for_each(|(p, (o, r))| *p = T::from_f64(heun_predictor(o.to_f64(), h, r.to_f64())));
     }
 
     /// Evaluates the derived quantities of the current state (areas, shapes, forces,
