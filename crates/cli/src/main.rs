@@ -545,6 +545,7 @@ fn note_skipped(notes: &study::analyze::FrameNotes, run_dir: &std::path::Path) {
         partial,
         stray,
         missing,
+        first_missing,
         complete,
     } = notes;
     if !complete {
@@ -556,10 +557,9 @@ fn note_skipped(notes: &study::analyze::FrameNotes, run_dir: &std::path::Path) {
     if *partial > 0 {
         eprintln!("note: skipped {partial} partially written frame(s)");
     }
-    if let Some(first) = missing.first() {
+    if let Some(first) = first_missing {
         eprintln!(
-            "note: {} frame(s) of the run's schedule are missing, the first at t ≈ {first:.3}: time differences and rates span the gap",
-            missing.len()
+            "note: {missing} frame(s) of the run's schedule are missing, the first at t ≈ {first:.3}: time differences and rates span the gap"
         );
     }
     if let Some(first) = stray.first() {

@@ -121,9 +121,11 @@ pub struct FrameNotes {
     pub partial: usize,
     /// Other files in `frames/` that were skipped (names that are not `frame_STEP.npz`).
     pub stray: Vec<String>,
-    /// Times of the frame schedule (multiples of the scene's frame interval) between the
-    /// first and the last frame that have no frame: removed, or lost to a full disk.
-    pub missing: Vec<f64>,
+    /// Frames of the schedule (multiples of the scene's frame interval) between the first and
+    /// the last frame that are not there: removed, or lost to a full disk.
+    pub missing: u64,
+    /// The time of the first missing frame.
+    pub first_missing: Option<f64>,
     /// Whether the run is marked complete ([`rundir::is_complete`]); if not, it is still
     /// being written, was killed, or was written by a version before the mark.
     pub complete: bool,
@@ -194,48 +196,48 @@ pub(crate) fn list_frames(run_dir: &Path, scene: &Scene) -> Result<FrameList> {
         ));
     }
     stray.sort();
-    let missing = missing_frames(scene, &frames);
+    let (missing, first_missing) = missing_frames(scene, &frames);
     Ok(FrameList {
         frames,
         notes: FrameNotes {
             partial,
             stray,
             missing,
+            first_missing,
             complete: rundir::is_complete(run_dir),
         },
     })
 }
 
-/// The times of the scene's frame schedule between the first and the last of `frames` (in
-/// step order) that have no frame: multiples of the frame interval in steps with fixed steps,
-/// in model time with the adaptive step (whose frames land on those times).
-fn missing_frames(scene: &Scene, frames: &[FrameFile]) -> Vec<f64> {
-    let (first, last) = (&frames[0], &frames[frames.len() - 1]);
-    let mut missing = Vec::new();
-    if scene.adaptive().is_some() {
-        let every = scene.file().run.output_every;
-        let tol = 1e-9 * every;
-        let mut have = frames.iter().map(|f| f.time).peekable();
-        let k0 = ((first.time - tol) / every).ceil() as u64;
-        let k1 = ((last.time + tol) / every).floor() as u64;
-        for t in (k0..=k1).map(|k| k as f64 * every) {
-            while have.next_if(|&s| s < t - tol).is_some() {}
-            if !have.peek().is_some_and(|&s| (s - t).abs() <= tol) {
-                missing.push(t);
-            }
-        }
-    } else {
-        let every = scene.step_counts().frame_every;
-        let dt = scene.step_params().dt;
-        let mut have = frames.iter().map(|f| f.step).peekable();
-        for step in (first.step.div_ceil(every)..=last.step / every).map(|k| k * every) {
-            while have.next_if(|&s| s < step).is_some() {}
-            if have.peek() != Some(&step) {
-                missing.push(step as f64 * dt);
-            }
+/// The frames of the scene's schedule between the first and the last of `frames` (in step
+/// order) that are not there: how many, and the time of the first. The schedule is every
+/// multiple of the frame interval in steps with fixed steps, in model time with the adaptive
+/// step (whose frames land on those times). Counted gap by gap, so a damaged step number
+/// costs nothing.
+fn missing_frames(scene: &Scene, frames: &[FrameFile]) -> (u64, Option<f64>) {
+    let (mut count, mut first) = (0u64, None);
+    for w in frames.windows(2) {
+        let (n, t) = if scene.adaptive().is_some() {
+            let every = scene.file().run.output_every;
+            let tol = 1e-9 * every;
+            let k0 = ((w[0].time + tol) / every).floor() + 1.0;
+            let k1 = ((w[1].time - tol) / every).ceil() - 1.0;
+            ((k1 - k0 + 1.0).max(0.0) as u64, k0 * every)
+        } else {
+            let every = scene.step_counts().frame_every;
+            let (s0, s1) = (w[0].step, w[1].step);
+            let n = ((s1 - 1) / every).saturating_sub(s0 / every);
+            (
+                n,
+                (s0 / every + 1) as f64 * every as f64 * scene.step_params().dt,
+            )
+        };
+        if n > 0 {
+            count = count.saturating_add(n);
+            first.get_or_insert(t);
         }
     }
-    missing
+    (count, first)
 }
 
 /// The default smoothing box of a scene: the odd side nearest 3R, at most the lattice's.
