@@ -63,7 +63,8 @@ pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Ve
         if let Some((k, v)) = o.split_once('=') {
             if k.trim() == "cells.from" {
                 let v = v.trim().trim_matches('"');
-                if Path::new(v).is_relative() {
+                // An empty path is left for the validation to name.
+                if !v.is_empty() && Path::new(v).is_relative() {
                     *o = quoted(&cwd.join(v));
                 }
             }
@@ -71,7 +72,7 @@ pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Ve
     }
     if let Ok(file) = scene::SceneFile::parse(text, &set) {
         if let Some(from) = file.cells.from.as_deref() {
-            if Path::new(from).is_relative() {
+            if !from.trim().is_empty() && Path::new(from).is_relative() {
                 let base = scene_path.parent().unwrap_or(Path::new(""));
                 set.push(quoted(&cwd.join(base).join(from)));
             }

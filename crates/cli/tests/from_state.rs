@@ -197,6 +197,7 @@ fn a_state_that_does_not_fit_is_refused_with_the_key_and_the_fix() {
             &["[cells] from", "init = \"frame\""],
         ),
         (&[], &["[cells] init", "from = "]),
+        (&["cells.from=\"\""], &["[cells] from", "the path is empty"]),
     ];
     for (i, (extra, want)) in cases.iter().enumerate() {
         let out = dir.path().join(format!("bad{i}"));
