@@ -125,8 +125,8 @@ const K: f64 = 2.0;
 
 impl<T: Real> Tissue<T> {
     /// One accepted adaptive step (Heun with one corrector, error-controlled; see
-    /// [`crate::adaptive`]), ending no later than `t_end`, with the check at the chokepoint.
-    /// Returns the step taken. Allocates nothing.
+    /// [`crate::adaptive`]), ending no later than `t_end` (ignored when it is not ahead of the
+    /// clock), with the check at the chokepoint. Returns the step taken. Allocates nothing.
     ///
     /// # Errors
     /// What `check` returns, or [`StepError::StepTooSmall`] when the error cannot be met with
@@ -139,10 +139,16 @@ impl<T: Real> Tissue<T> {
         t_end: f64,
         check: &mut (impl StepCheck + ?Sized),
     ) -> Result<f64, StepError> {
-        ctrl.dt = ctrl.dt.clamp(params.dt_min, params.dt_max);
+        // max/min rather than clamp: no panic on bounds a caller got wrong.
+        ctrl.dt = ctrl.dt.max(params.dt_min).min(params.dt_max);
         self.start_step(ws, ctrl.dt, check)?;
         let shapes = self.params.zeta != 0.0;
-        let remaining = t_end - self.time;
+        // A t_end not ahead of the clock lands nowhere (a step never goes back).
+        let remaining = if t_end > self.time {
+            t_end - self.time
+        } else {
+            f64::INFINITY
+        };
         loop {
             // Land exactly on t_end when the proposal reaches it (or nearly).
             let lands = ctrl.dt >= remaining * (1.0 - 1e-12);
@@ -188,7 +194,9 @@ impl<T: Real> Tissue<T> {
                     } else {
                         fac
                     };
-                    ctrl.dt = (ctrl.dt * fac.clamp(0.2, 2.0)).clamp(params.dt_min, params.dt_max);
+                    ctrl.dt = (ctrl.dt * fac.clamp(0.2, 2.0))
+                        .max(params.dt_min)
+                        .min(params.dt_max);
                     ctrl.err_prev = err;
                 }
                 ctrl.accepted += 1;
