@@ -23,10 +23,7 @@
 //! the time the caller asks for (an output time) without changing the controller's proposal.
 
 use phasefield::Real;
-use rayon::prelude::*;
 
-use crate::equations::heun_corrector;
-use crate::kernels::evaluate;
 use crate::step::StepCheck;
 use crate::tissue::Tissue;
 use crate::workspace::Workspace;
@@ -142,7 +139,6 @@ impl<T: Real> Tissue<T> {
         // max/min rather than clamp: no panic on bounds a caller got wrong.
         ctrl.dt = ctrl.dt.max(params.dt_min).min(params.dt_max);
         self.start_step(ws, ctrl.dt, check)?;
-        let shapes = self.params.zeta != 0.0;
         // A t_end not ahead of the clock lands nowhere (a step never goes back).
         let remaining = if t_end > self.time {
             t_end - self.time
@@ -154,35 +150,7 @@ impl<T: Real> Tissue<T> {
             let lands = ctrl.dt >= remaining * (1.0 - 1e-12);
             let h = if lands { remaining } else { ctrl.dt };
             self.predict(ws, h);
-            let Workspace {
-                phi_old,
-                k1,
-                k2,
-                sums,
-                cell_state,
-                com,
-                ..
-            } = &mut *ws;
-            evaluate(
-                &self.params,
-                &self.cells,
-                self.cells.phi(),
-                shapes,
-                k2,
-                sums,
-                cell_state,
-            );
-            let phi = self.cells.phi_mut();
-            let diff = phi
-                .par_iter_mut()
-                .zip(phi_old.par_iter())
-                .zip(k1.par_iter().zip(k2.par_iter()))
-                .map(|((p, o), (r1, r2))| {
-                    let (r1, r2) = (r1.to_f64(), r2.to_f64());
-                    *p = T::from_f64(heun_corrector(o.to_f64(), h, r1, r2));
-                    (r2 - r1).abs()
-                })
-                .reduce(|| 0.0, f64::max);
+            let diff = self.correct::<true>(ws, h);
             let err = 0.5 * h * diff / params.tolerance;
             if err <= 1.0 {
                 // The controller adapts the proposal only from full (unclipped) steps.
@@ -203,7 +171,7 @@ impl<T: Real> Tissue<T> {
                 ctrl.last_rejected = false;
                 self.iteration += 1;
                 self.time = if lands { t_end } else { self.time + h };
-                self.update_centres(com);
+                self.update_centres(&ws.com);
                 return Ok(h);
             }
             ctrl.rejected += 1;
@@ -213,7 +181,7 @@ impl<T: Real> Tissue<T> {
             // NaN (a blow-up inside the attempt) stops too.
             if next.is_nan() || next < params.dt_min {
                 // Back to the last good state.
-                self.cells.swap_phi(phi_old);
+                self.cells.swap_phi(&mut ws.phi_old);
                 return Err(StepError::StepTooSmall {
                     step: self.iteration,
                     time: self.time,

@@ -124,37 +124,12 @@ impl<T: Real> Tissue<T> {
         let dt = step_params.dt;
         self.start_step(ws, dt, check)?;
         self.predict(ws, dt);
-        let shapes = self.params.zeta != 0.0;
-        let Workspace {
-            phi_old,
-            k1,
-            k2,
-            sums,
-            cell_state,
-            com,
-            ..
-        } = ws;
         for _ in 0..step_params.npc {
-            evaluate(
-                &self.params,
-                &self.cells,
-                self.cells.phi(),
-                shapes,
-                k2,
-                sums,
-                cell_state,
-            );
-            let phi = self.cells.phi_mut();
-            phi.par_iter_mut()
-                .zip(phi_old.par_iter())
-                .zip(k1.par_iter().zip(k2.par_iter()))
-                .for_each(|((p, o), (r1, r2))| {
-                    *p = T::from_f64(heun_corrector(o.to_f64(), dt, r1.to_f64(), r2.to_f64()))
-                });
+            self.correct::<false>(ws, dt);
         }
         self.iteration += 1;
         self.time += dt;
-        self.update_centres(com);
+        self.update_centres(&ws.com);
         Ok(())
     }
 
@@ -204,6 +179,51 @@ impl<T: Real> Tissue<T> {
         phi.par_iter_mut()
             .zip(ws.phi_old.par_iter().zip(ws.k1.par_iter()))
             .for_each(|(p, (o, r))| *p = T::from_f64(heun_predictor(o.to_f64(), h, r.to_f64())));
+    }
+
+    /// A corrector pass of a step of size `h`: `k2 = R(φ)` of the fields as they are (the
+    /// predicted state), then `φ = φ_old + h/2 (k1 + k2)`. With `ESTIMATE`, also returns
+    /// `max |k2 − k1|` over every node (the adaptive step's error estimate; a maximum is exact
+    /// in any order), otherwise 0 without computing it.
+    pub(crate) fn correct<const ESTIMATE: bool>(&mut self, ws: &mut Workspace<T>, h: f64) -> f64 {
+        let shapes = self.params.zeta != 0.0;
+        let Workspace {
+            phi_old,
+            k1,
+            k2,
+            sums,
+            cell_state,
+            ..
+        } = ws;
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            shapes,
+            k2,
+            sums,
+            cell_state,
+        );
+        let updates = self
+            .cells
+            .phi_mut()
+            .par_iter_mut()
+            .zip(phi_old.par_iter())
+            .zip(k1.par_iter().zip(k2.par_iter()));
+        if ESTIMATE {
+            updates
+                .map(|((p, o), (r1, r2))| {
+                    let (r1, r2) = (r1.to_f64(), r2.to_f64());
+                    *p = T::from_f64(heun_corrector(o.to_f64(), h, r1, r2));
+                    (r2 - r1).abs()
+                })
+                .reduce(|| 0.0, f64::max)
+        } else {
+            updates.for_each(|((p, o), (r1, r2))| {
+                *p = T::from_f64(heun_corrector(o.to_f64(), h, r1.to_f64(), r2.to_f64()))
+            });
+            0.0
+        }
     }
 
     /// Evaluates the derived quantities of the current state (areas, shapes, forces,
