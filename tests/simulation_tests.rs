@@ -148,15 +148,20 @@ fn field_error(a: &Tissue, b: &Tissue) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Two overlapping cells pushing apart at ζ = 0.01 for 4 TU, stored on the full 40² domain
-/// (no patch moves, whose discrete jumps would hide the order), with time step `dt`.
-fn pair_after(dt: f64, npc: usize) -> Tissue {
-    let lattice = Lattice::new(40, 40);
-    let mut t = Tissue::new(
+/// Two overlapping cells at ζ = 0.01, stored on the full 40² domain (no patch moves, whose
+/// discrete jumps would hide the order of an integrator).
+fn pair() -> Tissue {
+    let t = Tissue::new(
         discs(40, 0, &[[14.0, 20.0], [25.0, 21.5]], 7.0),
         mechanics::ModelParams::paper(0.01),
     );
-    assert_eq!(t.lattice(), lattice);
+    assert_eq!(t.lattice(), Lattice::new(40, 40));
+    t
+}
+
+/// The [`pair`] pushing apart for 4 TU with time step `dt`.
+fn pair_after(dt: f64, npc: usize) -> Tissue {
+    let mut t = pair();
     let mut ws = mechanics::Workspace::new(t.cells());
     let steps = (4.0 / dt).round() as usize;
     for _ in 0..steps {
@@ -227,7 +232,7 @@ fn heap_bytes_count_the_patch_buffers() {
     );
 }
 
-/// The pair of `pair_after` run for 4 TU with the adaptive step at `tol`, on `threads`
+/// The [`pair`] run for 4 TU with the adaptive step at `tol`, on `threads`
 /// threads; the final tissue and the controller.
 fn adaptive_pair(tol: f64, dt0: f64, threads: usize) -> (Tissue, mechanics::Controller) {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -235,10 +240,7 @@ fn adaptive_pair(tol: f64, dt0: f64, threads: usize) -> (Tissue, mechanics::Cont
         .build()
         .unwrap();
     pool.install(|| {
-        let mut t = Tissue::new(
-            discs(40, 0, &[[14.0, 20.0], [25.0, 21.5]], 7.0),
-            mechanics::ModelParams::paper(0.01),
-        );
+        let mut t = pair();
         let mut ws = mechanics::Workspace::new(t.cells());
         let params = mechanics::AdaptiveParams::new(tol, 4.0);
         let mut ctrl = mechanics::Controller::new(dt0);
@@ -310,10 +312,7 @@ fn the_adaptive_step_is_independent_of_the_thread_count_and_recovers_from_reject
 /// tissue exactly as it was.
 #[test]
 fn an_unreachable_tolerance_stops_with_the_state_unchanged() {
-    let mut t = Tissue::new(
-        discs(40, 0, &[[14.0, 20.0], [25.0, 21.5]], 7.0),
-        mechanics::ModelParams::paper(0.01),
-    );
+    let mut t = pair();
     let mut ws = mechanics::Workspace::new(t.cells());
     let before = t.cells().phi().to_vec();
     let mut params = mechanics::AdaptiveParams::new(1e-14, 4.0);
@@ -342,10 +341,7 @@ fn an_unreachable_tolerance_stops_with_the_state_unchanged() {
 /// end in a clean error, not a panic.
 #[test]
 fn an_adaptive_step_never_goes_back() {
-    let mut t = Tissue::new(
-        discs(40, 0, &[[14.0, 20.0], [25.0, 21.5]], 7.0),
-        mechanics::ModelParams::paper(0.01),
-    );
+    let mut t = pair();
     let mut ws = mechanics::Workspace::new(t.cells());
     let params = mechanics::AdaptiveParams::new(1e-3, 1.0);
     let mut ctrl = mechanics::Controller::new(0.25);
