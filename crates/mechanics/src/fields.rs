@@ -48,17 +48,7 @@ impl<T: Real> Tissue<T> {
             velocity_field,
             |i, run, sums| {
                 let [ux, uy] = [cs[i].velocity.x, cs[i].velocity.y];
-                let [vx, vy] = sums;
-                let n = run.c.len();
-                let (vx, vy) = (&mut vx[..n], &mut vy[..n]);
-                run.map(
-                    [],
-                    |s, []| [s.c * ux, s.c * uy],
-                    |j, [x, y]| {
-                        vx[j] += x;
-                        vy[j] += y;
-                    },
-                );
+                run.add_to([], |s, []| [s.c * ux, s.c * uy], sums);
             },
         );
     }

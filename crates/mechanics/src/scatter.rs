@@ -142,7 +142,13 @@ impl<const K: usize> LatticeSums<K> {
     /// Lattice column `x` of every field.
     #[inline(always)]
     pub fn columns(&self, x: usize) -> [&[f64]; K] {
-        std::array::from_fn(|c| self.column(c, x))
+        assert!(x < self.lattice.lx);
+        let (base, stride) = self.locate(x);
+        let ly = self.lattice.ly;
+        // The K columns of the stripe's fields, cut from one slice that holds them all (one
+        // bounds check, where `column` per field does K).
+        let all = &self.data[base..base + (K - 1) * stride + ly];
+        std::array::from_fn(|c| &all[c * stride..c * stride + ly])
     }
 
     /// Field `c` at lattice node `node = x * ly + y`.
