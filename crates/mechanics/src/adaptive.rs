@@ -138,7 +138,7 @@ impl<T: Real> Tissue<T> {
     ) -> Result<f64, StepError> {
         // max/min rather than clamp: no panic on bounds a caller got wrong.
         ctrl.dt = ctrl.dt.max(params.dt_min).min(params.dt_max);
-        self.start_step(ws, ctrl.dt, check)?;
+        self.start_step(ws, ctrl.dt, None, check)?;
         // A t_end not ahead of the clock lands nowhere (a step never goes back).
         let remaining = if t_end > self.time {
             t_end - self.time

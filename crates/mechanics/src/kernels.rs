@@ -16,8 +16,8 @@ use phasefield::{Cells, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
 use crate::equations::{
-    force_density, nematic_density, pressure, pressure_cell_part, pressure_self_coefficient,
-    pressure_self_part_with, rhs, shape_tensor_density, velocity,
+    force_density, heun_corrector, heun_predictor, nematic_density, pressure, pressure_cell_part,
+    pressure_self_coefficient, pressure_self_part_with, rhs, shape_tensor_density, velocity,
 };
 use crate::geometry::TracelessTensor;
 use crate::params::{ModelParams, PressureKind};
@@ -86,6 +86,23 @@ fn cell_sums<T: Real, const SHAPE: bool>(
     st.shape = TracelessTensor::from(add_lanes(&acc));
 }
 
+/// What the last pass of [`evaluate`] does with each cell's right-hand side `k` once it has it,
+/// while the cell's fields are in cache: a Heun update that would otherwise be a sweep of its
+/// own over every field, and a parallel loop of its own. The values are those of the separate
+/// sweeps ([`crate::equations`]), to the bit.
+pub(crate) enum Post<'a, T> {
+    /// Nothing.
+    Nothing,
+    /// The predictor into `out`: `out = φ + h k`.
+    Predict { h: f64, out: &'a mut [T] },
+    /// The corrector on `old = φ_old`, in place: `old = φ_old + h/2 (k1 + k)`.
+    Correct {
+        h: f64,
+        k1: &'a [T],
+        old: &'a mut [T],
+    },
+}
+
 /// One evaluation of the right-hand side `R(φ)` into `rhs_out`, with every intermediate
 /// quantity (lattice sums, per-cell state) left in the buffers for inspection.
 ///
@@ -101,6 +118,7 @@ fn cell_sums<T: Real, const SHAPE: bool>(
 /// rearrangements of this function that only renamed or regrouped its locals: its speed
 /// depends on how LLVM inlines the closures, so time it after any change, with the whole-run
 /// command in `docs/performance.md`.)
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate<T: Real>(
     params: &ModelParams,
     cells: &Cells<T>,
@@ -109,6 +127,7 @@ pub(crate) fn evaluate<T: Real>(
     rhs_out: &mut [T],
     global: &mut LatticeSums<N_SUMS>,
     cell_state: &mut [CellState],
+    post: Post<'_, T>,
 ) {
     let shape = cells.shape();
     let plen = shape.len();
@@ -183,59 +202,88 @@ pub(crate) fn evaluate<T: Real>(
         PressureKind::Interaction => I_S2,
     };
     let c_self = pressure_self_coefficient(kind, &coef);
-    rhs_out
+    // The Heun update's field and what it does, per cell (an empty field when there is none,
+    // which the zip below must not see: it would end the loop).
+    let (h, k1, extra, update): (f64, &[T], &mut [T], u8) = match post {
+        Post::Nothing => (0.0, &[], &mut [], 0),
+        Post::Predict { h, out } => (h, &[], out, 1),
+        Post::Correct { h, k1, old } => (h, k1, old, 2),
+    };
+    let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, extra: &mut [T]| {
+        let xs = map.cell_x(shape, i);
+        let runs = RowRuns::new(map.cell_y(shape, i));
+        let mut acc = [[0.0; LANES]; 2];
+        for (a, &x) in xs.iter().enumerate() {
+            let cols = g.columns(x as usize);
+            for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
+                let y = run.run.y0..run.run.y0 + run.run.len;
+                let fields = [
+                    &cols[first][y.clone()],
+                    &cols[I_S2][y.clone()],
+                    &cols[I_U][y.clone()],
+                    &cols[I_QXX][y.clone()],
+                    &cols[I_QXY][y],
+                ];
+                let value = |s: Stencil, [s_first, s2, u, qxx, qxy]: [f64; 5]| {
+                    let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
+                        - pressure_self_part_with(c_self, s.c);
+                    force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()])
+                };
+                run.sum_into(fields, value, &mut acc);
+            });
+        }
+        let force = add_lanes(&acc);
+        let v = velocity(force, xi);
+        st.force = Vector2::from(force);
+        st.velocity = Vector2::from(v);
+        let area_factor = coef.area_factor(st.area);
+        for (a, &x) in xs.iter().enumerate() {
+            let s2_col = g.column(I_S2, x as usize);
+            let out_col = &mut out[a * ny..(a + 1) * ny];
+            for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
+                let (y0, b0, n) = (run.run.y0, run.run.b0, run.run.len);
+                run.write_to(
+                    [&s2_col[y0..y0 + n]],
+                    |s, [s2]| {
+                        let others = s2 - s.c * s.c;
+                        let dfdphi =
+                            coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
+                        [rhs(v, [s.dx(), s.dy()], dfdphi)]
+                    },
+                    [&mut out_col[b0..b0 + n]],
+                );
+            });
+        }
+        // The Heun update of this cell, while its fields are in cache.
+        let out: &[T] = out;
+        if update == 1 {
+            for ((e, p), r) in extra.iter_mut().zip(cell).zip(out) {
+                *e = T::from_f64(heun_predictor(p.to_f64(), h, r.to_f64()));
+            }
+        } else if update == 2 {
+            let k1 = &k1[i * plen..(i + 1) * plen];
+            for ((e, r1), r2) in extra.iter_mut().zip(k1).zip(out) {
+                *e = T::from_f64(heun_corrector(e.to_f64(), h, r1.to_f64(), r2.to_f64()));
+            }
+        }
+    };
+    let cells_iter = rhs_out
         .par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
-        .zip(cell_state.par_iter_mut())
-        .enumerate()
-        .for_each(|(i, ((out, cell), st))| {
-            let xs = map.cell_x(shape, i);
-            let runs = RowRuns::new(map.cell_y(shape, i));
-            let mut acc = [[0.0; LANES]; 2];
-            for (a, &x) in xs.iter().enumerate() {
-                let cols = g.columns(x as usize);
-                for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
-                    let y = run.run.y0..run.run.y0 + run.run.len;
-                    let fields = [
-                        &cols[first][y.clone()],
-                        &cols[I_S2][y.clone()],
-                        &cols[I_U][y.clone()],
-                        &cols[I_QXX][y.clone()],
-                        &cols[I_QXY][y],
-                    ];
-                    let value = |s: Stencil, [s_first, s2, u, qxx, qxy]: [f64; 5]| {
-                        let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
-                            - pressure_self_part_with(c_self, s.c);
-                        force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()])
-                    };
-                    run.sum_into(fields, value, &mut acc);
-                });
-            }
-            let force = add_lanes(&acc);
-            let v = velocity(force, xi);
-            st.force = Vector2::from(force);
-            st.velocity = Vector2::from(v);
-            let area_factor = coef.area_factor(st.area);
-            for (a, &x) in xs.iter().enumerate() {
-                let s2_col = g.column(I_S2, x as usize);
-                let out_col = &mut out[a * ny..(a + 1) * ny];
-                for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
-                    let (y0, b0, n) = (run.run.y0, run.run.b0, run.run.len);
-                    run.write_to(
-                        [&s2_col[y0..y0 + n]],
-                        |s, [s2]| {
-                            let others = s2 - s.c * s.c;
-                            let dfdphi = coef.free_energy_derivative(
-                                s.c,
-                                s.laplacian(),
-                                area_factor,
-                                others,
-                            );
-                            [rhs(v, [s.dx(), s.dy()], dfdphi)]
-                        },
-                        [&mut out_col[b0..b0 + n]],
-                    );
-                });
-            }
-        });
+        .zip(cell_state.par_iter_mut());
+    if update == 0 {
+        cells_iter
+            .enumerate()
+            .for_each(|(i, ((out, cell), st))| body(i, out, cell, st, &mut []));
+    } else {
+        assert_eq!(
+            extra.len(),
+            phi.len(),
+            "the Heun update's field holds every cell"
+        );
+        cells_iter
+            .zip(extra.par_chunks_mut(plen))
+            .enumerate()
+            .for_each(|(i, (((out, cell), st), e))| body(i, out, cell, st, e));
+    }
 }

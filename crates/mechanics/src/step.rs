@@ -5,7 +5,7 @@ use phasefield::Real;
 use rayon::prelude::*;
 
 use crate::equations::{heun_corrector, heun_predictor};
-use crate::kernels::evaluate;
+use crate::kernels::{evaluate, Post};
 use crate::params::StepParams;
 use crate::tissue::Tissue;
 use crate::workspace::{CellState, Workspace};
@@ -122,10 +122,15 @@ impl<T: Real> Tissue<T> {
         check: &mut (impl StepCheck + ?Sized),
     ) -> Result<(), StepError> {
         let dt = step_params.dt;
-        self.start_step(ws, dt, check)?;
-        self.predict(ws, dt);
-        for _ in 0..step_params.npc {
-            self.correct::<false>(ws, dt);
+        // The predictor and the last corrector pass are fused into the evaluations before
+        // them (`Post`): two sweeps over every field and two parallel loops fewer per step.
+        self.start_step(ws, dt, Some(dt), check)?;
+        for pass in 0..step_params.npc {
+            if pass + 1 < step_params.npc {
+                self.correct::<false>(ws, dt);
+            } else {
+                self.correct_last(ws, dt);
+            }
         }
         self.iteration += 1;
         self.time += dt;
@@ -134,8 +139,12 @@ impl<T: Real> Tissue<T> {
     }
 
     /// The start of a step of size `dt`: `k1 = R(φ)` of the current state into `ws.k1`, the
-    /// check at the chokepoint, then the state moved into `ws.phi_old` without a copy (the
-    /// next write to the fields overwrites the buffer that held the previous `phi_old`).
+    /// check at the chokepoint, then the state moved into `ws.phi_old` without a copy.
+    ///
+    /// With `predict = Some(h)` the fields are then the predictor `φ + h k1`, which the
+    /// evaluation wrote cell by cell into the spare buffer (`ws.phi_old` before the swap), so
+    /// that a failed check still leaves the state untouched. With `None` the fields hold
+    /// whatever the spare buffer held, for [`Tissue::predict`] to overwrite.
     ///
     /// # Errors
     /// Whatever `check` returns; the tissue is then unchanged.
@@ -143,6 +152,7 @@ impl<T: Real> Tissue<T> {
         &mut self,
         ws: &mut Workspace<T>,
         dt: f64,
+        predict: Option<f64>,
         check: &mut (impl StepCheck + ?Sized),
     ) -> Result<(), StepError> {
         let shapes = self.params.zeta != 0.0;
@@ -153,6 +163,10 @@ impl<T: Real> Tissue<T> {
             cell_state,
             ..
         } = ws;
+        let post = match predict {
+            Some(h) => Post::Predict { h, out: phi_old },
+            None => Post::Nothing,
+        };
         evaluate(
             &self.params,
             &self.cells,
@@ -161,6 +175,7 @@ impl<T: Real> Tissue<T> {
             k1,
             sums,
             cell_state,
+            post,
         );
         let at = CheckPoint {
             iteration: self.iteration,
@@ -170,6 +185,38 @@ impl<T: Real> Tissue<T> {
         check.check(at, cell_state)?;
         self.cells.swap_phi(phi_old);
         Ok(())
+    }
+
+    /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
+    /// fields, with `φ_old + h/2 (k1 + k2)` written over `ws.phi_old` cell by cell right after
+    /// each cell's `k2`, then swapped in: the fields hold the new state and `ws.phi_old` the
+    /// predicted one. (The adaptive step, which may have to go back to `φ_old`, and the
+    /// earlier passes of several use [`Tissue::correct`].)
+    pub(crate) fn correct_last(&mut self, ws: &mut Workspace<T>, h: f64) {
+        let shapes = self.params.zeta != 0.0;
+        let Workspace {
+            phi_old,
+            k1,
+            k2,
+            sums,
+            cell_state,
+            ..
+        } = ws;
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            shapes,
+            k2,
+            sums,
+            cell_state,
+            Post::Correct {
+                h,
+                k1,
+                old: phi_old,
+            },
+        );
+        self.cells.swap_phi(phi_old);
     }
 
     /// The predictor `φ = φ_old + h k1` (forward Euler) from what [`Tissue::start_step`]
@@ -203,6 +250,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
+            Post::Nothing,
         );
         let updates = self
             .cells
@@ -250,6 +298,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
+            Post::Nothing,
         );
     }
 }
