@@ -211,7 +211,7 @@ pub(crate) fn evaluate<T: Real>(
     };
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, extra: &mut [T]| {
         let xs = map.cell_x(shape, i);
-        let runs = RowRuns::new(map.cell_y(shape, i));
+        let runs = *g.cell_runs(i);
         let mut acc = [[0.0; LANES]; 2];
         for (a, &x) in xs.iter().enumerate() {
             let cols = g.columns(x as usize);

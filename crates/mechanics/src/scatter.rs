@@ -33,6 +33,9 @@ pub struct LatticeSums<const K: usize> {
     /// (rebuilt by every scatter; kept here so that it is allocated once).
     offsets: Vec<usize>,
     members: Vec<u32>,
+    /// The row runs of every patch (rebuilt by every scatter, once per cell where each stripe
+    /// would find them again; [`LatticeSums::cell_runs`]).
+    runs: Vec<RowRuns>,
 }
 
 impl<const K: usize> LatticeSums<K> {
@@ -42,6 +45,7 @@ impl<const K: usize> LatticeSums<K> {
             + self.dirty.capacity()
             + self.offsets.capacity() * std::mem::size_of::<usize>()
             + self.members.capacity() * std::mem::size_of::<u32>()
+            + self.runs.capacity() * std::mem::size_of::<RowRuns>()
     }
 
     /// `K` fields on `lattice`, all zero.
@@ -52,6 +56,7 @@ impl<const K: usize> LatticeSums<K> {
             dirty: vec![false; lattice.lx.div_ceil(STRIPE_ROWS)],
             offsets: vec![0; lattice.lx.div_ceil(STRIPE_ROWS) + 1],
             members: Vec::new(),
+            runs: Vec::new(),
         }
     }
 
@@ -61,6 +66,7 @@ impl<const K: usize> LatticeSums<K> {
         let mut sums = Self::new(lattice);
         sums.members
             .reserve_exact(n_cells * Self::most_stripes(sums.dirty.len(), nx));
+        sums.runs.reserve_exact(n_cells);
         sums
     }
 
@@ -116,6 +122,15 @@ impl<const K: usize> LatticeSums<K> {
             self.offsets[s] = self.offsets[s - 1];
         }
         self.offsets[0] = 0;
+    }
+
+    /// The row runs of cell `i`'s patch as the last scatter found them.
+    ///
+    /// # Panics
+    /// If no scatter of at least `i + 1` cells has run.
+    #[inline]
+    pub fn cell_runs(&self, i: usize) -> &RowRuns {
+        &self.runs[i]
     }
 
     /// Where lattice column `x` of field 0 starts, and the distance from one field to the next.
@@ -193,7 +208,10 @@ pub fn scatter<const K: usize, T: Real, F>(
     let (nx, ly) = (shape.nx, lattice.ly);
     let plen = shape.len();
     out.index_stripes(&map.origin, nx);
-    let (offsets, members) = (&out.offsets, &out.members);
+    out.runs.clear();
+    out.runs
+        .extend((0..cells.n_cells()).map(|i| RowRuns::new(map.cell_y(shape, i))));
+    let (offsets, members, all_runs) = (&out.offsets, &out.members, &out.runs);
     out.data
         .par_chunks_mut(STRIPE_ROWS * ly * K)
         .zip(out.dirty.par_iter_mut())
@@ -212,7 +230,7 @@ pub fn scatter<const K: usize, T: Real, F>(
             for &i in overlapping {
                 let i = i as usize;
                 let xs = map.cell_x(shape, i);
-                let runs = RowRuns::new(map.cell_y(shape, i));
+                let runs = all_runs[i];
                 let cell = &phi[i * plen..(i + 1) * plen];
                 for a in 0..nx {
                     let x = xs[a] as usize;
