@@ -202,21 +202,33 @@ impl<T: Real> StencilRun<'_, T> {
         }
         let mut j = 0;
         while j + LANES <= n {
-            self.map_chunk::<M, K, O, ADD>(&fields, j, 0, &value, &mut out);
+            self.map_chunk::<M, K, O, ADD, LANES>(&fields, j, 0, &value, &mut out);
             j += LANES;
         }
         if j < n {
-            self.map_chunk::<M, K, O, ADD>(&fields, n - LANES, LANES - (n - j), &value, &mut out);
+            // As in `sum_into`: half a chunk when at most half of the last one is new.
+            let skip = LANES - (n - j);
+            if skip >= HALF {
+                self.map_chunk::<M, K, O, ADD, HALF>(
+                    &fields,
+                    n - HALF,
+                    skip - HALF,
+                    &value,
+                    &mut out,
+                );
+            } else {
+                self.map_chunk::<M, K, O, ADD, LANES>(&fields, n - LANES, skip, &value, &mut out);
+            }
         }
     }
 
-    /// Writes or adds the `LANES` elements from `j`. Writing the lanes below `skip` (done by an
+    /// Writes or adds the `W` elements from `j`. Writing the elements below `skip` (done by an
     /// earlier chunk) again stores the same values; with `ADD` they get `0 × value` added, as in
     /// [`StencilRun::sum_into`]: a multiply, which compiles to clean SIMD code where a select
     /// did not (225 instructions for the 8 lanes instead of about 90). For a finite value this
     /// adds a zero, which leaves a sum unchanged: a sum that starts at `+0` is never `−0`.
     #[inline(always)]
-    fn map_chunk<const M: usize, const K: usize, O: Real, const ADD: bool>(
+    fn map_chunk<const M: usize, const K: usize, O: Real, const ADD: bool, const W: usize>(
         &self,
         fields: &[&[f64]; M],
         j: usize,
@@ -224,12 +236,12 @@ impl<T: Real> StencilRun<'_, T> {
         value: &impl Fn(Stencil, [f64; M]) -> [f64; K],
         out: &mut [&mut [O]; K],
     ) {
-        let c = load(self.c, j);
-        let (xm, xp) = (load(self.xm, j), load(self.xp, j));
-        let (ym, yp) = (load(self.ym, j), load(self.yp, j));
-        let f: [[f64; LANES]; M] = std::array::from_fn(|m| load(fields[m], j));
-        let mut v = [[0.0; LANES]; K];
-        for l in 0..LANES {
+        let c = load::<T, W>(self.c, j);
+        let (xm, xp) = (load::<T, W>(self.xm, j), load::<T, W>(self.xp, j));
+        let (ym, yp) = (load::<T, W>(self.ym, j), load::<T, W>(self.yp, j));
+        let f: [[f64; W]; M] = std::array::from_fn(|m| load(fields[m], j));
+        let mut v = [[0.0; W]; K];
+        for l in 0..W {
             let s = Stencil {
                 c: c[l],
                 xm: xm[l],
@@ -243,10 +255,10 @@ impl<T: Real> StencilRun<'_, T> {
             }
         }
         for k in 0..K {
-            let o: &mut [O; LANES] = (&mut out[k][j..j + LANES])
+            let o: &mut [O; W] = (&mut out[k][j..j + W])
                 .try_into()
-                .expect("a chunk is LANES long");
-            for l in 0..LANES {
+                .expect("a chunk is W long");
+            for l in 0..W {
                 o[l] = if ADD {
                     let w = if l >= skip { 1.0 } else { 0.0 };
                     O::from_f64(o[l].to_f64() + w * v[k][l])
@@ -281,11 +293,19 @@ impl<T: Real> StencilRun<'_, T> {
         let fields: [&[f64]; M] = std::array::from_fn(|m| &fields[m][..n]);
         let mut j = 0;
         while j + LANES <= n {
-            self.sum_chunk(&fields, j, 0, &value, acc);
+            self.sum_chunk::<M, K, LANES, 0>(&fields, j, 0, &value, acc);
             j += LANES;
         }
         if j < n && n >= LANES {
-            self.sum_chunk(&fields, n - LANES, LANES - (n - j), &value, acc);
+            // The chunk that ends at the run's end, whose first lanes repeat the chunk before;
+            // when at most half of it is new, only its second half is computed (the lanes the
+            // first half would have added to get weight zero anyway): the same sums, to the bit.
+            let skip = LANES - (n - j);
+            if skip >= HALF {
+                self.sum_chunk::<M, K, HALF, HALF>(&fields, n - HALF, skip, &value, acc);
+            } else {
+                self.sum_chunk::<M, K, LANES, 0>(&fields, n - LANES, skip, &value, acc);
+            }
         } else if n < LANES {
             // A short run, one element at a time into lanes 0, 1, …
             self.map(fields, &value, |l, v| {
@@ -296,11 +316,11 @@ impl<T: Real> StencilRun<'_, T> {
         }
     }
 
-    /// Adds the `LANES` elements from `j` to the partial sums, except the lanes below `skip`
-    /// (already taken by an earlier chunk), which get a weight of zero: a multiply, not a
-    /// branch, so that the chunk stays one SIMD computation.
+    /// Adds the `W` elements from `j` to lanes `OFF..OFF + W` of the partial sums, except the
+    /// lanes below `skip` (already taken by an earlier chunk), which get a weight of zero: a
+    /// multiply, not a branch, so that the chunk stays one SIMD computation.
     #[inline(always)]
-    fn sum_chunk<const M: usize, const K: usize>(
+    fn sum_chunk<const M: usize, const K: usize, const W: usize, const OFF: usize>(
         &self,
         fields: &[&[f64]; M],
         j: usize,
@@ -308,11 +328,11 @@ impl<T: Real> StencilRun<'_, T> {
         value: &impl Fn(Stencil, [f64; M]) -> [f64; K],
         acc: &mut [[f64; LANES]; K],
     ) {
-        let c = load(self.c, j);
-        let (xm, xp) = (load(self.xm, j), load(self.xp, j));
-        let (ym, yp) = (load(self.ym, j), load(self.yp, j));
-        let f: [[f64; LANES]; M] = std::array::from_fn(|m| load(fields[m], j));
-        for l in 0..LANES {
+        let c = load::<T, W>(self.c, j);
+        let (xm, xp) = (load::<T, W>(self.xm, j), load::<T, W>(self.xp, j));
+        let (ym, yp) = (load::<T, W>(self.ym, j), load::<T, W>(self.yp, j));
+        let f: [[f64; W]; M] = std::array::from_fn(|m| load(fields[m], j));
+        for l in 0..W {
             let s = Stencil {
                 c: c[l],
                 xm: xm[l],
@@ -321,9 +341,9 @@ impl<T: Real> StencilRun<'_, T> {
                 yp: yp[l],
             };
             let v = value(s, std::array::from_fn(|m| f[m][l]));
-            let w = if l >= skip { 1.0 } else { 0.0 };
+            let w = if OFF + l >= skip { 1.0 } else { 0.0 };
             for k in 0..K {
-                acc[k][l] += w * v[k];
+                acc[k][OFF + l] += w * v[k];
             }
         }
     }
@@ -335,10 +355,13 @@ pub fn add_lanes<const K: usize>(acc: &[[f64; LANES]; K]) -> [f64; K] {
     std::array::from_fn(|k| acc[k].iter().sum())
 }
 
-/// `LANES` values of `s` from element `j`, widened to `f64`.
+/// Half a chunk: the width of the last chunk of a run when at most half of it is new.
+const HALF: usize = LANES / 2;
+
+/// `W` values of `s` from element `j`, widened to `f64`.
 #[inline(always)]
-fn load<T: Real>(s: &[T], j: usize) -> [f64; LANES] {
-    let a = &s[j..j + LANES];
+fn load<T: Real, const W: usize>(s: &[T], j: usize) -> [f64; W] {
+    let a = &s[j..j + W];
     std::array::from_fn(|l| a[l].to_f64())
 }
 
