@@ -11,7 +11,9 @@
 //! taken in `LANES` interleaved partial sums. This is machinery: nothing here is public.
 
 use nalgebra::Vector2;
-use phasefield::kernel::{add_lanes, for_each_run_in_column, RowRuns, LANES};
+use phasefield::kernel::{
+    add_lanes, for_each_run_in_column_with, ColumnPlan, ColumnScratch, RowRuns, LANES,
+};
 use phasefield::{Cells, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
@@ -76,8 +78,10 @@ fn cell_sums<T: Real, const SHAPE: bool>(
     st.phi_min = -neg_lo.into_iter().fold(f64::NEG_INFINITY, f64::max);
     let mut acc = [[0.0; LANES]; 2];
     if SHAPE {
+        let plan = ColumnPlan::new(shape, runs);
+        let mut scratch = ColumnScratch::default();
         for a in 0..shape.nx {
-            for_each_run_in_column(cell, shape, runs, a, &mut |run| {
+            for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |run| {
                 let value = |s: Stencil, []: [f64; 0]| shape_tensor_density([s.dx(), s.dy()]);
                 run.sum_into([], value, &mut acc);
             });
@@ -211,11 +215,12 @@ pub(crate) fn evaluate<T: Real>(
     };
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, extra: &mut [T]| {
         let xs = map.cell_x(shape, i);
-        let runs = *g.cell_runs(i);
+        let plan = ColumnPlan::new(shape, g.cell_runs(i));
+        let mut scratch = ColumnScratch::default();
         let mut acc = [[0.0; LANES]; 2];
         for (a, &x) in xs.iter().enumerate() {
             let cols = g.columns(x as usize);
-            for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
+            for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |run| {
                 let y = run.run.y0..run.run.y0 + run.run.len;
                 let fields = [
                     &cols[first][y.clone()],
@@ -240,7 +245,7 @@ pub(crate) fn evaluate<T: Real>(
         for (a, &x) in xs.iter().enumerate() {
             let s2_col = g.column(I_S2, x as usize);
             let out_col = &mut out[a * ny..(a + 1) * ny];
-            for_each_run_in_column(cell, shape, &runs, a, &mut |run| {
+            for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |run| {
                 let (y0, b0, n) = (run.run.y0, run.run.b0, run.run.len);
                 run.write_to(
                     [&s2_col[y0..y0 + n]],

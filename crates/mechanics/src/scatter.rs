@@ -12,7 +12,9 @@
 //! A stripe that no patch overlaps is zeroed once and then left alone, so a scene of a few
 //! cells in a large box does no work per step on the nodes no cell covers.
 
-use phasefield::kernel::{for_each_run_in_column, RowRuns, StencilRun};
+use phasefield::kernel::{
+    for_each_run_in_column_with, ColumnPlan, ColumnScratch, RowRuns, StencilRun,
+};
 use phasefield::{Cells, Lattice, Real};
 use rayon::prelude::*;
 
@@ -227,10 +229,11 @@ pub fn scatter<const K: usize, T: Real, F>(
                 fields.iter_mut().for_each(|f| f.fill(0.0));
             }
             *dirty = !overlapping.is_empty();
+            let mut scratch = ColumnScratch::default();
             for &i in overlapping {
                 let i = i as usize;
                 let xs = map.cell_x(shape, i);
-                let runs = all_runs[i];
+                let plan = ColumnPlan::new(shape, &all_runs[i]);
                 let cell = &phi[i * plen..(i + 1) * plen];
                 for a in 0..nx {
                     let x = xs[a] as usize;
@@ -238,7 +241,7 @@ pub fn scatter<const K: usize, T: Real, F>(
                         continue;
                     }
                     let base = (x - x0) * ly;
-                    for_each_run_in_column(cell, shape, &runs, a, &mut |s| {
+                    for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |s| {
                         let start = base + s.run.y0;
                         let mut parts = fields.iter_mut();
                         let dst = std::array::from_fn(|_| {

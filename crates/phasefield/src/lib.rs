@@ -53,7 +53,10 @@ pub use stencil::{for_each_stencil, for_each_stencil_at, Stencil};
 /// API and may change with any release. Use [`for_each_stencil`] (node by node) instead.
 #[doc(hidden)]
 pub mod kernel {
-    pub use crate::runs::{add_lanes, for_each_run_in_column, RowRun, RowRuns, StencilRun, LANES};
+    pub use crate::runs::{
+        add_lanes, for_each_run_in_column, for_each_run_in_column_with, ColumnPlan, ColumnScratch,
+        RowRun, RowRuns, StencilRun, LANES,
+    };
     pub use crate::stencil::for_each_stencil_in_column;
 }
 

@@ -370,7 +370,120 @@ fn load<T: Real, const W: usize>(s: &[T], j: usize) -> [f64; W] {
 /// of one row, whose cost is negligible there.
 pub const MAX_COPIED_ROWS: usize = 64;
 
-/// Calls `f` with the [`StencilRun`] of each run of storage column `a` of one patch.
+/// How the columns of one patch are cut into [`StencilRun`]s: the runs with the storage rows of
+/// their y∓1 neighbours, the same for every column of the patch (its storage-to-lattice row
+/// map does not depend on the column). Build it once per patch and sweep, not per column.
+#[derive(Debug, Clone, Copy)]
+pub struct ColumnPlan {
+    /// Each piece: a run, and where its y−1 and y+1 neighbours start in the neighbour rows.
+    pieces: [(RowRun, usize, usize); 5],
+    count: usize,
+    /// Whether the neighbours come from a copy of the column ([`ColumnScratch`]) or from the
+    /// column itself (patches of more than [`MAX_COPIED_ROWS`] rows).
+    copied: bool,
+}
+
+impl ColumnPlan {
+    /// The plan for a patch of this shape whose rows are cut into `runs`.
+    #[inline]
+    pub fn new(shape: &PatchShape, runs: &RowRuns) -> Self {
+        let ny = shape.ny;
+        let mut plan = Self {
+            pieces: [(RowRun::default(), 0, 0); 5],
+            count: 0,
+            copied: ny <= MAX_COPIED_ROWS,
+        };
+        // Each piece is a run with the storage rows of its y∓1 neighbours, taken from the
+        // copy or from the row itself. ext[b] is row b − 1, periodic: the y−1 neighbours of
+        // rows b0.. are ext[b0..], the y+1 neighbours ext[b0 + 2..].
+        if plan.copied {
+            for &run in runs.as_slice() {
+                plan.pieces[plan.count] = (run, run.b0, run.b0 + 2);
+                plan.count += 1;
+            }
+        } else {
+            for &run in runs.as_slice() {
+                // Cut off the patch's first and last rows, whose neighbours wrap.
+                let end = run.b0 + run.len;
+                let first = usize::from(run.b0 == 0);
+                let last = usize::from(end == ny && run.len > first);
+                let piece = |b0: usize, len: usize, ym0: usize, yp0: usize| {
+                    let y0 = run.y0 + (b0 - run.b0);
+                    (RowRun { b0, len, y0 }, ym0, yp0)
+                };
+                if first == 1 {
+                    plan.pieces[plan.count] = piece(0, 1, ny - 1, 1);
+                    plan.count += 1;
+                }
+                let (b0, b1) = (run.b0 + first, end - last);
+                if b1 > b0 {
+                    plan.pieces[plan.count] = piece(b0, b1 - b0, b0 - 1, b0 + 1);
+                    plan.count += 1;
+                }
+                if last == 1 {
+                    plan.pieces[plan.count] = piece(ny - 1, 1, ny - 2, 0);
+                    plan.count += 1;
+                }
+            }
+        }
+        plan
+    }
+}
+
+/// The copy of a column with one wrapped row at each end, from which the y-neighbours of its
+/// runs are read: on the stack, and reused from column to column (made once per sweep, so that
+/// it is not zeroed for every column).
+#[derive(Debug, Clone, Copy)]
+pub struct ColumnScratch<T>([T; MAX_COPIED_ROWS + 2]);
+
+impl<T: Real> Default for ColumnScratch<T> {
+    fn default() -> Self {
+        Self([T::default(); MAX_COPIED_ROWS + 2])
+    }
+}
+
+/// Calls `f` with the [`StencilRun`] of each run of storage column `a` of one patch, cut as
+/// `plan` says, with `scratch` for the column's copy.
+///
+/// # Panics
+/// If `phi.len() != shape.len()`, `a >= shape.nx` or the plan is not one for this shape.
+#[inline(always)]
+pub fn for_each_run_in_column_with<T: Real, F: FnMut(StencilRun<'_, T>)>(
+    phi: &[T],
+    shape: &PatchShape,
+    plan: &ColumnPlan,
+    scratch: &mut ColumnScratch<T>,
+    a: usize,
+    f: &mut F,
+) {
+    let ny = shape.ny;
+    let [row, row_m, row_p] = shape.column_and_neighbours(phi, a);
+    let neighbours: &[T] = if plan.copied {
+        let ext = &mut scratch.0;
+        ext[0] = row[ny - 1];
+        ext[1..=ny].copy_from_slice(row);
+        ext[ny + 1] = row[0];
+        &ext[..]
+    } else {
+        row
+    };
+    // One call site of `f`, so that the kernel is inlined once.
+    for &(run, ym0, yp0) in &plan.pieces[..plan.count] {
+        let RowRun { b0, len, .. } = run;
+        f(StencilRun {
+            run,
+            c: &row[b0..b0 + len],
+            xm: &row_m[b0..b0 + len],
+            xp: &row_p[b0..b0 + len],
+            ym: &neighbours[ym0..ym0 + len],
+            yp: &neighbours[yp0..yp0 + len],
+        });
+    }
+}
+
+/// Calls `f` with the [`StencilRun`] of each run of storage column `a` of one patch: the plan
+/// and the scratch of [`for_each_run_in_column_with`] made for this column alone (for a sweep
+/// over a whole patch, make them once and use that function).
 ///
 /// # Panics
 /// If `phi.len() != shape.len()`, `a >= shape.nx` or the runs are not a patch's of this shape.
@@ -382,61 +495,8 @@ pub fn for_each_run_in_column<T: Real, F: FnMut(StencilRun<'_, T>)>(
     a: usize,
     f: &mut F,
 ) {
-    let ny = shape.ny;
-    let [row, row_m, row_p] = shape.column_and_neighbours(phi, a);
-    // Each piece is a run with the storage rows of its y∓1 neighbours, taken from `ext` or
-    // from the row itself. One call site of `f`, so that the kernel is inlined once.
-    let mut pieces = [(RowRun::default(), 0, 0); 5];
-    let mut count = 0;
-    // ext[b] is row b − 1, periodic: the y−1 neighbours of rows b0.. are ext[b0..], the y+1
-    // neighbours ext[b0 + 2..].
-    let mut ext = [T::default(); MAX_COPIED_ROWS + 2];
-    let copied = ny <= MAX_COPIED_ROWS;
-    if copied {
-        ext[0] = row[ny - 1];
-        ext[1..=ny].copy_from_slice(row);
-        ext[ny + 1] = row[0];
-        for &run in runs.as_slice() {
-            pieces[count] = (run, run.b0, run.b0 + 2);
-            count += 1;
-        }
-    } else {
-        for &run in runs.as_slice() {
-            // Cut off the patch's first and last rows, whose neighbours wrap.
-            let end = run.b0 + run.len;
-            let first = usize::from(run.b0 == 0);
-            let last = usize::from(end == ny && run.len > first);
-            let piece = |b0: usize, len: usize, ym0: usize, yp0: usize| {
-                let y0 = run.y0 + (b0 - run.b0);
-                (RowRun { b0, len, y0 }, ym0, yp0)
-            };
-            if first == 1 {
-                pieces[count] = piece(0, 1, ny - 1, 1);
-                count += 1;
-            }
-            let (b0, b1) = (run.b0 + first, end - last);
-            if b1 > b0 {
-                pieces[count] = piece(b0, b1 - b0, b0 - 1, b0 + 1);
-                count += 1;
-            }
-            if last == 1 {
-                pieces[count] = piece(ny - 1, 1, ny - 2, 0);
-                count += 1;
-            }
-        }
-    }
-    let neighbours: &[T] = if copied { &ext } else { row };
-    for &(run, ym0, yp0) in &pieces[..count] {
-        let RowRun { b0, len, .. } = run;
-        f(StencilRun {
-            run,
-            c: &row[b0..b0 + len],
-            xm: &row_m[b0..b0 + len],
-            xp: &row_p[b0..b0 + len],
-            ym: &neighbours[ym0..ym0 + len],
-            yp: &neighbours[yp0..yp0 + len],
-        });
-    }
+    let plan = ColumnPlan::new(shape, runs);
+    for_each_run_in_column_with(phi, shape, &plan, &mut ColumnScratch::default(), a, f);
 }
 
 #[cfg(test)]
