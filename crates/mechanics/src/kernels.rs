@@ -14,7 +14,7 @@ use nalgebra::Vector2;
 use phasefield::kernel::{
     add_lanes, for_each_run_in_column_with, ColumnPlan, ColumnScratch, RowRuns, LANES,
 };
-use phasefield::{Cells, PatchShape, Real, Stencil};
+use phasefield::{Cells, ComTable, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
 use crate::equations::{
@@ -99,11 +99,16 @@ pub(crate) enum Post<'a, T> {
     Nothing,
     /// The predictor into `out`: `out = φ + h k`.
     Predict { h: f64, out: &'a mut [T] },
-    /// The corrector on `old = φ_old`, in place: `old = φ_old + h/2 (k1 + k)`.
+    /// The corrector on `old = φ_old`, in place: `old = φ_old + h/2 (k1 + k)`, then the
+    /// centre of mass of the new field into `centres` (by Fourier phase, as
+    /// [`ComTable::centre_of_mass`] computes it after a step): the loop over the cells that
+    /// the step would otherwise need for them.
     Correct {
         h: f64,
         k1: &'a [T],
         old: &'a mut [T],
+        com: &'a ComTable,
+        centres: &'a mut [[f64; 2]],
     },
 }
 
@@ -208,12 +213,24 @@ pub(crate) fn evaluate<T: Real>(
     let c_self = pressure_self_coefficient(kind, &coef);
     // The Heun update's field and what it does, per cell (an empty field when there is none,
     // which the zip below must not see: it would end the loop).
-    let (h, k1, extra, update): (f64, &[T], &mut [T], u8) = match post {
-        Post::Nothing => (0.0, &[], &mut [], 0),
-        Post::Predict { h, out } => (h, &[], out, 1),
-        Post::Correct { h, k1, old } => (h, k1, old, 2),
-    };
-    let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, extra: &mut [T]| {
+    let (h, k1, extra, update, com, centres): (f64, &[T], &mut [T], u8, _, &mut [[f64; 2]]) =
+        match post {
+            Post::Nothing => (0.0, &[], &mut [], 0, None, &mut []),
+            Post::Predict { h, out } => (h, &[], out, 1, None, &mut []),
+            Post::Correct {
+                h,
+                k1,
+                old,
+                com,
+                centres,
+            } => (h, k1, old, 2, Some(com), centres),
+        };
+    let body = |i: usize,
+                out: &mut [T],
+                cell: &[T],
+                st: &mut CellState,
+                extra: &mut [T],
+                centre: Option<&mut [f64; 2]>| {
         let xs = map.cell_x(shape, i);
         let plan = ColumnPlan::new(shape, g.cell_runs(i));
         let mut scratch = ColumnScratch::default();
@@ -270,6 +287,9 @@ pub(crate) fn evaluate<T: Real>(
             for ((e, r1), r2) in extra.iter_mut().zip(k1).zip(out) {
                 *e = T::from_f64(heun_corrector(e.to_f64(), h, r1.to_f64(), r2.to_f64()));
             }
+            if let (Some(com), Some(centre)) = (com, centre) {
+                *centre = com.centre_of_mass(extra, shape, xs, map.cell_y(shape, i));
+            }
         }
     };
     let cells_iter = rhs_out
@@ -279,8 +299,8 @@ pub(crate) fn evaluate<T: Real>(
     if update == 0 {
         cells_iter
             .enumerate()
-            .for_each(|(i, ((out, cell), st))| body(i, out, cell, st, &mut []));
-    } else {
+            .for_each(|(i, ((out, cell), st))| body(i, out, cell, st, &mut [], None));
+    } else if update == 1 {
         assert_eq!(
             extra.len(),
             phi.len(),
@@ -289,6 +309,18 @@ pub(crate) fn evaluate<T: Real>(
         cells_iter
             .zip(extra.par_chunks_mut(plen))
             .enumerate()
-            .for_each(|(i, (((out, cell), st), e))| body(i, out, cell, st, e));
+            .for_each(|(i, (((out, cell), st), e))| body(i, out, cell, st, e, None));
+    } else {
+        assert_eq!(
+            extra.len(),
+            phi.len(),
+            "the Heun update's field holds every cell"
+        );
+        assert_eq!(centres.len(), cells.n_cells(), "a centre for every cell");
+        cells_iter
+            .zip(extra.par_chunks_mut(plen))
+            .zip(centres.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, ((((out, cell), st), e), c))| body(i, out, cell, st, e, Some(c)));
     }
 }

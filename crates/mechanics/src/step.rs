@@ -134,7 +134,12 @@ impl<T: Real> Tissue<T> {
         }
         self.iteration += 1;
         self.time += dt;
-        self.update_centres(&ws.com);
+        if step_params.npc > 0 {
+            // The last corrector pass measured the new centres (`Post::Correct`).
+            self.move_patches_to(&ws.next_centre);
+        } else {
+            self.update_centres(&ws.com);
+        }
         Ok(())
     }
 
@@ -189,8 +194,8 @@ impl<T: Real> Tissue<T> {
 
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
     /// fields, with `φ_old + h/2 (k1 + k2)` written over `ws.phi_old` cell by cell right after
-    /// each cell's `k2`, then swapped in: the fields hold the new state and `ws.phi_old` the
-    /// predicted one. (The adaptive step, which may have to go back to `φ_old`, and the
+    /// each cell's `k2`, and its centre of mass into `ws.next_centre`, then swapped in: the
+    /// fields hold the new state and `ws.phi_old` the predicted one. (The adaptive step, which may have to go back to `φ_old`, and the
     /// earlier passes of several use [`Tissue::correct`].)
     pub(crate) fn correct_last(&mut self, ws: &mut Workspace<T>, h: f64) {
         let shapes = self.params.zeta != 0.0;
@@ -200,6 +205,8 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
+            com,
+            next_centre,
             ..
         } = ws;
         evaluate(
@@ -214,6 +221,8 @@ impl<T: Real> Tissue<T> {
                 h,
                 k1,
                 old: phi_old,
+                com,
+                centres: next_centre,
             },
         );
         self.cells.swap_phi(phi_old);

@@ -240,4 +240,13 @@ impl<T: Real> Tissue<T> {
             self.cells.recentre(i, self.centre[i]);
         }
     }
+
+    /// Takes `centres` (computed from the current fields, as [`Tissue::update_centres`] would
+    /// compute them) as the centres, and moves each patch onto its cell's centre.
+    pub(crate) fn move_patches_to(&mut self, centres: &[[f64; 2]]) {
+        self.centre.copy_from_slice(centres);
+        for i in 0..self.cells.n_cells() {
+            self.cells.recentre(i, self.centre[i]);
+        }
+    }
 }

@@ -79,6 +79,8 @@ pub struct Workspace<T: Real = f64> {
     pub(crate) cell_state: Vec<CellState>,
     pub(crate) velocity_field: LatticeSums<2>,
     pub(crate) observed_centre: Vec<[f64; 2]>,
+    /// The centres of mass of the state a fixed step ends in, computed in its corrector pass.
+    pub(crate) next_centre: Vec<[f64; 2]>,
     pub(crate) com: ComTable,
 }
 
@@ -90,7 +92,8 @@ impl<T: Real> Workspace<T> {
             + self.sums.heap_bytes()
             + self.cell_state.capacity() * std::mem::size_of::<CellState>()
             + self.velocity_field.heap_bytes()
-            + self.observed_centre.capacity() * std::mem::size_of::<[f64; 2]>()
+            + (self.observed_centre.capacity() + self.next_centre.capacity())
+                * std::mem::size_of::<[f64; 2]>()
             + self.com.heap_bytes()
     }
 
@@ -106,6 +109,7 @@ impl<T: Real> Workspace<T> {
             cell_state: vec![CellState::default(); cells.n_cells()],
             velocity_field: LatticeSums::for_cells(lattice, cells.n_cells(), cells.shape().nx),
             observed_centre: vec![[0.0; 2]; cells.n_cells()],
+            next_centre: vec![[0.0; 2]; cells.n_cells()],
             com: ComTable::new(lattice),
         }
     }
