@@ -207,7 +207,7 @@ pub fn scatter<const K: usize, T: Real, F>(
     assert_eq!(out.lattice, lattice, "the sums belong to another lattice");
     let shape = cells.shape();
     let map = cells.map();
-    let (nx, ly) = (shape.nx, lattice.ly);
+    let (nx, lx, ly) = (shape.nx, lattice.lx, lattice.ly);
     let plen = shape.len();
     out.index_stripes(&map.origin, nx);
     out.runs.clear();
@@ -232,14 +232,22 @@ pub fn scatter<const K: usize, T: Real, F>(
             let mut scratch = ColumnScratch::default();
             for &i in overlapping {
                 let i = i as usize;
-                let xs = map.cell_x(shape, i);
                 let plan = ColumnPlan::new(shape, &all_runs[i]);
                 let cell = &phi[i * plen..(i + 1) * plen];
-                for a in 0..nx {
-                    let x = xs[a] as usize;
-                    if x < x0 || x >= x0 + rows {
+                let ([ox, _], [fx, _]) = (map.origin[i], map.offset[i]);
+                // The stripe's lattice columns that the patch covers, and their storage columns
+                // (the inverse of `PatchMap::cell_x`: a patch is never wider than the lattice,
+                // so a lattice column holds at most one of its columns). Each lattice node gets
+                // one value per cell whatever the order of the columns, so the sums are those
+                // of a visit in storage order.
+                for x in x0..x0 + rows {
+                    // u = (x − ox) mod lx, the logical column; a = (u + fx) mod nx.
+                    let u = if x >= ox { x - ox } else { x + lx - ox };
+                    if u >= nx {
                         continue;
                     }
+                    let a = if u + fx >= nx { u + fx - nx } else { u + fx };
+                    debug_assert_eq!(map.cell_x(shape, i)[a] as usize, x);
                     let base = (x - x0) * ly;
                     for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |s| {
                         let start = base + s.run.y0;
