@@ -138,18 +138,27 @@ impl<T: Real> Tissue<T> {
     ) -> Result<f64, StepError> {
         // max/min rather than clamp: no panic on bounds a caller got wrong.
         ctrl.dt = ctrl.dt.max(params.dt_min).min(params.dt_max);
-        self.start_step(ws, ctrl.dt, None, check)?;
         // A t_end not ahead of the clock lands nowhere (a step never goes back).
         let remaining = if t_end > self.time {
             t_end - self.time
         } else {
             f64::INFINITY
         };
+        // Land exactly on t_end when the proposal reaches it (or nearly).
+        let attempt = |dt: f64| {
+            let lands = dt >= remaining * (1.0 - 1e-12);
+            (lands, if lands { remaining } else { dt })
+        };
+        // The first attempt's predictor is written by the evaluation of k1 (`Post::Predict`);
+        // after a rejection `predict` writes the next one from the same k1.
+        self.start_step(ws, ctrl.dt, Some(attempt(ctrl.dt).1), check)?;
+        let mut first = true;
         loop {
-            // Land exactly on t_end when the proposal reaches it (or nearly).
-            let lands = ctrl.dt >= remaining * (1.0 - 1e-12);
-            let h = if lands { remaining } else { ctrl.dt };
-            self.predict(ws, h);
+            let (lands, h) = attempt(ctrl.dt);
+            if !first {
+                self.predict(ws, h);
+            }
+            first = false;
             let diff = self.correct::<true>(ws, h);
             let err = 0.5 * h * diff / params.tolerance;
             if err <= 1.0 {
