@@ -112,6 +112,22 @@ pub(crate) enum Post<'a, T> {
     },
 }
 
+/// [`Post`] for one cell: its slices of the fields the update reads and writes.
+enum CellPost<'c, T> {
+    Nothing,
+    Predict {
+        h: f64,
+        out: &'c mut [T],
+    },
+    Correct {
+        h: f64,
+        k1: &'c [T],
+        old: &'c mut [T],
+        com: &'c ComTable,
+        centre: &'c mut [f64; 2],
+    },
+}
+
 /// One evaluation of the right-hand side `R(φ)` into `rhs_out`, with every intermediate
 /// quantity (lattice sums, per-cell state) left in the buffers for inspection.
 ///
@@ -211,26 +227,7 @@ pub(crate) fn evaluate<T: Real>(
         PressureKind::Interaction => I_S2,
     };
     let c_self = pressure_self_coefficient(kind, &coef);
-    // The Heun update's field and what it does, per cell (an empty field when there is none,
-    // which the zip below must not see: it would end the loop).
-    let (h, k1, extra, update, com, centres): (f64, &[T], &mut [T], u8, _, &mut [[f64; 2]]) =
-        match post {
-            Post::Nothing => (0.0, &[], &mut [], 0, None, &mut []),
-            Post::Predict { h, out } => (h, &[], out, 1, None, &mut []),
-            Post::Correct {
-                h,
-                k1,
-                old,
-                com,
-                centres,
-            } => (h, k1, old, 2, Some(com), centres),
-        };
-    let body = |i: usize,
-                out: &mut [T],
-                cell: &[T],
-                st: &mut CellState,
-                extra: &mut [T],
-                centre: Option<&mut [f64; 2]>| {
+    let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
         let plan = ColumnPlan::new(shape, g.cell_runs(i));
         let mut scratch = ColumnScratch::default();
@@ -278,17 +275,24 @@ pub(crate) fn evaluate<T: Real>(
         }
         // The Heun update of this cell, while its fields are in cache.
         let out: &[T] = out;
-        if update == 1 {
-            for ((e, p), r) in extra.iter_mut().zip(cell).zip(out) {
-                *e = T::from_f64(heun_predictor(p.to_f64(), h, r.to_f64()));
+        match post {
+            CellPost::Nothing => {}
+            CellPost::Predict { h, out: pred } => {
+                for ((e, p), r) in pred.iter_mut().zip(cell).zip(out) {
+                    *e = T::from_f64(heun_predictor(p.to_f64(), h, r.to_f64()));
+                }
             }
-        } else if update == 2 {
-            let k1 = &k1[i * plen..(i + 1) * plen];
-            for ((e, r1), r2) in extra.iter_mut().zip(k1).zip(out) {
-                *e = T::from_f64(heun_corrector(e.to_f64(), h, r1.to_f64(), r2.to_f64()));
-            }
-            if let (Some(com), Some(centre)) = (com, centre) {
-                *centre = com.centre_of_mass(extra, shape, xs, map.cell_y(shape, i));
+            CellPost::Correct {
+                h,
+                k1,
+                old,
+                com,
+                centre,
+            } => {
+                for ((e, r1), r2) in old.iter_mut().zip(k1).zip(out) {
+                    *e = T::from_f64(heun_corrector(e.to_f64(), h, r1.to_f64(), r2.to_f64()));
+                }
+                *centre = com.centre_of_mass(old, shape, xs, map.cell_y(shape, i));
             }
         }
     };
@@ -296,31 +300,51 @@ pub(crate) fn evaluate<T: Real>(
         .par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
         .zip(cell_state.par_iter_mut());
-    if update == 0 {
-        cells_iter
+    match post {
+        Post::Nothing => cells_iter
             .enumerate()
-            .for_each(|(i, ((out, cell), st))| body(i, out, cell, st, &mut [], None));
-    } else if update == 1 {
-        assert_eq!(
-            extra.len(),
-            phi.len(),
-            "the Heun update's field holds every cell"
-        );
-        cells_iter
-            .zip(extra.par_chunks_mut(plen))
-            .enumerate()
-            .for_each(|(i, (((out, cell), st), e))| body(i, out, cell, st, e, None));
-    } else {
-        assert_eq!(
-            extra.len(),
-            phi.len(),
-            "the Heun update's field holds every cell"
-        );
-        assert_eq!(centres.len(), cells.n_cells(), "a centre for every cell");
-        cells_iter
-            .zip(extra.par_chunks_mut(plen))
-            .zip(centres.par_iter_mut())
-            .enumerate()
-            .for_each(|(i, ((((out, cell), st), e), c))| body(i, out, cell, st, e, Some(c)));
+            .for_each(|(i, ((out, cell), st))| body(i, out, cell, st, CellPost::Nothing)),
+        Post::Predict { h, out: pred } => {
+            assert_eq!(
+                pred.len(),
+                phi.len(),
+                "the predictor's field holds every cell"
+            );
+            cells_iter
+                .zip(pred.par_chunks_mut(plen))
+                .enumerate()
+                .for_each(|(i, (((out, cell), st), pred))| {
+                    body(i, out, cell, st, CellPost::Predict { h, out: pred })
+                });
+        }
+        Post::Correct {
+            h,
+            k1,
+            old,
+            com,
+            centres,
+        } => {
+            assert_eq!(
+                old.len(),
+                phi.len(),
+                "the corrector's field holds every cell"
+            );
+            assert_eq!(k1.len(), phi.len(), "k1 holds every cell");
+            assert_eq!(centres.len(), cells.n_cells(), "a centre for every cell");
+            cells_iter
+                .zip(old.par_chunks_mut(plen))
+                .zip(k1.par_chunks(plen).zip(centres.par_iter_mut()))
+                .enumerate()
+                .for_each(|(i, ((((out, cell), st), old), (k1, centre)))| {
+                    let post = CellPost::Correct {
+                        h,
+                        k1,
+                        old,
+                        com,
+                        centre,
+                    };
+                    body(i, out, cell, st, post)
+                });
+        }
     }
 }
