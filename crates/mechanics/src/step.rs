@@ -7,8 +7,9 @@ use rayon::prelude::*;
 use crate::equations::{heun_corrector, heun_predictor};
 use crate::kernels::{evaluate, Post};
 use crate::params::StepParams;
+use crate::scatter::LatticeSums;
 use crate::tissue::Tissue;
-use crate::workspace::{CellState, Workspace};
+use crate::workspace::{CellState, Workspace, N_SUMS};
 use crate::StepError;
 
 /// How far outside `[0, 1]` a phase field may go before the step is declared unstable.
@@ -160,7 +161,6 @@ impl<T: Real> Tissue<T> {
         predict: Option<f64>,
         check: &mut (impl StepCheck + ?Sized),
     ) -> Result<(), StepError> {
-        let shapes = self.params.zeta != 0.0;
         let Workspace {
             phi_old,
             k1,
@@ -172,16 +172,7 @@ impl<T: Real> Tissue<T> {
             Some(h) => Post::Predict { h, out: phi_old },
             None => Post::Nothing,
         };
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
-            shapes,
-            k1,
-            sums,
-            cell_state,
-            post,
-        );
+        self.evaluate_fields(self.step_needs_shapes(), k1, sums, cell_state, post);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -195,10 +186,10 @@ impl<T: Real> Tissue<T> {
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
     /// fields, with `φ_old + h/2 (k1 + k2)` written over `ws.phi_old` cell by cell right after
     /// each cell's `k2`, and its centre of mass into `ws.next_centre`, then swapped in: the
-    /// fields hold the new state and `ws.phi_old` the predicted one. (The adaptive step, which may have to go back to `φ_old`, and the
-    /// earlier passes of several use [`Tissue::correct`].)
+    /// fields hold the new state and `ws.phi_old` the predicted one. (The adaptive step, which
+    /// may have to go back to `φ_old`, and the earlier passes of several use
+    /// [`Tissue::correct`].)
     pub(crate) fn correct_last(&mut self, ws: &mut Workspace<T>, h: f64) {
-        let shapes = self.params.zeta != 0.0;
         let Workspace {
             phi_old,
             k1,
@@ -209,11 +200,8 @@ impl<T: Real> Tissue<T> {
             next_centre,
             ..
         } = ws;
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
-            shapes,
+        self.evaluate_fields(
+            self.step_needs_shapes(),
             k2,
             sums,
             cell_state,
@@ -242,7 +230,6 @@ impl<T: Real> Tissue<T> {
     /// `max |k2 − k1|` over every node (the adaptive step's error estimate; a maximum is exact
     /// in any order), otherwise 0 without computing it.
     pub(crate) fn correct<const ESTIMATE: bool>(&mut self, ws: &mut Workspace<T>, h: f64) -> f64 {
-        let shapes = self.params.zeta != 0.0;
         let Workspace {
             phi_old,
             k1,
@@ -251,11 +238,8 @@ impl<T: Real> Tissue<T> {
             cell_state,
             ..
         } = ws;
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
-            shapes,
+        self.evaluate_fields(
+            self.step_needs_shapes(),
             k2,
             sums,
             cell_state,
@@ -283,6 +267,33 @@ impl<T: Real> Tissue<T> {
         }
     }
 
+    /// Whether a step computes the deformation tensors and `Q`: only the active force uses
+    /// them (see [`evaluate`]).
+    fn step_needs_shapes(&self) -> bool {
+        self.params.zeta != 0.0
+    }
+
+    /// [`evaluate`] of the current fields, into `out` and the workspace parts given.
+    fn evaluate_fields(
+        &self,
+        shapes: bool,
+        out: &mut [T],
+        sums: &mut LatticeSums<N_SUMS>,
+        cell_state: &mut [CellState],
+        post: Post<'_, T>,
+    ) {
+        evaluate(
+            &self.params,
+            &self.cells,
+            self.cells.phi(),
+            shapes,
+            out,
+            sums,
+            cell_state,
+            post,
+        );
+    }
+
     /// Evaluates the derived quantities of the current state (areas, shapes, forces,
     /// velocities, the lattice sums) into `ws`, and measures the centres of mass of the
     /// stored values into [`Workspace::centres`], without stepping.
@@ -299,16 +310,7 @@ impl<T: Real> Tissue<T> {
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
-            true,
-            k2,
-            sums,
-            cell_state,
-            Post::Nothing,
-        );
+        self.evaluate_fields(true, k2, sums, cell_state, Post::Nothing);
     }
 }
 
