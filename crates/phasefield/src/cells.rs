@@ -254,8 +254,14 @@ impl<T: Real> Cells<T> {
     }
 
     /// Moves the patch of cell `cell_idx` so that it is centred on the node nearest to
-    /// `centre`. Only the origin and the offset change; no value is copied.
+    /// `centre`, keeping every value on its lattice node; the columns and rows that wrap
+    /// around keep the values they had on the far edge (the paper's algorithm).
     /// Returns the shift `[dx, dy]` in nodes. A no-op in full-domain mode.
+    ///
+    /// The patch's values are then rotated in place into logical order (storage offset
+    /// `[0, 0]`, see [`Cells::store_in_logical_order`]), so that a patch column is cut into runs
+    /// only where it crosses the lattice's edge. A move is rare (a cell crosses a node every
+    /// few tens of steps), so the copy costs far less than the split columns it saves.
     pub fn recentre(&mut self, cell_idx: usize, centre: [f64; 2]) -> [i64; 2] {
         let Some(_) = self.shape.margin else {
             return [0, 0];
@@ -276,8 +282,30 @@ impl<T: Real> Cells<T> {
             (off[1] as i64 + d[1]).rem_euclid(ny) as usize,
         ];
         self.map.origin[cell_idx] = new;
-        self.map.refresh_tables(self.lattice, &self.shape, cell_idx);
+        self.store_in_logical_order(cell_idx);
         d
+    }
+
+    /// Rotates the values of cell `cell_idx`'s patch in place so that storage column `a` and
+    /// row `b` are the logical ones (storage offset `[0, 0]`), and refreshes its tables. Every
+    /// value stays on its lattice node; only where it sits in storage changes. Allocates
+    /// nothing.
+    pub fn store_in_logical_order(&mut self, cell_idx: usize) {
+        let [fx, fy] = self.map.offset[cell_idx];
+        let (n, ny) = (self.shape.len(), self.shape.ny);
+        let patch = &mut self.phi[cell_idx * n..(cell_idx + 1) * n];
+        // Storage column (u + fx) mod nx holds logical column u, so rotating left by fx
+        // columns puts logical column u at storage column u; likewise for the rows.
+        if fx != 0 {
+            patch.rotate_left(fx * ny);
+        }
+        if fy != 0 {
+            for column in patch.chunks_exact_mut(ny) {
+                column.rotate_left(fy);
+            }
+        }
+        self.map.offset[cell_idx] = [0, 0];
+        self.map.refresh_tables(self.lattice, &self.shape, cell_idx);
     }
 
     /// The lattice.
@@ -420,13 +448,18 @@ fn min_image_int(d: i64, l: i64) -> i64 {
 mod tests {
     use super::*;
 
+    /// A move keeps every value on its lattice node, and the wrapped columns and rows keep
+    /// their far-edge values: exactly the move that only changes the origin and the storage
+    /// offset (the paper's algorithm, rebuilt here with `from_storage`), but with the values
+    /// rotated into logical order (offset `[0, 0]`). Across both periodic edges, by more than
+    /// one node, twice in a row.
     #[test]
-    fn recentre_moves_without_copying_and_keeps_lattice_positions() {
+    fn recentre_keeps_values_on_their_nodes_and_stores_the_patch_in_logical_order() {
         let lattice = Lattice::new(40, 30);
         let shape = PatchShape::new(lattice, 3).unwrap();
-        let mut cells = Cells::zeros(lattice, shape, &[[1.0, 2.0]]);
-        // Mark every node with a value encoding its lattice position.
+        let mut cells = Cells::zeros(lattice, shape.clone(), &[[1.0, 2.0]]);
         let (nx, ny) = (7, 7);
+        // Distinct values: the lattice position of each node, plus the storage index.
         let xs: Vec<u32> = cells.map().cell_x(cells.shape(), 0).to_vec();
         let ys: Vec<u32> = cells.map().cell_y(cells.shape(), 0).to_vec();
         for a in 0..nx {
@@ -434,27 +467,39 @@ mod tests {
                 cells.phi_mut()[a * ny + b] = (xs[a] * 1000 + ys[b]) as f64;
             }
         }
-        let before = cells.phi().to_vec();
-        // Move across both periodic edges by more than one node.
-        let d = cells.recentre(0, [38.2, 28.6]);
-        assert_eq!(d, [-3, -3]);
-        assert_eq!(cells.phi(), &before[..], "no value may be copied");
-        let xs2 = cells.map().cell_x(cells.shape(), 0).to_vec();
-        let ys2 = cells.map().cell_y(cells.shape(), 0).to_vec();
-        // Nodes still inside the patch keep their lattice coordinates.
-        let mut kept = 0;
-        for a in 0..nx {
-            for b in 0..ny {
-                let v = cells.phi()[a * ny + b] as u32;
-                if (xs2[a], ys2[b]) == (v / 1000, v % 1000) {
-                    kept += 1;
+        for (centre, shift) in [([38.2, 28.6], [-3, -3]), ([2.4, 27.2], [4, -2])] {
+            // The offset-only move of the same patch.
+            let old = cells.map().clone();
+            let d = [shift[0] as i64, shift[1] as i64];
+            let offset = [
+                (old.offset[0][0] as i64 + d[0]).rem_euclid(nx as i64) as usize,
+                (old.offset[0][1] as i64 + d[1]).rem_euclid(ny as i64) as usize,
+            ];
+            let origin = [
+                (old.origin[0][0] as i64 + d[0]).rem_euclid(40) as usize,
+                (old.origin[0][1] as i64 + d[1]).rem_euclid(30) as usize,
+            ];
+            let expected = Cells::from_storage(
+                lattice,
+                shape.clone(),
+                cells.phi().to_vec(),
+                vec![origin],
+                vec![offset],
+            )
+            .unwrap();
+            assert_eq!(cells.recentre(0, centre), d);
+            assert_eq!(cells.map().origin[0], origin);
+            assert_eq!(cells.map().offset[0], [0, 0], "stored in logical order");
+            for x in 0..40 {
+                for y in 0..30 {
+                    assert_eq!(cells.value_at(0, x, y), expected.value_at(0, x, y), "({x}, {y})");
                 }
             }
+            // Storage column a is lattice column origin + a.
+            let xs2 = cells.map().cell_x(cells.shape(), 0);
+            assert!((0..nx).all(|a| xs2[a] as usize == (origin[0] + a) % 40));
         }
-        assert_eq!(kept, 4 * 4);
         // The patch is centred on the rounded centre.
-        assert_eq!(cells.map().origin[0], [35, 26]);
-        assert_eq!(xs2[(cells.map().offset[0][0] + 3) % nx], 38);
-        assert_eq!(ys2[(cells.map().offset[0][1] + 3) % ny], 29);
+        assert_eq!(cells.map().origin[0], [40 - 1, 24]);
     }
 }
