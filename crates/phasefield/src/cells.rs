@@ -492,7 +492,11 @@ mod tests {
             assert_eq!(cells.map().offset[0], [0, 0], "stored in logical order");
             for x in 0..40 {
                 for y in 0..30 {
-                    assert_eq!(cells.value_at(0, x, y), expected.value_at(0, x, y), "({x}, {y})");
+                    assert_eq!(
+                        cells.value_at(0, x, y),
+                        expected.value_at(0, x, y),
+                        "({x}, {y})"
+                    );
                 }
             }
             // Storage column a is lattice column origin + a.
