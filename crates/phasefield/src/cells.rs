@@ -1,5 +1,6 @@
 //! The phase fields of all cells ([`Cells`]) in structure-of-arrays layout, and where each
-//! cell's patch sits on the lattice ([`PatchMap`]): origins, offsets, moves without copying.
+//! cell's patch sits on the lattice ([`PatchMap`]): origins, offsets, and moves that keep each
+//! value on its lattice node and the patch in logical order.
 //!
 //! All cells' values are one contiguous `Vec<T>` with stride `patch_len`; within a patch the
 //! storage index is `a * ny + b` (x slow, y contiguous, as on the [`Lattice`]).

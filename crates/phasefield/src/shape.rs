@@ -8,9 +8,11 @@
 //! A patch is periodic in itself (the paper's supplementary "domain decomposition" section).
 //! Storage column `a` of cell `i` holds lattice column
 //! `x = origin_x + ((a - offset_x) mod nx)  (mod lx)`, and likewise for rows.
-//! When the patch moves by `d` nodes only `origin` and `offset` change: no value is copied,
-//! and the columns that wrap around keep the values they had on the far edge (near zero when
-//! the margin is large enough).
+//! When the patch moves by `d` nodes the columns that wrap around keep the values they had on
+//! the far edge (near zero when the margin is large enough): the paper's algorithm changes only
+//! `origin` and `offset`. [`crate::Cells::recentre`] then rotates the values into logical order
+//! (`offset` back to `[0, 0]`), so that a patch column sits on consecutive lattice rows except
+//! where it crosses the lattice's edge.
 //!
 //! All cells' values are one contiguous `Vec<f64>` with stride `patch_len`; within a patch the
 //! storage index is `a * ny + b` (x slow, y contiguous, as on the [`Lattice`]).
