@@ -4,7 +4,7 @@
 //! `RELAX_STEPS` (default 3) steps at ζ = 0 from the initial discs, then `STEPS` timed steps.
 //!
 //! ```text
-//! cargo run --release -p monolayer-benches --example cost_per_cell -- N L [STEPS] [THREADS] [f32|f64] [RELAX_STEPS]
+//! cargo run --release -p monolayer-benches --example cost_per_cell -- N L [STEPS] [THREADS] [f32|f64] [RELAX_STEPS] [MARGIN]
 //! cargo run --release -p monolayer-benches --example cost_per_cell -- 100000 4082 4
 //! ```
 //!
@@ -12,6 +12,7 @@
 //! field values, but the cost depends on where the patches sit: a patch that crosses the
 //! lattice's edge has its columns cut into two runs. After 3 steps few cells have moved; give
 //! more `RELAX_STEPS` for a state in which the cells have spread out (issue 14 uses 250).
+//! `MARGIN` replaces the paper's margin 12 (the default of `monolayer run` is 16).
 
 use std::time::Instant;
 
@@ -37,14 +38,18 @@ fn time_steps<T: Real>(
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: cost_per_cell N L [STEPS] [THREADS] [f32|f64] [RELAX_STEPS]";
+    let usage = "usage: cost_per_cell N L [STEPS] [THREADS] [f32|f64] [RELAX_STEPS] [MARGIN]";
     let n: usize = args.first().and_then(|a| a.parse().ok()).expect(usage);
     let l: usize = args.get(1).and_then(|a| a.parse().ok()).expect(usage);
     let steps: usize = args.get(2).map_or(10, |a| a.parse().expect(usage));
     let threads: usize = args.get(3).map_or(2, |a| a.parse().expect(usage));
     let f32 = args.get(4).is_some_and(|a| a == "f32");
     let relax: usize = args.get(5).map_or(3, |a| a.parse().expect(usage));
-    let overrides = monolayer_benches::scaling_overrides(n, l);
+    let mut overrides = monolayer_benches::scaling_overrides(n, l).to_vec();
+    if let Some(m) = args.get(6) {
+        let m: usize = m.parse().expect(usage);
+        overrides.push(format!("integrator.margin={m}"));
+    }
     let pool = monolayer_benches::pool(threads);
     let step_s = pool.install(|| {
         if f32 {
