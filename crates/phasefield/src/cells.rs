@@ -460,7 +460,7 @@ mod tests {
         let shape = PatchShape::new(lattice, 3).unwrap();
         let mut cells = Cells::zeros(lattice, shape.clone(), &[[1.0, 2.0]]);
         let (nx, ny) = (7, 7);
-        // Distinct values: the lattice position of each node, plus the storage index.
+        // Mark every node with a value encoding its lattice position.
         let xs: Vec<u32> = cells.map().cell_x(cells.shape(), 0).to_vec();
         let ys: Vec<u32> = cells.map().cell_y(cells.shape(), 0).to_vec();
         for a in 0..nx {
