@@ -10,10 +10,10 @@
 //! rows are contiguous, so that its loops compile to SIMD instructions; per-cell sums are
 //! taken in `LANES` interleaved partial sums. This is machinery: nothing here is public.
 
+use std::cell::RefCell;
+
 use nalgebra::Vector2;
-use phasefield::kernel::{
-    add_lanes, for_each_run_in_column_with, ColumnPlan, ColumnScratch, RowRuns, LANES,
-};
+use phasefield::kernel::{add_lanes, PaddedParts, PaddedPatch, LANES};
 use phasefield::{Cells, ComTable, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
@@ -33,14 +33,18 @@ const I_U: usize = SumField::U.index();
 const I_QXX: usize = SumField::Qxx.index();
 const I_QXY: usize = SumField::Qxy.index();
 
+thread_local! {
+    /// Each thread's copy of the patch it works on, in the padded layout of [`PaddedPatch`]
+    /// (one run per patch), with the five lattice sums gathered beside it: allocated on the
+    /// thread's first evaluation, and again only when the thread meets a larger patch, so a
+    /// warm step allocates nothing. A cell's results depend only on its own values, never on
+    /// what the scratch held before, so they do not depend on which thread computed them.
+    static PADDED: RefCell<PaddedPatch<N_SUMS>> = RefCell::new(PaddedPatch::new());
+}
+
 /// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]
-fn cell_sums<T: Real, const SHAPE: bool>(
-    cell: &[T],
-    shape: &PatchShape,
-    runs: &RowRuns,
-    st: &mut CellState,
-) {
+fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mut CellState) {
     // Area and range need no stencil: passes over the patch in LANES partial results, one
     // quantity per pass, which compile to clean SIMD code; the three in one loop were
     // shuffled between registers (56 instructions per chunk of 8). `if c > m { c } else { m }`
@@ -78,14 +82,15 @@ fn cell_sums<T: Real, const SHAPE: bool>(
     st.phi_min = -neg_lo.into_iter().fold(f64::NEG_INFINITY, f64::max);
     let mut acc = [[0.0; LANES]; 2];
     if SHAPE {
-        let plan = ColumnPlan::new(shape, runs);
-        let mut scratch = ColumnScratch::default();
-        for a in 0..shape.nx {
-            for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |run| {
-                let value = |s: Stencil, []: [f64; 0]| shape_tensor_density([s.dx(), s.dy()]);
-                run.sum_into([], value, &mut acc);
-            });
-        }
+        PADDED.with_borrow_mut(|padded| {
+            padded.fill(cell, shape);
+            let PaddedParts { run, mask, .. } = padded.parts();
+            let value = |s: Stencil, [w]: [f64; 1]| {
+                let [sxx, sxy] = shape_tensor_density([s.dx(), s.dy()]);
+                [w * sxx, w * sxy]
+            };
+            run.sum_into([mask], value, &mut acc);
+        });
     }
     st.shape = TracelessTensor::from(add_lanes(&acc));
 }
@@ -156,10 +161,8 @@ pub(crate) fn evaluate<T: Real>(
 ) {
     let shape = cells.shape();
     let plen = shape.len();
-    let ny = shape.ny;
     let energy = params.energy;
     let zeta = params.zeta;
-    let patch_runs = RowRuns::patch(ny);
 
     // 1. Per cell: area, deformation tensor, range.
     cell_state
@@ -167,9 +170,9 @@ pub(crate) fn evaluate<T: Real>(
         .zip(phi.par_chunks(plen))
         .for_each(|(st, cell)| {
             if shapes {
-                cell_sums::<T, true>(cell, shape, &patch_runs, st);
+                cell_sums::<T, true>(cell, shape, st);
             } else {
-                cell_sums::<T, false>(cell, shape, &patch_runs, st);
+                cell_sums::<T, false>(cell, shape, st);
             }
         });
 
@@ -229,50 +232,43 @@ pub(crate) fn evaluate<T: Real>(
     let c_self = pressure_self_coefficient(kind, &coef);
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
-        let plan = ColumnPlan::new(shape, g.cell_runs(i));
-        let mut scratch = ColumnScratch::default();
-        let mut acc = [[0.0; LANES]; 2];
-        for (a, &x) in xs.iter().enumerate() {
-            let cols = g.columns(x as usize);
-            for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |run| {
-                let y = run.run.y0..run.run.y0 + run.run.len;
-                let fields = [
-                    &cols[first][y.clone()],
-                    &cols[I_S2][y.clone()],
-                    &cols[I_U][y.clone()],
-                    &cols[I_QXX][y.clone()],
-                    &cols[I_QXY][y],
-                ];
-                let value = |s: Stencil, [s_first, s2, u, qxx, qxy]: [f64; 5]| {
-                    let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
-                        - pressure_self_part_with(c_self, s.c);
-                    force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()])
-                };
-                run.sum_into(fields, value, &mut acc);
+        PADDED.with_borrow_mut(|padded| {
+            padded.fill(cell, shape);
+            padded.gather(xs, g.cell_runs(i), |x| {
+                let cols = g.columns(x);
+                [cols[first], cols[I_S2], cols[I_U], cols[I_QXX], cols[I_QXY]]
             });
-        }
-        let force = add_lanes(&acc);
-        let v = velocity(force, xi);
-        st.force = Vector2::from(force);
-        st.velocity = Vector2::from(v);
-        let area_factor = coef.area_factor(st.area);
-        for (a, &x) in xs.iter().enumerate() {
-            let s2_col = g.column(I_S2, x as usize);
-            let out_col = &mut out[a * ny..(a + 1) * ny];
-            for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |run| {
-                let (y0, b0, n) = (run.run.y0, run.run.b0, run.run.len);
-                run.write_to(
-                    [&s2_col[y0..y0 + n]],
-                    |s, [s2]| {
-                        let others = s2 - s.c * s.c;
-                        let dfdphi =
-                            coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
-                        [rhs(v, [s.dx(), s.dy()], dfdphi)]
-                    },
-                    [&mut out_col[b0..b0 + n]],
-                );
-            });
-        }
+            let PaddedParts {
+                run,
+                mask,
+                fields: [s_first, s2, u, qxx, qxy],
+                out: flat,
+            } = padded.parts();
+            let mut acc = [[0.0; LANES]; 2];
+            let value = |s: Stencil, [w, s_first, s2, u, qxx, qxy]: [f64; 6]| {
+                let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
+                    - pressure_self_part_with(c_self, s.c);
+                let [fx, fy] = force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()]);
+                [w * fx, w * fy]
+            };
+            run.sum_into([mask, s_first, s2, u, qxx, qxy], value, &mut acc);
+            let force = add_lanes(&acc);
+            let v = velocity(force, xi);
+            st.force = Vector2::from(force);
+            st.velocity = Vector2::from(v);
+            let area_factor = coef.area_factor(st.area);
+            run.write_to(
+                [s2],
+                |s, [s2]| {
+                    let others = s2 - s.c * s.c;
+                    let dfdphi =
+                        coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
+                    [rhs(v, [s.dx(), s.dy()], dfdphi)]
+                },
+                [flat],
+            );
+            padded.store(out);
+        });
         // The Heun update of this cell, while its fields are in cache.
         let out: &[T] = out;
         match post {

@@ -34,6 +34,7 @@ mod com;
 mod energy;
 pub mod init;
 mod lattice;
+mod padded;
 mod real;
 mod runs;
 mod shape;
@@ -53,6 +54,7 @@ pub use stencil::{for_each_stencil, for_each_stencil_at, Stencil};
 /// API and may change with any release. Use [`for_each_stencil`] (node by node) instead.
 #[doc(hidden)]
 pub mod kernel {
+    pub use crate::padded::{PaddedParts, PaddedPatch};
     pub use crate::runs::{
         add_lanes, for_each_run_in_column, for_each_run_in_column_with, ColumnPlan, ColumnScratch,
         RowRun, RowRuns, StencilRun, LANES,
