@@ -42,6 +42,13 @@ thread_local! {
     static PADDED: RefCell<PaddedPatch<N_SUMS>> = RefCell::new(PaddedPatch::new());
 }
 
+/// Sizes the scratch of every thread of the current rayon pool (the global one outside a pool)
+/// for patches of this shape, so that no step allocates it: [`crate::Workspace::new`] calls
+/// this. A thread of another pool makes its scratch on its first evaluation instead.
+pub(crate) fn prepare_scratch(shape: &PatchShape) {
+    rayon::broadcast(|_| PADDED.with_borrow_mut(|padded| padded.prepare(shape)));
+}
+
 /// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]
 fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mut CellState) {
@@ -85,7 +92,7 @@ fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mu
         PADDED.with_borrow_mut(|padded| {
             padded.fill(cell, shape);
             let PaddedParts { run, mask, .. } = padded.parts();
-            let value = |s: Stencil, [w]: [f64; 1]| {
+            let value = move |s: Stencil, [w]: [f64; 1]| {
                 let [sxx, sxy] = shape_tensor_density([s.dx(), s.dy()]);
                 [w * sxx, w * sxy]
             };
@@ -185,14 +192,14 @@ pub(crate) fn evaluate<T: Real>(
             let c = &cs[i];
             let area_factor = coef.area_factor(c.area);
             let sh = c.shape.components();
-            let node = |p: f64, u: f64| {
+            let node = move |p: f64, u: f64| {
                 let [q_xx, q_xy] = nematic_density(p, sh);
                 [p, p * p, u, q_xx, q_xy]
             };
             match kind {
                 PressureKind::Paper => run.add_to(
                     [],
-                    |s, []| {
+                    move |s, []| {
                         let p = s.c;
                         let u = pressure_cell_part(
                             PressureKind::Paper,
@@ -207,7 +214,7 @@ pub(crate) fn evaluate<T: Real>(
                 ),
                 PressureKind::Interaction => run.add_to(
                     [],
-                    |s, []| {
+                    move |s, []| {
                         let p = s.c;
                         node(
                             p,
@@ -245,7 +252,10 @@ pub(crate) fn evaluate<T: Real>(
                 out: flat,
             } = padded.parts();
             let mut acc = [[0.0; LANES]; 2];
-            let value = |s: Stencil, [w, s_first, s2, u, qxx, qxy]: [f64; 6]| {
+            // `move`: the coefficients are copied into the closure, so that they stay in
+            // registers across the chunk loop's optimisation barrier (by reference, each chunk
+            // loaded them again).
+            let value = move |s: Stencil, [w, s_first, s2, u, qxx, qxy]: [f64; 6]| {
                 let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
                     - pressure_self_part_with(c_self, s.c);
                 let [fx, fy] = force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()]);
@@ -259,7 +269,7 @@ pub(crate) fn evaluate<T: Real>(
             let area_factor = coef.area_factor(st.area);
             run.write_to(
                 [s2],
-                |s, [s2]| {
+                move |s, [s2]| {
                     let others = s2 - s.c * s.c;
                     let dfdphi =
                         coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);

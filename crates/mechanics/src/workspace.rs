@@ -101,6 +101,7 @@ impl<T: Real> Workspace<T> {
     pub fn new(cells: &Cells<T>) -> Self {
         let n = cells.n_cells() * cells.patch_len();
         let lattice = cells.lattice();
+        crate::kernels::prepare_scratch(cells.shape());
         Self {
             phi_old: vec![T::default(); n],
             k1: vec![T::default(); n],
