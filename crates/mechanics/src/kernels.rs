@@ -6,9 +6,12 @@
 //! 3. per cell, in parallel: the force `F_i`, the velocity `v_i`, then `R_i` on the same patch
 //!    while it is in cache.
 //!
-//! Every kernel works on runs of patch rows (`phasefield::kernel::StencilRun`), whose lattice
-//! rows are contiguous, so that its loops compile to SIMD instructions; per-cell sums are
-//! taken in `LANES` interleaved partial sums. This is machinery: nothing here is public.
+//! Every kernel works on runs of stencils (`phasefield::kernel::StencilRun`), so that its loops
+//! compile to SIMD instructions; per-cell sums are taken in `LANES` interleaved partial sums.
+//! The per-cell passes (1 and 3) sweep each patch as one run of a padded copy
+//! (`phasefield::kernel::PaddedPatch`, each thread's own), with the lattice sums they read
+//! gathered beside it; the scatter (2) writes lattice columns, so it goes column by column.
+//! This is machinery: nothing here is public.
 
 use std::cell::RefCell;
 
