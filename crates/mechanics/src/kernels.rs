@@ -38,10 +38,11 @@ const I_QXY: usize = SumField::Qxy.index();
 
 thread_local! {
     /// Each thread's copy of the patch it works on, in the padded layout of [`PaddedPatch`]
-    /// (one run per patch), with the five lattice sums gathered beside it: allocated on the
-    /// thread's first evaluation, and again only when the thread meets a larger patch, so a
-    /// warm step allocates nothing. A cell's results depend only on its own values, never on
-    /// what the scratch held before, so they do not depend on which thread computed them.
+    /// (one run per patch), with the five lattice sums gathered beside it: sized for every
+    /// thread of the pool when a workspace is made ([`prepare_scratch`]), and grown only when
+    /// a thread meets a larger patch, so a step allocates nothing. A cell's results depend
+    /// only on its own values, never on what the scratch held before, so they do not depend
+    /// on which thread computed them.
     static PADDED: RefCell<PaddedPatch<N_SUMS>> = RefCell::new(PaddedPatch::new());
 }
 
