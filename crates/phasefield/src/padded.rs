@@ -77,12 +77,6 @@ impl<const M: usize> PaddedPatch<M> {
         self.len() == 0
     }
 
-    /// The position in the run of storage node `(a, b)`.
-    #[inline(always)]
-    pub fn position(&self, a: usize, b: usize) -> usize {
-        a * self.stride() + b
-    }
-
     /// Sizes the buffers for `shape` ([`PaddedPatch::fill`] does it too); the gathered fields
     /// are zeroed when the shape changes, so that the ghost rows hold finite values. Buffers
     /// only grow: a scratch that has seen a patch this large allocates nothing here.

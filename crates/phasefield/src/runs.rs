@@ -69,18 +69,6 @@ impl RowRuns {
         runs
     }
 
-    /// One run of all `ny` rows, for kernels that touch no lattice field (`y0` = 0).
-    pub fn patch(ny: usize) -> Self {
-        assert!(ny > 0, "a patch has at least one row");
-        let mut runs = [RowRun::default(); 3];
-        runs[0] = RowRun {
-            b0: 0,
-            len: ny,
-            y0: 0,
-        };
-        Self { runs, n: 1 }
-    }
-
     /// The runs, in storage order.
     #[inline]
     pub fn as_slice(&self) -> &[RowRun] {
@@ -223,8 +211,9 @@ impl<T: Real> StencilRun<'_, T> {
         while j + LANES <= n {
             this.map_chunk::<M, K, O, ADD, LANES>(&fields, j, 0, &value, &mut out);
             // Opaque to the optimiser, so that LLVM's loop vectoriser leaves this loop alone:
-            // on a long run (a padded patch) it vectorised across chunks, each vector gathered
-            // from four chunks, at 164 instructions per chunk instead of 98 (see `sum_into`).
+            // on a long run (a padded patch) it vectorised the right-hand side's loop across
+            // chunks, each vector gathered from four chunks: 164 instructions per chunk, against
+            // about 100 with this barrier.
             j = std::hint::black_box(j + LANES);
         }
         if j < n {
@@ -305,10 +294,10 @@ impl<T: Real> StencilRun<'_, T> {
         let mut j = 0;
         while j + LANES <= n {
             this.sum_chunk::<M, K, LANES, 0>(&fields, j, 0, &value, acc);
-            // Opaque to the optimiser, so that LLVM's loop vectoriser leaves this loop alone:
-            // on a long run (a padded patch) it vectorised across chunks, the lanes of each
-            // gathered from several chunks (so `map_chunks` lost 40 %; this loop too, measured
-            // on the shape tensor's sum).
+            // Opaque to the optimiser, as in `map_chunks`, where LLVM's loop vectoriser
+            // vectorised a long run's loop across chunks. Here it was not seen to: this barrier
+            // alone took the force chunk from 95 to 98 instructions and the shape tensor's from
+            // 48 to 52 (not measured again without it since the slices are `cut`).
             j = std::hint::black_box(j + LANES);
         }
         if j < n && n >= LANES {
