@@ -357,13 +357,23 @@ fn single_precision_storage_tracks_double_precision() {
 }
 
 /// The lattice fields are the step's own sums: `Σ_x Q = Σ_i S_i Σ_x φ_i`,
-/// `Σ_x v = Σ_i v_i Σ_x φ_i`, and the stress is `−P𝕀 − ζQ`, to round-off.
+/// `Σ_x v = Σ_i v_i Σ_x φ_i`, and the stress is `−P𝕀 − ζQ`, to round-off. The pressure the
+/// force pass reads, computed once per node after the scatter, is the pressure formula of the
+/// other sums at every node, bit for bit.
 #[test]
 fn lattice_fields_are_consistent_with_the_cells() {
+    use mechanics::equations::pressure as pressure_of;
     for pressure in PRESSURES {
         let (mut t, mut ws) = confluent(100, 5, 100, pressure);
         t.params_mut().zeta = 0.007;
         let f = t.fields(&mut ws);
+        let coef = t.params().energy.coefficients();
+        let [s1, s2, u] = [SumField::S1, SumField::S2, SumField::U].map(|s| ws.sum_field(s));
+        for k in 0..f.pressure.len() {
+            let p = pressure_of(pressure, &coef, s1[k], s2[k], u[k]);
+            assert_eq!(f.pressure[k].to_bits(), p.to_bits(), "node {k}");
+        }
+        assert!(f.pressure.iter().any(|&p| p != 0.0));
         let (mut qx, mut qy, mut vx, mut vy) = (0.0, 0.0, 0.0, 0.0);
         for i in 0..t.cells().n_cells() {
             let mass: f64 = t.cells().cell_phi(i).iter().sum();

@@ -4,7 +4,6 @@
 
 use phasefield::Real;
 
-use crate::equations::pressure;
 use crate::geometry::TracelessTensor;
 use crate::scatter::scatter;
 use crate::tissue::Tissue;
@@ -42,7 +41,7 @@ impl<T: Real> Tissue<T> {
             ..
         } = ws;
         let cs: &[_] = cell_state;
-        scatter::<2, T, _>(
+        scatter::<2, T, _, _>(
             &self.cells,
             self.cells.phi(),
             velocity_field,
@@ -50,32 +49,26 @@ impl<T: Real> Tissue<T> {
                 let [ux, uy] = [cs[i].velocity.x, cs[i].velocity.y];
                 run.add_to([], |s, []| [s.c * ux, s.c * uy], sums);
             },
+            |_| {},
         );
     }
 
     /// Evaluates the state and returns its lattice fields. Allocates the result; meant for
     /// output steps, not for the time step.
     ///
-    /// The pressure is [`crate::equations::pressure`] of the lattice sums, the formula the
-    /// force kernel uses.
+    /// The pressure is the one the force kernel reads ([`SumField::P`]):
+    /// [`crate::equations::pressure`] of the lattice sums.
     pub fn fields(&self, ws: &mut Workspace<T>) -> TissueFields {
         self.refresh(ws);
         self.scatter_velocity(ws);
         let zeta = self.params.zeta;
-        let coef = self.params.energy.coefficients();
         let [vx, vy] = ws.velocity_field();
-        let [s1, s2, u] = [SumField::S1, SumField::S2, SumField::U].map(|f| ws.sum_field(f));
         let mut f = TissueFields {
             vx,
             vy,
             qxx: ws.sum_field(SumField::Qxx),
             qxy: ws.sum_field(SumField::Qxy),
-            pressure: s1
-                .iter()
-                .zip(&s2)
-                .zip(&u)
-                .map(|((&s1, &s2), &u)| pressure(self.params.pressure, &coef, s1, s2, u))
-                .collect(),
+            pressure: ws.sum_field(SumField::P),
             ..Default::default()
         };
         let n = f.pressure.len();

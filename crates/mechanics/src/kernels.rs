@@ -2,7 +2,8 @@
 //! the named functions of [`crate::equations`]:
 //! 1. per cell, in parallel: area `A_i = Σ φ_i²`, range and deformation tensor `S_i`;
 //! 2. scatter onto the lattice, stripe-parallel in cell order: `s1, s2`, `U`, `Q_xx, Q_xy`
-//!    ([`crate::SumField`]);
+//!    ([`crate::SumField`]), then, stripe by stripe while it is in cache, the pressure `P` of
+//!    each lattice node from its sums;
 //! 3. per cell, in parallel: the force `F_i`, the velocity `v_i`, then `R_i` on the same patch
 //!    while it is in cache.
 //!
@@ -30,11 +31,13 @@ use crate::scatter::{scatter, LatticeSums};
 use crate::workspace::{CellState, SumField, N_SUMS};
 
 // Where each lattice sum is stored.
-const I_S1: usize = SumField::S1.index();
 const I_S2: usize = SumField::S2.index();
-const I_U: usize = SumField::U.index();
 const I_QXX: usize = SumField::Qxx.index();
 const I_QXY: usize = SumField::Qxy.index();
+const I_P: usize = SumField::P.index();
+
+/// The lattice sums the force pass reads, gathered beside each patch: `P`, `s2`, `Q_xx`, `Q_xy`.
+const N_GATHERED: usize = 4;
 
 thread_local! {
     /// Each thread's copy of the patch it works on, in the padded layout of [`PaddedPatch`]
@@ -43,7 +46,7 @@ thread_local! {
     /// a thread meets a larger patch, so a step allocates nothing. A cell's results depend
     /// only on its own values, never on what the scratch held before, so they do not depend
     /// on which thread computed them.
-    static PADDED: RefCell<PaddedPatch<N_SUMS>> = RefCell::new(PaddedPatch::new());
+    static PADDED: RefCell<PaddedPatch<N_GATHERED>> = RefCell::new(PaddedPatch::new());
 }
 
 /// Sizes the scratch of every thread of the current rayon pool (the global one outside a pool)
@@ -152,9 +155,11 @@ enum CellPost<'c, T> {
 /// 9 % of a passive step (960 cells, 1 thread: 16.2 → 14.7 ms). Observations always compute them.
 ///
 /// The pressure form is dispatched outside the loops, and the force loop has no branch on it:
-/// the interaction form of [`pressure`] is the paper form with `s2` in the place of `s1`, so
-/// the loop reads `s2` into that slot, and the self term is weighted 1 (paper) or 0
-/// (interaction); both identities are tested in `equations`. (A version monomorphised on the
+/// it reads the pressure `P` that the scatter computed per lattice node ([`SumField::P`]), and
+/// the self term is weighted 1 (paper) or 0 (interaction), an identity tested in `equations`.
+/// (Reading `P`, where each cell computed it again from `s1`, `s2` and `U`, gathers one field
+/// less and takes 9 instructions from the force chunk: 87.5 → 85.7 instructions per
+/// node-update, with the same results to the bit.) (A version monomorphised on the
 /// form was 9 % slower on the paper scene, 1 thread, measured alternately; so were some
 /// rearrangements of this function that only renamed or regrouped its locals: its speed
 /// depends on how LLVM inlines the closures, so time it after any change, with the whole-run
@@ -192,54 +197,63 @@ pub(crate) fn evaluate<T: Real>(
     let kind = params.pressure;
     {
         let cs: &[CellState] = cell_state;
-        scatter::<N_SUMS, T, _>(cells, phi, global, |i, run, sums| {
-            let c = &cs[i];
-            let area_factor = coef.area_factor(c.area);
-            let sh = c.shape.components();
-            let node = move |p: f64, u: f64| {
-                let [q_xx, q_xy] = nematic_density(p, sh);
-                [p, p * p, u, q_xx, q_xy]
-            };
-            match kind {
-                PressureKind::Paper => run.add_to(
-                    [],
-                    move |s, []| {
-                        let p = s.c;
-                        let u = pressure_cell_part(
-                            PressureKind::Paper,
-                            &coef,
-                            p,
-                            s.laplacian(),
-                            area_factor,
-                        );
-                        node(p, u)
-                    },
-                    sums,
-                ),
-                PressureKind::Interaction => run.add_to(
-                    [],
-                    move |s, []| {
-                        let p = s.c;
-                        node(
-                            p,
-                            pressure_cell_part(PressureKind::Interaction, &coef, p, 0.0, 0.0),
-                        )
-                    },
-                    sums,
-                ),
-            }
-        });
+        scatter::<N_SUMS, T, _, _>(
+            cells,
+            phi,
+            global,
+            |i, run, [s1, s2, u, qxx, qxy, _]| {
+                let sums = [s1, s2, u, qxx, qxy];
+                let c = &cs[i];
+                let area_factor = coef.area_factor(c.area);
+                let sh = c.shape.components();
+                let node = move |p: f64, u: f64| {
+                    let [q_xx, q_xy] = nematic_density(p, sh);
+                    [p, p * p, u, q_xx, q_xy]
+                };
+                match kind {
+                    PressureKind::Paper => run.add_to(
+                        [],
+                        move |s, []| {
+                            let p = s.c;
+                            let u = pressure_cell_part(
+                                PressureKind::Paper,
+                                &coef,
+                                p,
+                                s.laplacian(),
+                                area_factor,
+                            );
+                            node(p, u)
+                        },
+                        sums,
+                    ),
+                    PressureKind::Interaction => run.add_to(
+                        [],
+                        move |s, []| {
+                            let p = s.c;
+                            node(
+                                p,
+                                pressure_cell_part(PressureKind::Interaction, &coef, p, 0.0, 0.0),
+                            )
+                        },
+                        sums,
+                    ),
+                }
+            },
+            // The pressure, once per lattice node, where the force pass would compute it
+            // again for every cell over the node: the same formula on the same sums, so the
+            // same values to the bit.
+            |[s1, s2, u, _, _, p]| {
+                for (((p, &s1), &s2), &u) in p.iter_mut().zip(&*s1).zip(&*s2).zip(&*u) {
+                    *p = pressure(kind, &coef, s1, s2, u);
+                }
+            },
+        );
     }
 
     // 3. Forces, velocities and the right-hand side.
     let g: &LatticeSums<N_SUMS> = global;
     let map = cells.map();
     let xi = params.xi;
-    // The interaction form is the paper form with s2 in the place of s1 (see the doc above).
-    let first = match kind {
-        PressureKind::Paper => I_S1,
-        PressureKind::Interaction => I_S2,
-    };
     let c_self = pressure_self_coefficient(kind, &coef);
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
@@ -247,25 +261,24 @@ pub(crate) fn evaluate<T: Real>(
             padded.fill(cell, shape);
             padded.gather(xs, g.cell_runs(i), |x| {
                 let cols = g.columns(x);
-                [cols[first], cols[I_S2], cols[I_U], cols[I_QXX], cols[I_QXY]]
+                [cols[I_P], cols[I_S2], cols[I_QXX], cols[I_QXY]]
             });
             let PaddedParts {
                 run,
                 mask,
-                fields: [s_first, s2, u, qxx, qxy],
+                fields: [p_all, s2, qxx, qxy],
                 out: flat,
             } = padded.parts();
             let mut acc = [[0.0; LANES]; 2];
             // `move`: the coefficients are copied into the closure, so that they stay in
             // registers across the chunk loop's optimisation barrier (by reference, each chunk
             // loaded them again).
-            let value = move |s: Stencil, [w, s_first, s2, u, qxx, qxy]: [f64; 6]| {
-                let p = pressure(PressureKind::Paper, &coef, s_first, s2, u)
-                    - pressure_self_part_with(c_self, s.c);
+            let value = move |s: Stencil, [w, p_all, qxx, qxy]: [f64; 4]| {
+                let p = p_all - pressure_self_part_with(c_self, s.c);
                 let [fx, fy] = force_density(p, zeta, [qxx, qxy], [s.dx(), s.dy()]);
                 [w * fx, w * fy]
             };
-            run.sum_into([mask, s_first, s2, u, qxx, qxy], value, &mut acc);
+            run.sum_into([mask, p_all, qxx, qxy], value, &mut acc);
             let force = add_lanes(&acc);
             let v = velocity(force, xi);
             st.force = Vector2::from(force);

@@ -195,13 +195,21 @@ impl<const K: usize> LatticeSums<K> {
 /// `dst[c]` the slice of field `c` on the lattice rows of the run (`dst[c][j]` is the node
 /// of `run.c[j]`); it adds its values there. The stencil lets a value use derivatives of `φ_i`
 /// without a buffer of its own.
-pub fn scatter<const K: usize, T: Real, F>(
+///
+/// `finish(fields)` is then called once for each stripe that a patch overlaps, with
+/// `fields[c]` the stripe's part of field `c` (its lattice columns, one after the other), once
+/// every cell has added to it: it may compute fields that are functions of the sums node by
+/// node, while the stripe is in cache (the pressure, in [`crate::SumField::P`]). Stripes that no
+/// patch overlaps hold zeros in every field, so such a function must map zeros to zero.
+pub fn scatter<const K: usize, T: Real, F, G>(
     cells: &Cells<T>,
     phi: &[T],
     out: &mut LatticeSums<K>,
     add: F,
+    finish: G,
 ) where
     F: Fn(usize, &StencilRun<'_, T>, [&mut [f64]; K]) + Sync,
+    G: Fn([&mut [f64]; K]) + Sync,
 {
     let lattice: Lattice = cells.lattice();
     assert_eq!(out.lattice, lattice, "the sums belong to another lattice");
@@ -259,6 +267,9 @@ pub fn scatter<const K: usize, T: Real, F>(
                         add(i, &s, dst);
                     });
                 }
+            }
+            if !overlapping.is_empty() {
+                finish(fields);
             }
         });
 }

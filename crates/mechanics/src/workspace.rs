@@ -8,7 +8,7 @@ use crate::geometry::TracelessTensor;
 use crate::scatter::LatticeSums;
 
 /// Fields of the lattice-wide sums of one evaluation.
-pub(crate) const N_SUMS: usize = 5;
+pub(crate) const N_SUMS: usize = 6;
 
 /// A lattice-wide sum left in the [`Workspace`] by an evaluation (read it with
 /// [`Workspace::sum`] or [`Workspace::sum_field`]).
@@ -26,11 +26,16 @@ pub enum SumField {
     Qxx,
     /// `Q_xy = Σ_i φ_i S_i,xy`.
     Qxy,
+    /// The tissue pressure `P` ([`crate::equations::pressure`] of `s1`, `s2` and `U`),
+    /// computed once per lattice node after the sums, for the force pass to read (where every
+    /// cell over a node computed it again from the three sums).
+    P,
 }
 
 impl SumField {
     /// Every field, in storage order.
-    pub const ALL: [SumField; N_SUMS] = [Self::S1, Self::S2, Self::U, Self::Qxx, Self::Qxy];
+    pub const ALL: [SumField; N_SUMS] =
+        [Self::S1, Self::S2, Self::U, Self::Qxx, Self::Qxy, Self::P];
 
     /// Index in the storage of the sums.
     #[inline(always)]
@@ -41,6 +46,7 @@ impl SumField {
             Self::U => 2,
             Self::Qxx => 3,
             Self::Qxy => 4,
+            Self::P => 5,
         }
     }
 }
