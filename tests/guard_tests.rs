@@ -331,3 +331,36 @@ fn fuzzed_scenes_end_in_a_clean_error_or_a_valid_run() {
         "{t:?}: the corpus must reach both outcomes"
     );
 }
+
+/// `Workspace::heap_bytes` counts the patch scratch of every thread of the pool: one cell on
+/// a full 64² domain, where the scratch (about 56 bytes per patch node per thread) is more
+/// than the lattice sums and the stage buffers together, so that leaving it out would fail.
+/// In a pool of 3 threads, whatever the machine.
+#[test]
+fn the_workspace_counts_every_threads_patch_scratch() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap();
+    pool.install(workspace_counts_every_threads_patch_scratch);
+}
+
+fn workspace_counts_every_threads_patch_scratch() {
+    let s = scene(
+        "[domain]\nlx = 64\nly = 64\n[cells]\ncount = 1\nradius = 8.0\n[run]\ntime = 1\n",
+        &["integrator.margin=0", "integrator.precision=\"f32\""],
+    );
+    let t = s.tissue::<f32>().expect("one disc builds");
+    let ws = Workspace::new(t.cells());
+    let shape = t.cells().shape();
+    let scratch = 3 * mechanics::thread_scratch_bytes(shape);
+    let sums = 8 * 8 * t.lattice().len();
+    let stages = 3 * 4 * shape.len();
+    assert!(scratch > sums + stages, "the test must not be vacuous");
+    assert!(
+        ws.heap_bytes() >= scratch + sums + stages,
+        "{} bytes counted, below the {scratch} of the scratch and {} of the sums and stages",
+        ws.heap_bytes(),
+        sums + stages
+    );
+}

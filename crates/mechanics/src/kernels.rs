@@ -56,6 +56,20 @@ pub(crate) fn prepare_scratch(shape: &PatchShape) {
     rayon::broadcast(|_| PADDED.with_borrow_mut(|padded| padded.prepare(shape)));
 }
 
+/// Bytes of heap memory held by the scratch of the threads of the current rayon pool (the
+/// global one outside a pool).
+pub(crate) fn scratch_bytes() -> usize {
+    rayon::broadcast(|_| PADDED.with_borrow(|padded| padded.heap_bytes()))
+        .into_iter()
+        .sum()
+}
+
+/// The bytes of one thread's scratch for patches of this shape (what [`scratch_bytes`] counts
+/// per thread of a pool that has met no larger patch).
+pub fn thread_scratch_bytes(shape: &PatchShape) -> usize {
+    PaddedPatch::<N_GATHERED>::bytes_for(shape)
+}
+
 /// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]
 fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mut CellState) {

@@ -69,6 +69,7 @@ mod workspace;
 pub use adaptive::{AdaptiveParams, Controller};
 pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
+pub use kernels::thread_scratch_bytes;
 pub use nalgebra::Vector2;
 pub use observables::Observables;
 pub use params::{ModelParams, Precision, PressureKind, StepParams, ACTIVITY_DT};

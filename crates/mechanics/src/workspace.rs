@@ -91,7 +91,9 @@ pub struct Workspace<T: Real = f64> {
 }
 
 impl<T: Real> Workspace<T> {
-    /// Bytes of heap memory held by the scratch buffers, lattice sums and tables.
+    /// Bytes of heap memory held by the scratch buffers, lattice sums and tables, and by the
+    /// patch scratch of every thread of the current rayon pool (the global one outside a pool;
+    /// [`crate::thread_scratch_bytes`] per thread).
     pub fn heap_bytes(&self) -> usize {
         (self.phi_old.capacity() + self.k1.capacity() + self.k2.capacity())
             * std::mem::size_of::<T>()
@@ -101,6 +103,7 @@ impl<T: Real> Workspace<T> {
             + (self.observed_centre.capacity() + self.next_centre.capacity())
                 * std::mem::size_of::<[f64; 2]>()
             + self.com.heap_bytes()
+            + crate::kernels::scratch_bytes()
     }
 
     /// Scratch memory for a tissue of this size.

@@ -72,6 +72,20 @@ impl<const M: usize> PaddedPatch<M> {
         }
     }
 
+    /// Bytes of heap memory held by the buffers.
+    pub fn heap_bytes(&self) -> usize {
+        (self.phi.capacity() + self.mask.capacity() + self.fields.capacity() + self.out.capacity())
+            * std::mem::size_of::<f64>()
+    }
+
+    /// The bytes [`PaddedPatch::heap_bytes`] reports once the scratch is prepared for `shape`
+    /// and nothing larger: `8 ((nx + 2)(ny + 2) + (M + 2) n)`, `n` the run's length.
+    pub fn bytes_for(shape: &PatchShape) -> usize {
+        let p = shape.ny + 2;
+        let n = (shape.nx - 1) * p + shape.ny;
+        ((shape.nx + 2) * p + (M + 2) * n) * std::mem::size_of::<f64>()
+    }
+
     /// True before the first [`PaddedPatch::fill`].
     pub fn is_empty(&self) -> bool {
         self.len() == 0
@@ -87,14 +101,19 @@ impl<const M: usize> PaddedPatch<M> {
         self.nx = shape.nx;
         self.ny = shape.ny;
         let (n, p) = (self.len(), self.stride());
-        self.phi.clear();
+        // `reserve_exact`, so that a scratch holds what `bytes_for` says.
+        let exact = |v: &mut Vec<f64>, len: usize| {
+            v.clear();
+            v.reserve_exact(len);
+        };
+        exact(&mut self.phi, (shape.nx + 2) * p);
         self.phi.resize((shape.nx + 2) * p, 0.0);
-        self.mask.clear();
+        exact(&mut self.mask, n);
         self.mask
             .extend((0..n).map(|k| if k % p < shape.ny { 1.0 } else { 0.0 }));
-        self.fields.clear();
+        exact(&mut self.fields, M * n);
         self.fields.resize(M * n, 0.0);
-        self.out.clear();
+        exact(&mut self.out, n);
         self.out.resize(n, 0.0);
     }
 
@@ -240,6 +259,21 @@ mod tests {
     use proptest::prelude::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// A scratch prepared for a shape holds what `bytes_for` says, and a smaller shape
+    /// afterwards allocates nothing more.
+    #[test]
+    fn a_prepared_scratch_holds_what_bytes_for_says() {
+        for (nx, ny) in [(1, 1), (25, 25), (33, 33), (7, 19)] {
+            let shape = PatchShape::new(Lattice::new(nx, ny), 0).unwrap();
+            let mut padded = PaddedPatch::<4>::new();
+            padded.prepare(&shape);
+            assert_eq!(padded.heap_bytes(), PaddedPatch::<4>::bytes_for(&shape));
+            let small = PatchShape::new(Lattice::new(1, 1), 0).unwrap();
+            padded.prepare(&small);
+            assert_eq!(padded.heap_bytes(), PaddedPatch::<4>::bytes_for(&shape));
+        }
+    }
 
     proptest! {
         #![proptest_config(ProptestConfig {

@@ -121,15 +121,19 @@ impl Scene {
 
     /// An estimate of the memory a run of this scene needs at its peak, in bytes, computed
     /// from the scene alone (nothing is allocated): with `N` cells of `p` patch nodes, `b`
-    /// bytes per stored value (4 in f32, 8 in f64) and `L` lattice nodes,
+    /// bytes per stored value (4 in f32, 8 in f64), `L` lattice nodes and `t` the threads this
+    /// machine can run at once,
     ///
-    /// `N p (4b + 16) + 64 L + 1024 N + 16 MiB`:
+    /// `N p (4b + 16) + 64 L + 1024 N + t s + 16 MiB`:
     ///
     /// the fields and the three stage buffers of the step (`4b` per patch node), the f64 discs
-    /// of the initial state or the f64 copy a frame is written from (`16`), the seven f64
-    /// lattice sums of the step and the flow (`64` per node, with their stripe index), the
-    /// per-cell state, and the program itself. It bounds `Tissue::heap_bytes` +
-    /// `Workspace::heap_bytes` from above (tested), so a scene it refuses could not have run.
+    /// of the initial state or the f64 copy a frame is written from (`16`), the eight f64
+    /// lattice fields of the step (five sums and the pressure) and of the flow (`64` per node;
+    /// their stripe index is a few bytes per stripe), the
+    /// per-cell state, each thread's copy of the patch it works on (`s`, about `56 p`:
+    /// [`mechanics::thread_scratch_bytes`]), and the program itself. It bounds
+    /// `Tissue::heap_bytes` + `Workspace::heap_bytes` from above (tested), so a scene it refuses
+    /// could not have run.
     pub fn memory_estimate(&self) -> f64 {
         let n = self.file.cells.count as f64;
         let shape = self.patch_shape();
@@ -139,7 +143,9 @@ impl Scene {
             Precision::F64 => 8.0,
         };
         let l = self.lattice().len() as f64;
-        n * p * (4.0 * b + 16.0) + 64.0 * l + 1024.0 * n + 16.0 * 1024.0 * 1024.0
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get()) as f64;
+        let scratch = threads * mechanics::thread_scratch_bytes(&shape) as f64;
+        n * p * (4.0 * b + 16.0) + 64.0 * l + 1024.0 * n + scratch + 16.0 * 1024.0 * 1024.0
     }
 
     /// The storage precision of the fields.
