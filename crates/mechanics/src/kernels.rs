@@ -41,11 +41,11 @@ const N_GATHERED: usize = 4;
 
 thread_local! {
     /// Each thread's copy of the patch it works on, in the padded layout of [`PaddedPatch`]
-    /// (one run per patch), with the five lattice sums gathered beside it: sized for every
-    /// thread of the pool when a workspace is made ([`prepare_scratch`]), and grown only when
-    /// a thread meets a larger patch, so a step allocates nothing. A cell's results depend
-    /// only on its own values, never on what the scratch held before, so they do not depend
-    /// on which thread computed them.
+    /// (one run per patch), with the four lattice fields the force pass reads gathered beside
+    /// it (`P`, `s2`, `Q_xx`, `Q_xy`): sized for every thread of the pool when a workspace is
+    /// made ([`prepare_scratch`]), and grown only when a thread meets a larger patch, so a step
+    /// allocates nothing. A cell's results depend only on its own values, never on what the
+    /// scratch held before, so they do not depend on which thread computed them.
     static PADDED: RefCell<PaddedPatch<N_GATHERED>> = RefCell::new(PaddedPatch::new());
 }
 
