@@ -64,8 +64,9 @@ pub(crate) fn scratch_bytes() -> usize {
         .sum()
 }
 
-/// The bytes of one thread's scratch for patches of this shape (what [`scratch_bytes`] counts
-/// per thread of a pool that has met no larger patch).
+/// The bytes of one thread's scratch for patches of this shape: what
+/// [`crate::Workspace::heap_bytes`] counts for each thread of a pool that has met no larger
+/// patch.
 pub fn thread_scratch_bytes(shape: &PatchShape) -> usize {
     PaddedPatch::<N_GATHERED>::bytes_for(shape)
 }
