@@ -12,7 +12,8 @@
 //! The per-cell passes (1 and 3) sweep each patch as one run of a padded copy
 //! (`phasefield::kernel::PaddedPatch`, each thread's own), with the lattice sums they read
 //! gathered beside it; the scatter (2) writes lattice columns, so it goes column by column.
-//! This is machinery: nothing here is public.
+//! This is machinery: nothing here is public but [`thread_scratch_bytes`], the size of each
+//! thread's scratch, for memory estimates.
 
 use std::cell::RefCell;
 
