@@ -65,11 +65,7 @@ impl<const M: usize> PaddedPatch<M> {
     /// Positions in the run: from node `(0, 0)` to node `(nx − 1, ny − 1)`.
     #[inline(always)]
     pub fn len(&self) -> usize {
-        if self.nx == 0 {
-            0
-        } else {
-            (self.nx - 1) * self.stride() + self.ny
-        }
+        lengths(self.nx, self.ny).1
     }
 
     /// Bytes of heap memory held by the buffers.
@@ -81,9 +77,8 @@ impl<const M: usize> PaddedPatch<M> {
     /// The bytes [`PaddedPatch::heap_bytes`] reports once the scratch is prepared for `shape`
     /// and nothing larger: `8 ((nx + 2)(ny + 2) + (M + 2) n)`, `n` the run's length.
     pub fn bytes_for(shape: &PatchShape) -> usize {
-        let p = shape.ny + 2;
-        let n = (shape.nx - 1) * p + shape.ny;
-        ((shape.nx + 2) * p + (M + 2) * n) * std::mem::size_of::<f64>()
+        let (padded, n) = lengths(shape.nx, shape.ny);
+        (padded + (M + 2) * n) * std::mem::size_of::<f64>()
     }
 
     /// True before the first [`PaddedPatch::fill`].
@@ -100,14 +95,14 @@ impl<const M: usize> PaddedPatch<M> {
         }
         self.nx = shape.nx;
         self.ny = shape.ny;
-        let (n, p) = (self.len(), self.stride());
+        let ((padded, n), p) = (lengths(shape.nx, shape.ny), self.stride());
         // `reserve_exact`, so that a scratch holds what `bytes_for` says.
         let exact = |v: &mut Vec<f64>, len: usize| {
             v.clear();
             v.reserve_exact(len);
         };
-        exact(&mut self.phi, (shape.nx + 2) * p);
-        self.phi.resize((shape.nx + 2) * p, 0.0);
+        exact(&mut self.phi, padded);
+        self.phi.resize(padded, 0.0);
         exact(&mut self.mask, n);
         self.mask
             .extend((0..n).map(|k| if k % p < shape.ny { 1.0 } else { 0.0 }));
@@ -248,6 +243,15 @@ fn copy_runs<const M: usize>(dst: [&mut [f64]; M], src: [&[f64]; M]) {
         // otherwise see the loop as M copies and call `memcpy` for each.
         j = std::hint::black_box((j + W).min(n - W));
     }
+}
+
+/// The lengths of a padded patch of `nx × ny` nodes: its values with the ghost rows and
+/// columns, `(nx + 2)(ny + 2)`, and its run, `(nx − 1)(ny + 2) + ny` (0 for no patch).
+#[inline(always)]
+fn lengths(nx: usize, ny: usize) -> (usize, usize) {
+    let p = ny + 2;
+    let run = if nx == 0 { 0 } else { (nx - 1) * p + ny };
+    ((nx + 2) * p, run)
 }
 
 #[cfg(test)]
