@@ -138,9 +138,14 @@ pub fn velocity(force: [f64; 2], xi: f64) -> [f64; 2] {
 /// The right-hand side of the dynamics at a node (MODEL.md §4):
 /// `R_i = ∂_t φ_i = −v_i·∂φ_i − δF/δφ_i`, advection by the cell's velocity plus the
 /// relaxation of the free energy.
+///
+/// Written `−v_x ∂_xφ − v_y ∂_yφ − δF/δφ`, which rounds exactly as `−(v·∂φ) − δF/δφ` (negation
+/// is exact): in that form LLVM's SLP vectoriser paired `v_x ∂_xφ` with `v_y ∂_yφ` across the
+/// lanes of a chunk, with 8 blends and spills, 99 instructions per chunk of 8 nodes against 86
+/// in this one (x86-64-v3).
 #[inline(always)]
 pub fn rhs(velocity: [f64; 2], grad: [f64; 2], dfdphi: f64) -> f64 {
-    -(velocity[0] * grad[0] + velocity[1] * grad[1]) - dfdphi
+    -velocity[0] * grad[0] - velocity[1] * grad[1] - dfdphi
 }
 
 /// The Heun predictor (a forward-Euler step): `φ* = φⁿ + Δt R(φⁿ)` (MODEL.md §4).
