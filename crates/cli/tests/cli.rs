@@ -4,8 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-mod common;
-use common::run_files;
+use crate::common::run_files;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_monolayer"))

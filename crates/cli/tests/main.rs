@@ -1,0 +1,7 @@
+//! The `monolayer` binary end to end: one test executable (one link), a module per topic.
+
+mod adaptive;
+mod cli;
+mod common;
+mod from_state;
+mod view;

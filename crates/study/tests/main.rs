@@ -1,0 +1,4 @@
+//! Sweeps and damaged frames end to end: one test executable, a module per topic.
+
+mod damaged_frames;
+mod sweep;
