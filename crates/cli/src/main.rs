@@ -97,9 +97,9 @@ enum Command {
         /// the defect density and the creation rate to the summary.
         #[arg(long)]
         analyze: bool,
-        /// With `--analyze`: the first time analysed (default: the end of relaxation).
-        #[arg(long, requires = "analyze")]
-        from: Option<f64>,
+        /// With `--analyze`: the options of `monolayer analyze`.
+        #[command(flatten)]
+        analysis: AnalysisArgs,
         /// Refuse a local sweep whose largest point, times --jobs, has a memory estimate above
         /// this, e.g. `8G` (default: the memory available on this machine).
         #[arg(long, value_name = "BYTES")]
@@ -196,28 +196,58 @@ enum Command {
     Analyze {
         /// A directory written by `monolayer run`.
         run_dir: PathBuf,
-        /// First time analysed (default: the end of relaxation).
-        #[arg(long)]
-        from: Option<f64>,
-        /// Side of the smoothing box, odd (default: the odd side nearest 3R).
-        #[arg(long = "box")]
-        box_side: Option<usize>,
-        /// Side of the defect-centred crops, odd.
-        #[arg(long, default_value_t = 101)]
-        crop: usize,
-        /// Longest link of a defect between frames (default: R).
-        #[arg(long)]
-        max_link: Option<f64>,
-        /// Largest separation of a created or annihilated pair (default: 2R).
-        #[arg(long)]
-        max_pair: Option<f64>,
-        /// S_rms of a zeta = 0 run, to report S_rms relative to it.
-        #[arg(long)]
-        s_rms_baseline: Option<f64>,
+        #[command(flatten)]
+        analysis: AnalysisArgs,
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
     },
+}
+
+/// The options of `monolayer analyze` (also those of `sweep --analyze`).
+#[derive(clap::Args)]
+struct AnalysisArgs {
+    /// First time analysed (default: the end of relaxation).
+    #[arg(long)]
+    from: Option<f64>,
+    /// Side of the smoothing box, odd (default: the odd side nearest 3R).
+    #[arg(long = "box")]
+    box_side: Option<usize>,
+    /// Side of the defect-centred crops, odd (default: 101, or twice the lattice's shorter
+    /// side plus one when that is smaller).
+    #[arg(long)]
+    crop: Option<usize>,
+    /// Longest link of a defect between frames (default: R).
+    #[arg(long)]
+    max_link: Option<f64>,
+    /// Largest separation of a created or annihilated pair (default: 2R).
+    #[arg(long)]
+    max_pair: Option<f64>,
+    /// S_rms of a zeta = 0 run, to report S_rms relative to it.
+    #[arg(long)]
+    s_rms_baseline: Option<f64>,
+}
+
+impl AnalysisArgs {
+    fn options(&self) -> AnalyzeOptions {
+        AnalyzeOptions {
+            from: self.from,
+            box_side: self.box_side,
+            crop_side: self.crop,
+            max_link: self.max_link,
+            max_pair: self.max_pair,
+            s_rms_baseline: self.s_rms_baseline,
+        }
+    }
+
+    fn given(&self) -> bool {
+        self.from.is_some()
+            || self.box_side.is_some()
+            || self.crop.is_some()
+            || self.max_link.is_some()
+            || self.max_pair.is_some()
+            || self.s_rms_baseline.is_some()
+    }
 }
 
 #[derive(Subcommand)]
@@ -245,15 +275,54 @@ enum ExportFormat {
 
 fn main() -> ExitCode {
     match real_main() {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            // A sweep (or a figure's sweeps) stopped by a signal: resumable, not failed.
+            let stopped = e.chain().find_map(|c| match c.downcast_ref() {
+                Some(study::SweepError::Interrupted { signal, .. }) => Some(*signal),
+                _ => None,
+            });
+            match stopped {
+                Some(signal) => {
+                    eprintln!("{e:#}");
+                    ExitCode::from((128 + signal).clamp(0, 255) as u8)
+                }
+                None => {
+                    eprintln!("error: {e:#}");
+                    ExitCode::FAILURE
+                }
+            }
         }
     }
 }
 
-fn real_main() -> Result<()> {
+/// What `run` prints at its end, and its exit status: 0, or 128 + the signal that stopped it.
+fn finished(info: &run::RunInfo, dir: &std::path::Path, quiet: bool) -> ExitCode {
+    if let Some((step, time, signal)) = info.stopped {
+        // Printed even with --quiet: the run did not do what was asked.
+        eprintln!(
+            "stopped at step {step} (t = {time}): resume with monolayer run --resume {}",
+            dir.display()
+        );
+        return ExitCode::from((128 + signal).clamp(0, 255) as u8);
+    }
+    if !quiet {
+        let resumed = info
+            .resumed_from
+            .map(|s| format!("resumed at step {s}, "))
+            .unwrap_or_default();
+        eprintln!(
+            "done: {resumed}{} steps in {:.2} s, {} frames in {}",
+            info.steps,
+            info.wall_s,
+            info.frames,
+            dir.display()
+        );
+    }
+    ExitCode::SUCCESS
+}
+
+fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run {
@@ -268,17 +337,8 @@ fn real_main() -> Result<()> {
         } => {
             if let Some(dir) = resume {
                 let pool = pool(threads)?;
-                let (from, info) = pool.install(|| run::resume(&dir, &set, quiet))?;
-                if !quiet {
-                    eprintln!(
-                        "done: resumed at step {from}, {} steps in {:.2} s, {} frames in {}",
-                        info.steps,
-                        info.wall_s,
-                        info.frames,
-                        dir.display()
-                    );
-                }
-                return Ok(());
+                let info = pool.install(|| run::resume(&dir, &set, quiet))?;
+                return Ok(finished(&info, &dir, quiet));
             }
             let (Some(scene), Some(out)) = (scene, out) else {
                 anyhow::bail!("give a scene and --out DIR, or --resume DIR");
@@ -293,19 +353,9 @@ fn real_main() -> Result<()> {
             // Read before --out is prepared: --overwrite may remove the frame it names.
             let state = rundir::initial_state(&parsed)
                 .with_context(|| format!("in scene {}", scene.display()))?;
-            rundir::prepare(&out, overwrite)?;
             let pool = pool(threads)?;
-            let info = pool.install(|| run::run(&parsed, state.as_ref(), &out, quiet))?;
-            if !quiet {
-                eprintln!(
-                    "done: {} steps in {:.2} s, {} frames in {}",
-                    info.steps,
-                    info.wall_s,
-                    info.frames,
-                    out.display()
-                );
-            }
-            Ok(())
+            let info = pool.install(|| run::run(&parsed, state, &out, overwrite, quiet))?;
+            Ok(finished(&info, &out, quiet))
         }
         Command::Sweep {
             scene,
@@ -320,9 +370,13 @@ fn real_main() -> Result<()> {
             collect,
             threads,
             analyze,
-            from,
+            analysis,
             max_memory,
         } => {
+            anyhow::ensure!(
+                analyze || !analysis.given(),
+                "--from, --box, --crop, --max-link, --max-pair and --s-rms-baseline are options of the analysis: add --analyze"
+            );
             anyhow::ensure!(
                 !(analyze && backend == "slurm" && !collect),
                 "--analyze runs after the runs: give it with --collect once the SLURM tasks are done"
@@ -356,10 +410,7 @@ fn real_main() -> Result<()> {
                 quiet,
                 action,
                 max_memory: max_memory.as_deref(),
-                analyze: analyze.then(|| AnalyzeOptions {
-                    from,
-                    ..AnalyzeOptions::default()
-                }),
+                analyze: analyze.then(|| analysis.options()),
             };
             match monolayer_cli::sweep::sweep(&args)? {
                 SweepOutcome::Ran(info, n) if !quiet => eprintln!(
@@ -387,7 +438,7 @@ fn real_main() -> Result<()> {
                 }
                 _ => {}
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Reproduce {
             figure,
@@ -406,7 +457,7 @@ fn real_main() -> Result<()> {
                 (cores / jobs).max(1),
                 quiet,
             )?;
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Threshold { dir, key } => {
             let path = dir.join("summary.csv");
@@ -423,7 +474,7 @@ fn real_main() -> Result<()> {
                 .with_context(|| format!("cannot write {}", out.display()))?;
             print!("{table}");
             eprintln!("written to {}", out.display());
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Render {
             run_dir,
@@ -481,7 +532,7 @@ fn real_main() -> Result<()> {
                     None => eprintln!("drew {} frames into {}", info.frames, out.display()),
                 }
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Export {
             format:
@@ -506,26 +557,14 @@ fn real_main() -> Result<()> {
                     out.join("fields.pvd").display()
                 );
             }
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Analyze {
             run_dir,
-            from,
-            box_side,
-            crop,
-            max_link,
-            max_pair,
-            s_rms_baseline,
+            analysis,
             threads,
         } => {
-            let opts = AnalyzeOptions {
-                from,
-                box_side,
-                crop_side: crop,
-                max_link,
-                max_pair,
-                s_rms_baseline,
-            };
+            let opts = analysis.options();
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
             note_skipped(&info.notes, &run_dir);
             eprintln!(
@@ -535,7 +574,7 @@ fn real_main() -> Result<()> {
                 info.events,
                 run_dir.join("analysis").display()
             );
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
     }
 }

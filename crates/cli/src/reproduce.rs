@@ -107,7 +107,8 @@ pub fn run(
         scale,
         SweepParams::new(jobs, threads),
         reporter.clone(),
-    );
+    )
+    .with_interrupt(rundir::Interrupt::install()?);
     let mut reports = Vec::new();
     for f in figures {
         let report = reproduce(f, &params)?;

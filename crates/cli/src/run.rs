@@ -1,5 +1,5 @@
-//! `monolayer run`: builds the scene's [`mechanics::Simulation`], adds the run directory's
-//! writers (`rundir::add_writers`) and a progress report, and runs it.
+//! `monolayer run`: the run directory ([`rundir::RunDir`]: lock, writers, checkpoints,
+//! signals) with a progress report added, run to its end or to a signal.
 
 use std::io::IsTerminal;
 use std::path::Path;
@@ -8,11 +8,10 @@ use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mechanics::{Callback, CallbackError, Observation, Precision};
 use phasefield::{Cells, Real};
+use rundir::{FinalToo, Interrupt, Outcome, RunDir, RunError};
 use scene::Scene;
 
-use rundir::FinalToo;
-
-/// What a finished run reports.
+/// What a run reports: finished, or stopped by a signal.
 #[derive(Debug, Clone, Copy)]
 pub struct RunInfo {
     /// Steps taken.
@@ -21,27 +20,30 @@ pub struct RunInfo {
     pub wall_s: f64,
     /// Frames written.
     pub frames: usize,
+    /// The step a resumed run continued from.
+    pub resumed_from: Option<u64>,
+    /// `Some((step, time, signal))` when a signal stopped the run (it is resumable).
+    pub stopped: Option<(u64, f64, i32)>,
 }
 
-/// Runs a valid scene, writing into `out`, from `state` when the scene starts from a saved
-/// one (`rundir::initial_state`, read before `out` is prepared). On a step error the output
-/// written so far is kept and the error is returned.
+/// Runs a valid scene, writing into `out` (prepared by [`RunDir::create`]), from `state` when
+/// the scene starts from a saved one (`rundir::initial_state`, read before `out` is
+/// prepared). On a step error the output written so far is kept and the error is returned.
 ///
 /// # Errors
-/// When the directory cannot be written or the run stops early.
-pub fn run(scene: &Scene, state: Option<&Cells<f64>>, out: &Path, quiet: bool) -> Result<RunInfo> {
-    rundir::write_scene(out, scene)?;
+/// When the directory is held by another process, cannot be written, or the run stops early.
+pub fn run(
+    scene: &Scene,
+    state: Option<Cells<f64>>,
+    out: &Path,
+    overwrite: bool,
+    quiet: bool,
+) -> Result<RunInfo> {
+    let dir = RunDir::create(out, scene.clone(), state, overwrite, Interrupt::install()?)?;
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
-    let from = match state {
-        Some(s) => Start::State(s),
-        None => Start::Scene,
-    };
-    match scene.precision() {
-        Precision::F64 => run_in::<f64>(scene, out, quiet, from),
-        Precision::F32 => run_in::<f32>(scene, out, quiet, from),
-    }
+    drive(&dir, quiet)
 }
 
 /// `[cells] from` made absolute, as an override appended to `set`: a relative path given with
@@ -81,124 +83,61 @@ pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Ve
     Ok(set)
 }
 
-/// Where a run's state comes from.
-#[derive(Clone, Copy)]
-enum Start<'a> {
-    /// The scene's initial discs.
-    Scene,
-    /// A saved state (`init = "frame"`).
-    State(&'a Cells<f64>),
-    /// A checkpoint of this run (`--resume`).
-    Checkpoint(&'a Path),
-}
-
 /// Continues the run in `dir` from its latest readable checkpoint to the end of its scene,
 /// with `set` overrides of `run.time` (to extend a finished run). Rows and frames at or
 /// after the checkpoint are written again, so the directory ends as one uninterrupted run
-/// would have left it. Returns the step it resumed from and what the run did.
+/// would have left it.
 ///
 /// # Errors
-/// No usable checkpoint, an override other than `run.time`, a run already at its end, or
-/// what [`run`] can fail with.
-pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<(u64, RunInfo)> {
-    for s in set {
-        let key = s.split('=').next().unwrap_or("");
-        anyhow::ensure!(
-            key.trim() == "run.time",
-            "--resume continues the run as it was: only --set run.time=T (to extend it) can change; {key} would make it another run (start a new scene instead)"
-        );
-    }
-    let all = rundir::checkpoint::checkpoints(dir);
-    anyhow::ensure!(
-        !all.is_empty(),
-        "{} has no checkpoints/ to resume from (runs write them every [run] checkpoint_every; this one was killed before the first, or was not run by monolayer run)",
-        dir.display()
-    );
-    let mut last_err = None;
-    for (step, path) in all.iter().rev() {
-        let attempt = || -> Result<(Scene, u64)> {
-            let text = rundir::checkpoint::checkpoint_scene(path)?;
-            let scene = Scene::parse(&text, set)
-                .with_context(|| format!("the scene in {}", path.display()))?;
-            Ok((scene, *step))
-        };
-        match attempt() {
-            Ok((scene, step)) => {
-                let time = rundir::read_npz(path, &["time"])?[0]
-                    .scalar()
-                    .unwrap_or(f64::NAN);
-                let total = scene.step_counts().total_steps();
-                let (complete, at) = match scene.adaptive() {
-                    Some(_) => (
-                        time >= scene.end_time() * (1.0 - 1e-12),
-                        format!("t = {time} of {}", scene.end_time()),
-                    ),
-                    None => (step >= total, format!("step {step} of {total}")),
-                };
-                anyhow::ensure!(
-                    !complete,
-                    "the run in {} is complete ({at}); extend it with --set run.time=T, T above {}",
-                    dir.display(),
-                    scene.file().run.time
-                );
-                rundir::write_scene(dir, &scene)?;
-                let from = Start::Checkpoint(path);
-                let info = match scene.precision() {
-                    Precision::F64 => run_in::<f64>(&scene, dir, quiet, from),
-                    Precision::F32 => run_in::<f32>(&scene, dir, quiet, from),
-                }?;
-                return Ok((step, info));
-            }
-            Err(e) => {
-                if !quiet {
-                    eprintln!("note: skipping {}: {e:#}", path.display());
-                }
-                last_err = Some(e);
-            }
+/// No usable checkpoint, a checkpoint of another run, an override other than `run.time`, a
+/// run already at its end, or what [`run`] can fail with.
+pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<RunInfo> {
+    let run = RunDir::resume(dir, set, Interrupt::install()?)?;
+    if !quiet {
+        for s in run.skipped() {
+            eprintln!("note: skipping {s}");
         }
     }
-    Err(last_err.expect("at least one checkpoint was tried"))
+    drive(&run, quiet)
 }
 
-fn run_in<T: Real>(scene: &Scene, out: &Path, quiet: bool, from: Start<'_>) -> Result<RunInfo> {
-    let schedules = scene.output_schedules();
-    let (mut sim, written) = match from {
-        Start::Scene | Start::State(_) => {
-            let tissue = match from {
-                Start::State(state) => scene.tissue_from_state::<T>(state)?,
-                _ => scene.tissue::<T>()?,
-            };
-            let mut sim = scene.simulation_from(tissue);
-            let w = rundir::add_writers(&mut sim, out, &schedules)?;
-            (sim, w)
-        }
-        Start::Checkpoint(path) => {
-            let tissue = rundir::checkpoint::read_checkpoint::<T>(path, scene)?;
-            let step = tissue.iteration();
-            let mut sim = scene.simulation_from(tissue);
-            if let Some(c) = rundir::checkpoint::read_controller(path)? {
-                sim.set_controller(c);
-            }
-            let w = rundir::add_writers_resumed(&mut sim, out, &schedules, step)?;
-            (sim, w)
-        }
-    };
-    rundir::add_checkpoints(&mut sim, out, schedules.checkpoints, &scene.to_toml());
+fn drive(dir: &RunDir, quiet: bool) -> Result<RunInfo> {
+    match dir.scene().precision() {
+        Precision::F64 => drive_in::<f64>(dir, quiet),
+        Precision::F32 => drive_in::<f32>(dir, quiet),
+    }
+}
+
+fn drive_in<T: Real>(dir: &RunDir, quiet: bool) -> Result<RunInfo> {
+    let (mut sim, written) = dir.simulation::<T>()?;
+    let scene = dir.scene();
     sim.add_output_writer(
         "progress",
-        schedules.series,
+        scene.output_schedules().series,
         FinalToo::new(Progress::new(scene.end_time(), quiet)),
     );
-    let result = sim.run();
-    let info = result.map_err(|e| {
-        let kept = stopped(out, sim.tissue().iteration(), &e);
+    let outcome = dir.run(&mut sim).map_err(|e| {
+        let kept = match &e {
+            RunError::Simulation(s) => stopped(dir.dir(), sim.tissue().iteration(), s),
+            _ => String::new(),
+        };
         anyhow::Error::new(e).context(kept)
     })?;
-    rundir::mark_complete(out, scene)?;
+    let (info, stopped) = match outcome {
+        Outcome::Complete(info) => (info, None),
+        Outcome::Stopped {
+            step,
+            time,
+            signal,
+            info,
+        } => (info, Some((step, time, signal))),
+    };
     Ok(RunInfo {
         steps: info.iterations,
         wall_s: info.wall_time.as_secs_f64(),
         frames: written.frames(),
+        resumed_from: dir.resumed_from(),
+        stopped,
     })
 }
 

@@ -176,7 +176,8 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
         }
     });
     let params = SweepParams::new(a.jobs, a.threads);
-    let info = run_points(&points, a.out, params, progress)?;
+    let interrupt = rundir::Interrupt::install()?;
+    let info = run_points(&points, a.out, params, progress, &interrupt)?;
     if let Some(b) = bar {
         b.finish();
     }

@@ -1221,7 +1221,7 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
     refuse(
         &full,
         &[],
-        "is complete (step 1600 of 1600); extend it with --set run.time=T",
+        "is complete (step 1600 of 1600); extend it with --resume",
     );
     refuse(
         &full,

@@ -4,4 +4,5 @@ mod adaptive;
 mod cli;
 mod common;
 mod from_state;
+mod signals;
 mod view;

@@ -18,6 +18,7 @@
 
 pub mod checkpoint;
 mod frame;
+pub mod run;
 mod series;
 mod sidecar;
 pub mod state;
@@ -29,10 +30,13 @@ use std::path::{Path, PathBuf};
 pub use frame::{
     last_frame, npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ,
 };
+pub use run::{lock_dir, DirLock, Interrupt, Outcome, RunDir, RunError, LOCK};
 pub use series::{SeriesWriter, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
 pub use state::{initial_state, initial_tissue, read_state, StateError};
-pub use writers::{add_checkpoints, add_writers, add_writers_resumed, FinalToo, Written};
+pub use writers::{
+    add_checkpoints, add_checkpoints_with, add_writers, add_writers_resumed, FinalToo, Written,
+};
 
 /// A file of a run directory could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -97,8 +101,8 @@ impl RunDirError {
 pub type Result<T> = std::result::Result<T, RunDirError>;
 
 /// Makes `dir` ready for a new run: creates it, and makes sure it holds no earlier run. With
-/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml`, `frames/` and
-/// `checkpoints/`; without,
+/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml`, `frames/`,
+/// `checkpoints/` and `analysis/` (which described the old run); without,
 /// refuses.
 ///
 /// # Errors
@@ -114,7 +118,7 @@ pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
         std::fs::remove_file(&series).map_err(|e| RunDirError::io("remove", &series, e))?;
         let _ = std::fs::remove_file(dir.join("scene.toml"));
         let _ = std::fs::remove_file(dir.join("run.json"));
-        for sub in ["frames", "checkpoints"] {
+        for sub in ["frames", "checkpoints", "analysis"] {
             let d = dir.join(sub);
             if d.exists() {
                 std::fs::remove_dir_all(&d).map_err(|e| RunDirError::io("remove", &d, e))?;

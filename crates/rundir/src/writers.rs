@@ -4,6 +4,7 @@
 use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::time::{Duration, Instant};
 
 use mechanics::{Callback, CallbackError, Observation, Schedule, Simulation};
 use phasefield::Real;
@@ -151,15 +152,31 @@ pub fn add_checkpoints<T: Real>(
     schedule: Schedule,
     scene_toml: &str,
 ) {
-    let writer = || Checkpoints {
+    add_checkpoints_with(sim, dir, schedule, scene_toml, None);
+}
+
+/// [`add_checkpoints`], skipping a checkpoint of `schedule` that would come less than
+/// `min_wall` of wall time after the last one written (the one at the end is always written).
+pub fn add_checkpoints_with<T: Real>(
+    sim: &mut Simulation<T>,
+    dir: &Path,
+    schedule: Schedule,
+    scene_toml: &str,
+    min_wall: Option<Duration>,
+) {
+    let writer = |min_wall, at_end| Checkpoints {
         dir: dir.to_path_buf(),
         scene: scene_toml.to_string(),
+        min_wall,
+        at_end,
+        last_wall: None,
+        last_step: None,
     };
-    sim.add_output_writer("checkpoint", schedule, FinalToo::new(writer()));
+    sim.add_output_writer("checkpoint", schedule, writer(min_wall, true));
     sim.add_output_writer(
         "checkpoint (wall time)",
-        Schedule::WallTimeInterval(std::time::Duration::from_secs(600)),
-        writer(),
+        Schedule::WallTimeInterval(Duration::from_secs(600)),
+        writer(None, false),
     );
 }
 
@@ -167,11 +184,48 @@ pub fn add_checkpoints<T: Real>(
 struct Checkpoints {
     dir: PathBuf,
     scene: String,
+    /// The least wall time since the last checkpoint for a scheduled one.
+    min_wall: Option<Duration>,
+    /// Whether the final state gets one too.
+    at_end: bool,
+    last_wall: Option<Instant>,
+    last_step: Option<u64>,
+}
+
+impl Checkpoints {
+    fn write<T: Real>(
+        &mut self,
+        obs: &mut Observation<'_, T>,
+    ) -> std::result::Result<(), CallbackError> {
+        write_checkpoint(&self.dir, obs.tissue(), obs.controller(), &self.scene)?;
+        self.last_wall = Some(Instant::now());
+        self.last_step = Some(obs.iteration());
+        Ok(())
+    }
 }
 
 impl<T: Real> Callback<T> for Checkpoints {
+    fn initialize(&mut self, _: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
+        // The run's start counts as the last checkpoint for the wall-time rule.
+        self.last_wall = Some(Instant::now());
+        Ok(())
+    }
+
     fn call(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
-        write_checkpoint(&self.dir, obs.tissue(), obs.controller(), &self.scene)?;
+        let recent = match (self.min_wall, self.last_wall) {
+            (Some(min), Some(last)) => last.elapsed() < min,
+            _ => false,
+        };
+        if recent || self.last_step == Some(obs.iteration()) {
+            return Ok(());
+        }
+        self.write(obs)
+    }
+
+    fn finalize(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
+        if self.at_end && self.last_step != Some(obs.iteration()) {
+            self.write(obs)?;
+        }
         Ok(())
     }
 }

@@ -71,34 +71,33 @@ pub fn crop_fields(f: &TissueFields) -> CropFields<'_> {
     }
 }
 
-/// Options of `monolayer analyze`.
-#[derive(Debug, Clone, PartialEq)]
+/// The default side of the defect-centred crops: the paper's Fig. 4 window (4R on each
+/// side of the defect for R = 8, with room around it).
+pub const DEFAULT_CROP: usize = 101;
+
+/// The crop side used when none is given: [`DEFAULT_CROP`], or on a lattice too small for
+/// it, the largest side `analyze` accepts there (twice the shorter side plus one; beyond it a
+/// crop only repeats the periodic lattice).
+pub fn default_crop(lattice: phasefield::Lattice) -> usize {
+    DEFAULT_CROP.min(2 * lattice.lx.min(lattice.ly) + 1)
+}
+
+/// Options of `monolayer analyze`; the default leaves every choice to the run's scene.
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct AnalyzeOptions {
     /// First time analysed (default: the scene's `relax_time`, the start of activity).
     pub from: Option<f64>,
     /// Side of the smoothing box (odd; default: the odd side nearest 3R).
     pub box_side: Option<usize>,
-    /// Side of the defect-centred crops (odd).
-    pub crop_side: usize,
+    /// Side of the defect-centred crops (odd; default [`DEFAULT_CROP`], or the largest odd
+    /// side below the lattice's shorter side when that is smaller).
+    pub crop_side: Option<usize>,
     /// Longest link of a defect between frames (default R).
     pub max_link: Option<f64>,
     /// Largest separation of a created or annihilated pair (default 2R).
     pub max_pair: Option<f64>,
     /// `S_rms` of a ζ = 0 run, to report `S_rms` relative to it.
     pub s_rms_baseline: Option<f64>,
-}
-
-impl Default for AnalyzeOptions {
-    fn default() -> Self {
-        Self {
-            from: None,
-            box_side: None,
-            crop_side: 101,
-            max_link: None,
-            max_pair: None,
-            s_rms_baseline: None,
-        }
-    }
 }
 
 /// What an analysis found.
@@ -481,6 +480,8 @@ macro_rules! row {
 /// On a missing, partial or foreign run directory, with what is wrong.
 pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let scene = read_scene(run_dir)?;
+    // One process at a time: not while a run or another analysis writes the directory.
+    let _lock = rundir::lock_dir(run_dir).map_err(|e| input(run_dir, e.to_string()))?;
     let lattice = scene.lattice();
     let shape = scene.patch_shape();
     let FrameList { frames, notes } = list_frames(run_dir, &scene)?;
@@ -489,7 +490,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let box_side = opts.box_side.unwrap_or_else(|| default_box(&scene));
     box_smooth(lattice, &vec![0.0; lattice.len()], box_side)
         .map_err(|e| AnalyzeError::Options(format!("--box {box_side}: {e}")))?;
-    if opts.crop_side % 2 != 1 {
+    let crop_side = opts.crop_side.unwrap_or_else(|| default_crop(lattice));
+    if crop_side % 2 != 1 {
         return Err(AnalyzeError::Options(
             "--crop must be odd (the defect sits on the centre node), e.g. 101".into(),
         ));
@@ -497,10 +499,10 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     // A crop wraps the periodic lattice; beyond twice its side it only repeats it (and a
     // huge one exhausts memory: --crop 100001 asked for 10¹⁰ nodes per component).
     let most = 2 * lattice.lx.min(lattice.ly) + 1;
-    if opts.crop_side > most {
+    if crop_side > most {
         return Err(AnalyzeError::Options(format!(
             "--crop {}: more than twice the lattice ({}×{}) only repeats it; use an odd side up to {most} (default 101)",
-            opts.crop_side, lattice.lx, lattice.ly
+            crop_side, lattice.lx, lattice.ly
         )));
     }
     for (flag, v) in [
@@ -562,7 +564,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         Correlator::new(lattice),
     ];
     let mut tracker = Tracker::new(lattice, params);
-    let mut avg = DefectAverage::new(opts.crop_side);
+    let mut avg = DefectAverage::new(crop_side);
     let mut info = AnalyzeInfo {
         frames: 0,
         defects: 0,

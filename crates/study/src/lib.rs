@@ -57,8 +57,8 @@ pub use plan::{plan, Point, Seeds, Vary};
 pub use slurm::{write_job_array, JobArray};
 pub use spec::SweepSpec;
 pub use sweep::{
-    analyze_points, in_jobs, is_complete, pending, run_dir, run_points, write_summary, SweepInfo,
-    SweepParams, COMPLETE,
+    analyze_points, in_jobs, is_complete, pending, run_dir, run_points, write_summary, Stopped,
+    SweepInfo, SweepParams, COMPLETE,
 };
 
 /// What stops a sweep, naming the argument, the point or the file.
@@ -114,6 +114,23 @@ pub enum SweepError {
         /// The error.
         #[source]
         source: mechanics::SimulationError,
+    },
+    /// A point's run directory is held by another process, or its run failed.
+    #[error("sweep point {point}")]
+    Held {
+        /// The point.
+        point: String,
+        /// The error.
+        #[source]
+        source: Box<rundir::RunError>,
+    },
+    /// A signal stopped the sweep; the runs in progress wrote a checkpoint.
+    #[error("stopped by signal {signal}: {}; run the same sweep command again to continue", runs.iter().map(|r| format!("{} at step {} (t = {})", r.dir.display(), r.step, r.time)).collect::<Vec<_>>().join(", "))]
+    Interrupted {
+        /// The signal.
+        signal: i32,
+        /// The runs it stopped.
+        runs: Vec<crate::sweep::Stopped>,
     },
     /// A series cannot be summarised.
     #[error("{}: {why}", path.display())]

@@ -61,10 +61,29 @@ pub fn write_job_array(
          #SBATCH --cpus-per-task={threads}\n\
          #SBATCH --ntasks=1\n\
          #SBATCH --output={logs}/%a.out\n\
-         set -euo pipefail\n\
+         # SIGTERM to this script two minutes before the time limit; the run stops after its\n\
+         # step with a checkpoint, and the task is requeued and resumes from it.\n\
+         #SBATCH --signal=B:TERM@120\n\
+         #SBATCH --requeue\n\
+         #SBATCH --open-mode=append\n\
+         set -uo pipefail\n\
          run=$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" {points})\n\
-         {binary} run \"$run/scene.toml\" --out \"$run\" --overwrite --threads {threads} --quiet\n\
-         cp \"$run/scene.toml\" \"$run/{COMPLETE}\"\n",
+         if cmp -s \"$run/scene.toml\" \"$run/{COMPLETE}\"; then exit 0; fi\n\
+         if compgen -G \"$run/checkpoints/checkpoint_*.npz\" >/dev/null; then\n\
+         \x20   {binary} run --resume \"$run\" --threads {threads} --quiet &\n\
+         else\n\
+         \x20   {binary} run \"$run/scene.toml\" --out \"$run\" --overwrite --threads {threads} --quiet &\n\
+         fi\n\
+         pid=$!\n\
+         trap 'kill -TERM $pid' TERM\n\
+         wait $pid; rc=$?\n\
+         # A trapped signal interrupts `wait`: wait again for the run to write its checkpoint.\n\
+         while kill -0 $pid 2>/dev/null; do wait $pid; rc=$?; done\n\
+         if [ $rc -eq 143 ]; then\n\
+         \x20   scontrol requeue \"${{SLURM_ARRAY_JOB_ID}}_${{SLURM_ARRAY_TASK_ID}}\"\n\
+         \x20   exit 0\n\
+         fi\n\
+         exit $rc\n",
         script = absolute(&script).display(),
         dir = absolute(dir).display(),
         last = todo.len() - 1,

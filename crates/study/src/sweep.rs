@@ -7,6 +7,7 @@ use std::sync::{Arc, Mutex};
 
 use mechanics::{Callback, CallbackError, Observation, Precision, Schedule};
 use phasefield::Real;
+use rundir::{Interrupt, Outcome, RunDir};
 
 use crate::analyze::{analyze, AnalyzeOptions};
 use crate::plan::Point;
@@ -50,6 +51,17 @@ pub struct SweepInfo {
     pub steps: u64,
 }
 
+/// A run of a sweep that a signal stopped (resumable).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stopped {
+    /// Its run directory.
+    pub dir: PathBuf,
+    /// The step it stopped at.
+    pub step: u64,
+    /// Its model time.
+    pub time: f64,
+}
+
 /// The run directory of `point` in the sweep directory `dir`.
 pub fn run_dir(dir: &Path, point: &Point) -> PathBuf {
     dir.join("runs").join(&point.name)
@@ -72,20 +84,32 @@ pub fn pending<'a>(dir: &Path, points: &'a [Point]) -> (Vec<&'a Point>, u64) {
 }
 
 /// Runs every point of `points` that has no complete run in `dir` yet, `params.jobs` at a
-/// time; a run that was interrupted is started again from its beginning. `progress` is told
-/// of the steps taken, every 10 steps of each run.
+/// time, each through a [`RunDir`] (locked; resumed from its checkpoint when it has one of
+/// the same scene, started afresh otherwise, which removes its earlier output and analysis).
+/// `progress` is told of the steps taken, every 10 steps of each run. When `interrupt`
+/// catches a signal, the runs in progress stop after their step with a checkpoint and no new
+/// run starts: the same call later continues them.
 ///
 /// # Errors
 /// The first run that fails (its directory keeps what it wrote, and no `complete` mark);
-/// runs already started finish first.
+/// runs already started finish first. [`SweepError::Interrupted`] after a signal.
 pub fn run_points(
     points: &[Point],
     dir: &Path,
     params: SweepParams,
     progress: Arc<dyn Fn(u64) + Send + Sync>,
+    interrupt: &Interrupt,
 ) -> Result<SweepInfo, SweepError> {
     let (todo, steps) = pending(dir, points);
-    in_jobs(&todo, params, |p| run_point(p, dir, progress.clone()))?;
+    let stops = Mutex::new(Vec::new());
+    in_jobs(&todo, params, |p| {
+        run_point(p, dir, progress.clone(), interrupt, &stops)
+    })?;
+    if let Some(signal) = interrupt.caught() {
+        let mut runs = stops.into_inner().unwrap_or_else(|p| p.into_inner());
+        runs.sort_by(|a, b| a.dir.cmp(&b.dir));
+        return Err(SweepError::Interrupted { signal, runs });
+    }
     Ok(SweepInfo {
         ran: todo.len(),
         skipped: points.len() - todo.len(),
@@ -160,47 +184,46 @@ fn run_point(
     point: &Point,
     dir: &Path,
     progress: Arc<dyn Fn(u64) + Send + Sync>,
+    interrupt: &Interrupt,
+    stops: &Mutex<Vec<Stopped>>,
 ) -> Result<(), SweepError> {
-    let out = prepare_point(dir, point)?;
-    match point.scene.precision() {
-        Precision::F64 => run_in::<f64>(point, &out, progress),
-        Precision::F32 => run_in::<f32>(point, &out, progress),
-    }?;
-    rundir::mark_complete(&out, &point.scene).map_err(|source| SweepError::RunDir {
+    let out = run_dir(dir, point);
+    let rd = |source| SweepError::Held {
         point: point.name.clone(),
-        source,
-    })
+        source: Box::new(source),
+    };
+    if interrupt.caught().is_some() {
+        return Ok(());
+    }
+    let run = RunDir::resume_or_create(&out, point.scene.clone(), interrupt.clone()).map_err(rd)?;
+    let outcome = match point.scene.precision() {
+        Precision::F64 => run_in::<f64>(&run, progress),
+        Precision::F32 => run_in::<f32>(&run, progress),
+    }
+    .map_err(rd)?;
+    if let Outcome::Stopped { step, time, .. } = outcome {
+        let mut s = stops.lock().unwrap_or_else(|p| p.into_inner());
+        s.push(Stopped {
+            dir: out,
+            step,
+            time,
+        });
+    }
+    Ok(())
 }
 
 fn run_in<T: Real>(
-    point: &Point,
-    out: &Path,
+    run: &RunDir,
     progress: Arc<dyn Fn(u64) + Send + Sync>,
-) -> Result<(), SweepError> {
-    let tissue = rundir::initial_tissue::<T>(&point.scene).map_err(|source| SweepError::State {
-        point: point.name.clone(),
-        source: Box::new(source),
-    })?;
-    let mut sim = point.scene.simulation_from(tissue);
-    rundir::add_writers(&mut sim, out, &point.scene.output_schedules()).map_err(|source| {
-        SweepError::RunDir {
-            point: point.name.clone(),
-            source,
-        }
-    })?;
+) -> Result<Outcome, rundir::RunError> {
+    let (mut sim, _) = run.simulation::<T>()?;
+    let reported = run.resumed_from().unwrap_or(0);
     sim.add_callback(
         "progress",
         Schedule::IterationInterval(10),
-        Steps {
-            progress,
-            reported: 0,
-        },
+        Steps { progress, reported },
     );
-    sim.run().map_err(|source| SweepError::Run {
-        point: point.name.clone(),
-        source,
-    })?;
-    Ok(())
+    run.run(&mut sim)
 }
 
 /// Tells the sweep's progress of the steps taken.

@@ -163,7 +163,7 @@ fn damaged_frames_end_in_a_clean_error_never_a_panic() {
             let a = analyze(
                 &dir,
                 &AnalyzeOptions {
-                    crop_side: 21,
+                    crop_side: Some(21),
                     ..Default::default()
                 },
             )

@@ -48,6 +48,7 @@ fn sweep(dir: &std::path::Path, jobs: usize) -> (study::SweepInfo, String, u64) 
         Arc::new(move |n| {
             s.fetch_add(n, Ordering::Relaxed);
         }),
+        &rundir::Interrupt::never(),
     )
     .unwrap();
     let path = write_summary(dir, &keys, &points, false).unwrap();

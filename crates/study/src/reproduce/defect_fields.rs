@@ -108,7 +108,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             varies: vec!["model.pressure=paper,interaction".into()],
             analyze: Some(AnalyzeOptions {
                 from: Some(from),
-                crop_side: CROP,
+                crop_side: Some(CROP),
                 ..AnalyzeOptions::default()
             }),
         },

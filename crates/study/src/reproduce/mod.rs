@@ -271,6 +271,8 @@ pub struct ReproduceParams {
     pub sweep: SweepParams,
     /// Told of progress.
     pub reporter: Arc<dyn Reporter>,
+    /// Stops the runs on a signal ([`ReproduceParams::with_interrupt`]; none by default).
+    pub interrupt: rundir::Interrupt,
 }
 
 impl ReproduceParams {
@@ -286,7 +288,14 @@ impl ReproduceParams {
             scale,
             sweep,
             reporter,
+            interrupt: rundir::Interrupt::never(),
         }
+    }
+
+    /// The same, with the runs stopped (resumably) when `interrupt` catches a signal.
+    pub fn with_interrupt(mut self, interrupt: rundir::Interrupt) -> Self {
+        self.interrupt = interrupt;
+        self
     }
 
     fn figure_dir(&self, figure: Figure) -> Result<PathBuf, SweepError> {
@@ -334,7 +343,13 @@ pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, S
     let (todo, steps) = crate::pending(&dir, &points);
     p.reporter.sweep(&job.name, todo.len(), steps);
     let rep = p.reporter.clone();
-    run_points(&points, &dir, p.sweep, Arc::new(move |n| rep.steps(n)))?;
+    run_points(
+        &points,
+        &dir,
+        p.sweep,
+        Arc::new(move |n| rep.steps(n)),
+        &p.interrupt,
+    )?;
     if let Some(opts) = &job.analyze {
         p.reporter.stage(&format!("analysing {}", job.name));
         analyze_points(&points, &dir, opts, p.sweep)?;

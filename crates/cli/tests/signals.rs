@@ -1,0 +1,190 @@
+//! SIGINT, SIGTERM and SIGHUP stop a run after its step in progress, with a checkpoint and a
+//! line that says how to resume; the resumed run ends byte-identical to an uninterrupted one.
+//! One process writes a run directory at a time.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use crate::common::run_files;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_monolayer"))
+}
+
+fn paper() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The paper scene for about a second, with the default checkpoint interval (a twentieth of
+/// the run, at least a minute of wall time apart): a run stopped by a signal has only the
+/// checkpoint the signal made.
+const ARGS: [&str; 10] = [
+    "--set",
+    "run.relax_time=20",
+    "--set",
+    "run.time=300",
+    "--set",
+    "run.output_every=20",
+    "--set",
+    "run.series_every=5",
+    "--threads",
+    "1",
+];
+
+fn spawn(out: &Path) -> Child {
+    bin()
+        .arg("run")
+        .arg(paper())
+        .arg("--out")
+        .arg(out)
+        .arg("--quiet")
+        .args(ARGS)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn send(child: &Child, signal: &str) {
+    let ok = Command::new("kill")
+        .arg(format!("-{signal}"))
+        .arg(child.id().to_string())
+        .status()
+        .unwrap();
+    assert!(ok.success(), "kill -{signal}");
+}
+
+/// Waits until `dir`'s lock file names its holder (the run has started).
+fn wait_for_lock(dir: &Path) {
+    let start = Instant::now();
+    while std::fs::read_to_string(dir.join(rundir::LOCK)).map_or(true, |s| s.is_empty()) {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the run never started"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// SIGTERM, SIGINT and SIGHUP at points drawn from a fixed seed (so a failure repeats): each
+/// stops the run with status 128 + the signal, the message, a checkpoint at the step it
+/// names and no `complete` mark; `--resume` (on another thread count) then ends byte-identical
+/// to the uninterrupted run, `series.csv` and every frame.
+#[test]
+fn a_signalled_run_stops_with_a_checkpoint_and_resumes_bit_for_bit() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = dir.path().join("full");
+    let o = bin()
+        .arg("run")
+        .arg(paper())
+        .arg("--out")
+        .arg(&full)
+        .arg("--quiet")
+        .args(ARGS)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let want = run_files(&full);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut draw = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let mut stopped = 0;
+    for (k, (signal, number)) in [("TERM", 15), ("INT", 2), ("HUP", 1), ("TERM", 15)]
+        .into_iter()
+        .enumerate()
+    {
+        let ms = 20 + draw() % 600;
+        let out = dir.path().join(format!("stopped{k}"));
+        let child = spawn(&out);
+        wait_for_lock(&out);
+        std::thread::sleep(Duration::from_millis(ms));
+        send(&child, signal);
+        let o = child.wait_with_output().unwrap();
+        let err = stderr(&o);
+        if o.status.success() {
+            continue; // it finished before the signal
+        }
+        assert_eq!(o.status.code(), Some(128 + number), "SIG{signal}: {err}");
+        let step: u64 = err
+            .split("stopped at step ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("SIG{signal} at {ms} ms: no 'stopped at step N': {err}"));
+        assert!(
+            err.contains(&format!(
+                "resume with monolayer run --resume {}",
+                out.display()
+            )),
+            "{err}"
+        );
+        assert!(!rundir::is_complete(&out), "a stopped run is not complete");
+        let newest = rundir::checkpoint::checkpoints(&out).last().cloned();
+        assert_eq!(
+            newest.map(|c| c.0),
+            Some(step),
+            "the checkpoint is at the stop"
+        );
+        let o = bin()
+            .args(["run", "--resume"])
+            .arg(&out)
+            .args(["--quiet", "--threads", "2"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let got = run_files(&out);
+        assert_eq!(got.len(), want.len(), "SIG{signal} at {ms} ms: file count");
+        for (g, w) in got.iter().zip(&want) {
+            assert!(g == w, "SIG{signal} at {ms} ms: {} differs", w.0);
+        }
+        assert!(rundir::is_complete(&out));
+        stopped += 1;
+    }
+    assert!(stopped >= 3, "only {stopped} of 4 signals stopped the run");
+}
+
+/// While a run writes a directory, a second `run --out` (even with `--overwrite`) and a
+/// `--resume` of it are refused, naming the holder's process; `analyze` is refused too.
+/// Two signals in a row end the run at once.
+#[test]
+fn a_second_writer_is_refused_and_a_second_signal_exits_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("busy");
+    let child = spawn(&out);
+    wait_for_lock(&out);
+    let pid = child.id();
+    for extra in [vec!["--overwrite"], vec![]] {
+        let o = bin()
+            .arg("run")
+            .arg(paper())
+            .arg("--out")
+            .arg(&out)
+            .args(&extra)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("in use by another monolayer process")
+                && err.contains(&format!("pid {pid}")),
+            "{err}"
+        );
+    }
+    let o = bin().args(["run", "--resume"]).arg(&out).output().unwrap();
+    assert!(stderr(&o).contains(&format!("pid {pid}")), "{}", stderr(&o));
+    let o = bin().arg("analyze").arg(&out).output().unwrap();
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains(&format!("pid {pid}")), "{}", stderr(&o));
+    send(&child, "TERM");
+    send(&child, "TERM");
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(143), "{}", stderr(&o));
+}

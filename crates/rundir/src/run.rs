@@ -1,0 +1,560 @@
+//! A run directory as one value, [`RunDir`]: it creates a new run or resumes one from its
+//! newest checkpoint, holds the directory's lock while it lives, hands back the ready
+//! [`Simulation`] with every writer attached, runs it until the end or until a signal
+//! ([`Interrupt`]), and marks the run complete. `monolayer run`, `--resume` and every run of a
+//! local sweep go through it, so they share one life cycle:
+//!
+//! 1. [`RunDir::create`] (a new run: the directory prepared, `scene.toml` written),
+//!    [`RunDir::resume`] (`--resume`: the newest readable checkpoint whose scene is the run's
+//!    own) or [`RunDir::resume_or_create`] (a sweep's point: resumed when it has such a
+//!    checkpoint, started afresh otherwise);
+//! 2. [`RunDir::simulation`]: the tissue (from the scene, a saved state or the checkpoint), the
+//!    series and frame writers, the checkpoints, and a callback that stops the run after the
+//!    step in progress when the [`Interrupt`] has caught a signal;
+//! 3. [`RunDir::run`]: runs it and returns [`Outcome::Complete`] (the run is marked complete)
+//!    or [`Outcome::Stopped`] (the final checkpoint is written; `monolayer run --resume DIR`
+//!    continues it bit for bit).
+
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, OnceLock};
+use std::time::Duration;
+
+use mechanics::{
+    Callback, CallbackError, Observation, RunInfo, Schedule, Simulation, SimulationError,
+};
+use phasefield::{Cells, Real};
+use scene::Scene;
+
+use crate::writers::{add_checkpoints_with, add_writers, add_writers_resumed, Written};
+use crate::{checkpoint, RunDirError};
+
+/// The lock file of a run directory: it exists while and after a process holds the directory
+/// (an advisory `flock`, released by the operating system when the holder exits, however it
+/// exits), and holds a line naming its holder.
+pub const LOCK: &str = ".lock";
+
+/// The least wall time between two checkpoints on the default schedule (a twentieth of the
+/// run): short runs write their final one only, and long ones spend a bounded share of their
+/// time on them. An explicit `[run] checkpoint_every` is kept as given.
+pub const MIN_CHECKPOINT_WALL: Duration = Duration::from_secs(60);
+
+/// Why a run directory cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunError {
+    /// A file of the directory.
+    #[error(transparent)]
+    Files(#[from] RunDirError),
+    /// Another process holds the directory.
+    #[error("{} is in use by another monolayer process ({holder}); wait for it to finish, or stop it (a stopped run can be continued with monolayer run --resume {0})", dir.display())]
+    Locked {
+        /// The directory.
+        dir: PathBuf,
+        /// What the lock file says of its holder.
+        holder: String,
+    },
+    /// Nothing to resume from.
+    #[error("{} has no checkpoints/ to resume from (runs write one at the end, on a signal, and on [run] checkpoint_every; this one was killed before the first, or was not run by monolayer run)", dir.display())]
+    NoCheckpoint {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// A checkpoint of another run.
+    #[error("{} was not written by the run in {} (its scene differs from scene.toml: {diff}); remove it, or start a new run from it with [cells] init = \"frame\", from = \"{0}\"", path.display(), dir.display())]
+    OtherRun {
+        /// The checkpoint.
+        path: PathBuf,
+        /// The directory.
+        dir: PathBuf,
+        /// The lines that differ.
+        diff: String,
+    },
+    /// A resumed run is already at its end.
+    #[error("the run in {} is complete ({at}); extend it with --resume {0} --set run.time=T, T above {time}", dir.display())]
+    Complete {
+        /// The directory.
+        dir: PathBuf,
+        /// Where the checkpoint is, against the end.
+        at: String,
+        /// The run's active time.
+        time: f64,
+    },
+    /// `--resume` with an override other than `run.time`.
+    #[error("--resume continues the run as it was: only --set run.time=T (to extend it) can change; {key} would make it another run (start a new scene instead)")]
+    Override {
+        /// The key.
+        key: String,
+    },
+    /// The scene in a checkpoint, or the initial tissue, is not valid.
+    #[error("{context}: {source}")]
+    Scene {
+        /// Where.
+        context: String,
+        /// What.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// The run stopped with an error (the tissue keeps the last good state).
+    #[error(transparent)]
+    Simulation(#[from] SimulationError),
+}
+
+type Result<T> = std::result::Result<T, RunError>;
+
+/// Catches SIGINT, SIGTERM and SIGHUP for the runs that check it: the first such signal asks
+/// each run to stop after its step in progress (and write a checkpoint); a second one ends
+/// the process at once with status 128 + its number. [`Interrupt::never`] catches nothing.
+#[derive(Debug, Clone)]
+pub struct Interrupt {
+    signal: Arc<AtomicUsize>,
+}
+
+static INSTALLED: OnceLock<Interrupt> = OnceLock::new();
+
+impl Interrupt {
+    /// The process's handler, installed on the first call (later calls return the same).
+    ///
+    /// # Errors
+    /// When the operating system refuses a handler.
+    pub fn install() -> std::io::Result<Self> {
+        if let Some(i) = INSTALLED.get() {
+            return Ok(i.clone());
+        }
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        let caught = Arc::new(AtomicBool::new(false));
+        let signal = Arc::new(AtomicUsize::new(0));
+        for sig in [SIGINT, SIGTERM, SIGHUP] {
+            // In this order: the second signal finds `caught` set and exits; the first sets it.
+            signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, caught.clone())?;
+            signal_hook::flag::register(sig, caught.clone())?;
+            signal_hook::flag::register_usize(sig, signal.clone(), sig as usize)?;
+        }
+        Ok(INSTALLED.get_or_init(|| Self { signal }).clone())
+    }
+
+    /// A handle that never reports a signal (library use, tests).
+    pub fn never() -> Self {
+        Self {
+            signal: Arc::new(AtomicUsize::new(0)),
+        }
+    }
+
+    /// The signal caught, if any.
+    pub fn caught(&self) -> Option<i32> {
+        match self.signal.load(Ordering::SeqCst) {
+            0 => None,
+            s => Some(s as i32),
+        }
+    }
+
+    /// Records `signal` as caught, as the handler does (for tests of what follows).
+    pub fn raise(&self, signal: i32) {
+        self.signal.store(signal as usize, Ordering::SeqCst);
+    }
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outcome {
+    /// It reached its end and is marked complete.
+    Complete(RunInfo),
+    /// A signal stopped it after a whole step; the final checkpoint is written.
+    Stopped {
+        /// The step it stopped at.
+        step: u64,
+        /// Its model time.
+        time: f64,
+        /// The signal.
+        signal: i32,
+        /// What this call did.
+        info: RunInfo,
+    },
+}
+
+/// Where the run's state comes from.
+#[derive(Debug)]
+enum Start {
+    Scene,
+    State(Box<Cells<f64>>),
+    Checkpoint { path: PathBuf, step: u64 },
+}
+
+/// A run directory held by this process (see the module docs).
+#[derive(Debug)]
+pub struct RunDir {
+    dir: PathBuf,
+    scene: Scene,
+    start: Start,
+    interrupt: Interrupt,
+    skipped: Vec<String>,
+    _lock: File,
+}
+
+impl RunDir {
+    /// A new run of `scene` in `dir` (created if missing), from `state` when the scene starts
+    /// from a saved one (read before, since `overwrite` may remove it): takes the lock,
+    /// prepares the directory ([`crate::prepare`]) and writes `scene.toml` and `run.json`.
+    ///
+    /// # Errors
+    /// [`RunError::Locked`]; a directory that holds a run, without `overwrite`; I/O errors.
+    pub fn create(
+        dir: &Path,
+        scene: Scene,
+        state: Option<Cells<f64>>,
+        overwrite: bool,
+        interrupt: Interrupt,
+    ) -> Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))?;
+        let lock = lock(dir)?;
+        crate::prepare(dir, overwrite)?;
+        let _ = std::fs::remove_file(dir.join(crate::COMPLETE));
+        crate::write_scene(dir, &scene)?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            scene,
+            start: match state {
+                Some(s) => Start::State(Box::new(s)),
+                None => Start::Scene,
+            },
+            interrupt,
+            skipped: Vec::new(),
+            _lock: lock,
+        })
+    }
+
+    /// The run in `dir`, to be continued from its newest readable checkpoint, with `set`
+    /// overrides of `run.time` only (to extend it). A checkpoint whose scene is not the one in
+    /// `dir/scene.toml` (but for `run.time`) is refused; unreadable ones are skipped
+    /// ([`RunDir::skipped`] says which and why).
+    ///
+    /// # Errors
+    /// [`RunError::Locked`], [`RunError::Override`], [`RunError::NoCheckpoint`],
+    /// [`RunError::OtherRun`], [`RunError::Complete`], or the last checkpoint's error when
+    /// none can be read.
+    pub fn resume(dir: &Path, set: &[String], interrupt: Interrupt) -> Result<Self> {
+        for s in set {
+            let key = s.split('=').next().unwrap_or("").trim();
+            if key != "run.time" {
+                return Err(RunError::Override { key: key.into() });
+            }
+        }
+        if !dir.is_dir() {
+            return Err(RunError::NoCheckpoint {
+                dir: dir.to_path_buf(),
+            });
+        }
+        let lock = lock(dir)?;
+        let own = std::fs::read_to_string(dir.join("scene.toml")).ok();
+        let all = checkpoint::checkpoints(dir);
+        if all.is_empty() {
+            return Err(RunError::NoCheckpoint {
+                dir: dir.to_path_buf(),
+            });
+        }
+        let mut skipped = Vec::new();
+        let mut last_err = None;
+        for (step, path) in all.iter().rev() {
+            let scene = match read_scene(path, set) {
+                Ok(s) => s,
+                Err(e) => {
+                    skipped.push(format!("{}: {e}", path.display()));
+                    last_err = Some(e);
+                    continue;
+                }
+            };
+            if let Some(own) = &own {
+                let diff = scene_diff(own, &scene.to_toml());
+                if !diff.is_empty() {
+                    return Err(RunError::OtherRun {
+                        path: path.clone(),
+                        dir: dir.to_path_buf(),
+                        diff,
+                    });
+                }
+            }
+            let time = crate::read_npz(path, &["time"])?[0]
+                .scalar()
+                .unwrap_or(f64::NAN);
+            let total = scene.step_counts().total_steps();
+            let (complete, at) = match scene.adaptive() {
+                Some(_) => (
+                    time >= scene.end_time() * (1.0 - 1e-12),
+                    format!("t = {time} of {}", scene.end_time()),
+                ),
+                None => (*step >= total, format!("step {step} of {total}")),
+            };
+            if complete {
+                return Err(RunError::Complete {
+                    dir: dir.to_path_buf(),
+                    at,
+                    time: scene.file().run.time,
+                });
+            }
+            crate::write_scene(dir, &scene)?;
+            // Its analysis described the run before; the frames from the checkpoint on are
+            // written again.
+            let analysis = dir.join("analysis");
+            if analysis.exists() {
+                std::fs::remove_dir_all(&analysis)
+                    .map_err(|e| RunDirError::io("remove", &analysis, e))?;
+            }
+            return Ok(Self {
+                dir: dir.to_path_buf(),
+                scene,
+                start: Start::Checkpoint {
+                    path: path.clone(),
+                    step: *step,
+                },
+                interrupt,
+                skipped,
+                _lock: lock,
+            });
+        }
+        Err(last_err.expect("at least one checkpoint was tried"))
+    }
+
+    /// A sweep's point: `scene` resumed from the newest checkpoint in `dir` that holds this
+    /// very scene and is not at its end, or started afresh (overwriting what `dir` holds).
+    ///
+    /// # Errors
+    /// [`RunError::Locked`]; I/O errors.
+    pub fn resume_or_create(dir: &Path, scene: Scene, interrupt: Interrupt) -> Result<Self> {
+        let own = scene.to_toml();
+        let resumable = std::fs::read_to_string(dir.join("scene.toml")).is_ok_and(|s| s == own)
+            && checkpoint::checkpoints(dir)
+                .last()
+                .is_some_and(|(_, p)| checkpoint::checkpoint_scene(p).is_ok_and(|s| s == own));
+        if resumable {
+            match Self::resume(dir, &[], interrupt.clone()) {
+                Ok(r) => return Ok(r),
+                Err(e @ RunError::Locked { .. }) => return Err(e),
+                Err(_) => {}
+            }
+        }
+        Self::create(dir, scene, None, true, interrupt)
+    }
+
+    /// The directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The run's resolved scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The step a resumed run continues from.
+    pub fn resumed_from(&self) -> Option<u64> {
+        match self.start {
+            Start::Checkpoint { step, .. } => Some(step),
+            _ => None,
+        }
+    }
+
+    /// Checkpoints that [`RunDir::resume`] could not read, with the reason.
+    pub fn skipped(&self) -> &[String] {
+        &self.skipped
+    }
+
+    /// The run's simulation with its writers (series, frames, checkpoints) and the signal
+    /// check attached; add more callbacks, then give it to [`RunDir::run`].
+    ///
+    /// # Errors
+    /// A damaged checkpoint, a state that does not fit, I/O errors.
+    pub fn simulation<T: Real>(&self) -> Result<(Simulation<T>, Written)> {
+        let scene = &self.scene;
+        let schedules = scene.output_schedules();
+        let bad = |context: String| {
+            move |e: Box<dyn std::error::Error + Send + Sync>| RunError::Scene {
+                context,
+                source: e,
+            }
+        };
+        let (mut sim, written) = match &self.start {
+            Start::Checkpoint { path, .. } => {
+                let tissue = checkpoint::read_checkpoint::<T>(path, scene)?;
+                let step = tissue.iteration();
+                let mut sim = scene.simulation_from(tissue);
+                if let Some(c) = checkpoint::read_controller(path)? {
+                    sim.set_controller(c);
+                }
+                let w = add_writers_resumed(&mut sim, &self.dir, &schedules, step)?;
+                (sim, w)
+            }
+            start => {
+                let tissue = match start {
+                    Start::State(state) => scene.tissue_from_state::<T>(state),
+                    _ => scene.tissue::<T>(),
+                }
+                .map_err(|e| bad("the initial state".into())(Box::new(e)))?;
+                let mut sim = scene.simulation_from(tissue);
+                let w = add_writers(&mut sim, &self.dir, &schedules)?;
+                (sim, w)
+            }
+        };
+        let min_wall = scene
+            .file()
+            .run
+            .checkpoint_every
+            .is_none()
+            .then_some(MIN_CHECKPOINT_WALL);
+        add_checkpoints_with(
+            &mut sim,
+            &self.dir,
+            schedules.checkpoints,
+            &scene.to_toml(),
+            min_wall,
+        );
+        sim.add_callback(
+            "signal check",
+            Schedule::IterationInterval(1),
+            StopOnSignal(self.interrupt.clone()),
+        );
+        Ok((sim, written))
+    }
+
+    /// Runs `sim` (from [`RunDir::simulation`]) to its end, then marks the run complete; or,
+    /// when a signal stops it, leaves it resumable ([`Outcome::Stopped`]).
+    ///
+    /// # Errors
+    /// The simulation's error (what was written so far is kept) or a failed mark.
+    pub fn run<T: Real>(&self, sim: &mut Simulation<T>) -> Result<Outcome> {
+        let info = sim.run()?;
+        if let Some(signal) = self.interrupt.caught() {
+            let t = sim.tissue();
+            return Ok(Outcome::Stopped {
+                step: t.iteration(),
+                time: t.time(),
+                signal,
+                info,
+            });
+        }
+        crate::mark_complete(&self.dir, &self.scene)?;
+        Ok(Outcome::Complete(info))
+    }
+}
+
+/// The lines of two resolved scenes that differ, `run.time` aside (`key: a → b`).
+fn scene_diff(own: &str, other: &str) -> String {
+    let norm = |s: &str| -> Vec<String> {
+        let mut section = String::new();
+        s.lines()
+            .filter_map(|l| {
+                let l = l.trim();
+                if l.starts_with('[') {
+                    section = l.trim_matches(|c| c == '[' || c == ']').to_string();
+                    return None;
+                }
+                let (k, v) = l.split_once('=')?;
+                let key = format!("{section}.{}", k.trim());
+                (key != "run.time").then(|| format!("{key} = {}", v.trim()))
+            })
+            .collect()
+    };
+    let (a, b) = (norm(own), norm(other));
+    let mut out = Vec::new();
+    for l in &b {
+        if !a.contains(l) {
+            let key = l.split(" = ").next().unwrap_or("");
+            let was = a
+                .iter()
+                .find(|m| m.split(" = ").next() == Some(key))
+                .and_then(|m| m.split(" = ").nth(1))
+                .unwrap_or("(none)");
+            out.push(format!(
+                "{key} is {} there, {was} here",
+                l.split(" = ").nth(1).unwrap_or("")
+            ));
+        }
+    }
+    for l in &a {
+        let key = l.split(" = ").next().unwrap_or("");
+        if !b.iter().any(|m| m.split(" = ").next() == Some(key)) {
+            out.push(format!("{key} is not set there"));
+        }
+    }
+    out.join("; ")
+}
+
+/// The scene a checkpoint carries, with `set` applied.
+fn read_scene(path: &Path, set: &[String]) -> Result<Scene> {
+    let text = checkpoint::checkpoint_scene(path)?;
+    Scene::parse(&text, set).map_err(|e| RunError::Scene {
+        context: format!("the scene in {}", path.display()),
+        source: Box::new(e),
+    })
+}
+
+/// Takes the lock of `dir` without waiting, and writes this process into it.
+fn lock(dir: &Path) -> Result<File> {
+    let path = dir.join(LOCK);
+    let mut f = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .map_err(|e| RunDirError::io("open", &path, e))?;
+    match f.try_lock() {
+        Ok(()) => {}
+        Err(TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = f.read_to_string(&mut holder);
+            let holder = holder.trim();
+            return Err(RunError::Locked {
+                dir: dir.to_path_buf(),
+                holder: if holder.is_empty() {
+                    "its lock file names no process yet".into()
+                } else {
+                    holder.into()
+                },
+            });
+        }
+        Err(TryLockError::Error(e)) => return Err(RunDirError::io("lock", &path, e).into()),
+    }
+    let args: Vec<String> = std::env::args().collect();
+    let line = format!(
+        "pid {} since {} s after the Unix epoch: {}\n",
+        std::process::id(),
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_secs()),
+        args.join(" ")
+    );
+    let written = f
+        .set_len(0)
+        .and_then(|()| f.seek(SeekFrom::Start(0)))
+        .and_then(|_| f.write_all(line.as_bytes()));
+    written.map_err(|e| RunDirError::io("write", &path, e))?;
+    Ok(f)
+}
+
+/// Takes the lock of `dir` (creating it) for as long as the returned value lives: for a
+/// process that reads a run and writes beside it (`monolayer analyze`), or a sweep's directory.
+///
+/// # Errors
+/// [`RunError::Locked`] while another process holds it; I/O errors.
+pub fn lock_dir(dir: &Path) -> Result<DirLock> {
+    std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))?;
+    Ok(DirLock(lock(dir)?))
+}
+
+/// A held lock ([`lock_dir`]), released when dropped or when the process ends.
+#[derive(Debug)]
+pub struct DirLock(#[allow(dead_code)] File);
+
+/// Stops the run after the step in progress once a signal is caught.
+struct StopOnSignal(Interrupt);
+
+impl<T: Real> Callback<T> for StopOnSignal {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
+        if self.0.caught().is_some() {
+            obs.request_stop();
+        }
+        Ok(())
+    }
+}
