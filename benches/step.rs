@@ -1,8 +1,8 @@
 //! One relaxed time step (Heun, dt = 0.2, ζ = 0.005) of the shipped scenes `paper.toml`
 //! (60 cells, 100²) and `large.toml` (960 cells, 400²), with patch margins 12 and 25, on one
 //! and two threads, with the fields stored in `f64` and (960 cells, margin 12) in `f32`. Throughput is in node updates: cells × patch nodes per step (each step is
-//! two sweeps, predictor and corrector), the unit of `node_substeps_per_s` in
-//! `../shared/reference/celadro-performance.csv`.
+//! two sweeps, predictor and corrector), the unit of `node_substeps_per_s` in the reference code's measurements
+//! (quoted in `docs/performance.md`).
 //!
 //! Run with `cargo bench -p monolayer-benches --bench step`.
 

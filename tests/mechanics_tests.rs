@@ -95,7 +95,7 @@ fn translated_rotated_and_mirrored_states_give_the_image_trajectory() {
     }
 }
 
-/// An isolated cell feels no force in the continuum (MODEL.md §3), and none on the lattice
+/// An isolated cell feels no force in the continuum (docs/model.md §3), and none on the lattice
 /// either, to round-off:
 /// - with the interaction pressure `P = 0`, and the active force `ζ S Σ φ ∂φ` vanishes because
 ///   the central-difference sum `Σ φ(x)(φ(x+1) − φ(x−1))` telescopes on the periodic patch;

@@ -70,7 +70,7 @@ fn sixty_cells_relax_at_zero_activity() {
     assert!(end.s_rms > 0.1, "{}", end.s_rms);
 }
 
-/// The reference's protocol (`../shared/reference/README.md`, "Agreement"): interaction
+/// The reference's protocol (the authors' code run on this machine kind, figures below): interaction
 /// pressure, 200 TU relaxation, 1000 TU at ζ = 0.005, averages over the last 500 TU. The
 /// reference code gives, over five seeds, v_rms 0.0425 ± 0.0052, area 158.3 ± 1.6,
 /// S_rms 2.30 ± 0.17. Ours over seeds 1–5: v_rms 0.0453 ± 0.0019, area 158.2 ± 0.6,

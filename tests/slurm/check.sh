@@ -7,7 +7,7 @@
 #
 #   bash tests/slurm/check.sh
 #
-# After ../shared/notes/local-slurm.md. Needs root (it is, on these machines).
+# Needs root (it is, on these machines).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 

@@ -1,4 +1,4 @@
-//! Normalised autocorrelation functions on the periodic lattice (MODEL.md §7), by FFT.
+//! Normalised autocorrelation functions on the periodic lattice (docs/model.md §7), by FFT.
 //!
 //! For a field with components `f_c`, the correlation at displacement `d` is
 //! `A(d) = (1/N) Σ_x Σ_c f_c(x) f_c(x + d)`, computed by Wiener–Khinchin as

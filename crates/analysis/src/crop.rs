@@ -1,4 +1,4 @@
-//! Fields averaged in the frame of each defect (MODEL.md §7; the paper's figure 4).
+//! Fields averaged in the frame of each defect (docs/model.md §7; the paper's figure 4).
 //!
 //! Around a defect at `p` with orientation `ψ`, the crop samples every field at
 //! `p + R(ψ)·(u, v)` for `u, v = −h, ..., h` (side `2h + 1`), by bilinear interpolation on

@@ -1,4 +1,4 @@
-//! Topological defects of a nematic field `Q` on the periodic lattice (MODEL.md §7).
+//! Topological defects of a nematic field `Q` on the periodic lattice (docs/model.md §7).
 //!
 //! **Axes.** x is the first lattice index, y the second, and the frame is right-handed:
 //! angles are measured counterclockwise from +x towards +y. Image data with y pointing down

@@ -1,4 +1,4 @@
-//! Derived lattice fields and scalar observables (MODEL.md §7).
+//! Derived lattice fields and scalar observables (docs/model.md §7).
 
 use phasefield::Lattice;
 

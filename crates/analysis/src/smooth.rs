@@ -1,4 +1,4 @@
-//! Smoothing by a periodic sliding box (MODEL.md §7: side `3R`, applied to `v`, `ω` and `Q`
+//! Smoothing by a periodic sliding box (docs/model.md §7: side `3R`, applied to `v`, `ω` and `Q`
 //! before correlations and defects).
 //!
 //! The box mean `f̄(x, y) = (1/w²) Σ_{|i|,|j| ≤ h} f(x+i, y+j)`, `w = 2h + 1`, is separable:
@@ -67,7 +67,7 @@ pub fn box_smooth_into(
     Ok(())
 }
 
-/// The odd box side nearest to `3R`, as the paper smooths (MODEL.md §7).
+/// The odd box side nearest to `3R`, as the paper smooths (docs/model.md §7).
 pub fn paper_box_side(radius: f64) -> usize {
     let s = (3.0 * radius).round() as usize;
     if s.is_multiple_of(2) {

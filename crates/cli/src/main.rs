@@ -141,9 +141,9 @@ enum Command {
     Render {
         /// A directory written by `monolayer run`.
         run_dir: PathBuf,
-        /// The directory of the PNGs (created if missing).
-        #[arg(long)]
-        out: PathBuf,
+        /// The directory of the PNGs (created if missing; not needed with --no-pngs).
+        #[arg(long, required_unless_present = "no_pngs")]
+        out: Option<PathBuf>,
         /// `all`, or steps such as `0,500,1000` (the numbers in frames/frame_STEP.npz).
         #[arg(long, default_value = "all")]
         frames: String,
@@ -517,12 +517,23 @@ fn real_main() -> Result<ExitCode> {
                 fps,
                 pngs: !no_pngs,
             };
+            // With --no-pngs only the movie is written, beside which nothing else goes.
+            let out = out.unwrap_or_else(|| {
+                let m = opts.movie.as_deref().unwrap_or(std::path::Path::new("."));
+                m.parent()
+                    .filter(|p| !p.as_os_str().is_empty())
+                    .unwrap_or(std::path::Path::new("."))
+                    .to_path_buf()
+            });
             let mut progress = monolayer_cli::view::frames_progress("drawn", quiet);
             let info =
                 pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
             if !quiet {
                 note_skipped(&info.notes, &run_dir);
                 match &opts.movie {
+                    Some(m) if no_pngs => {
+                        eprintln!("drew {} frames into {}", info.frames, m.display())
+                    }
                     Some(m) => eprintln!(
                         "drew {} frames into {} and {}",
                         info.frames,

@@ -3,6 +3,7 @@
 mod adaptive;
 mod cli;
 mod common;
+mod docs;
 mod from_state;
 mod signals;
 mod view;

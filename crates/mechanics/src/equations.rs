@@ -1,4 +1,4 @@
-//! The equations of MODEL.md §3–4, one named function each, at one lattice node.
+//! The equations of docs/model.md §3–4, one named function each, at one lattice node.
 //!
 //! The kernels ([`crate::Tissue::step`], [`crate::TissueFields`]) are built from these
 //! functions and nothing else, so that each formula exists once. All are
@@ -15,7 +15,7 @@ use phasefield::EnergyCoefficients;
 
 use crate::params::PressureKind;
 
-/// The integrand of the deformation tensor (MODEL.md §3):
+/// The integrand of the deformation tensor (docs/model.md §3):
 ///
 /// ```text
 /// S_i = −Σ_x [ ∇φ_i ∇φ_iᵀ − ½ |∇φ_i|² 𝕀 ],   so   S_xx = Σ_x ½(∂_yφ² − ∂_xφ²),  S_xy = −Σ_x ∂_xφ ∂_yφ
@@ -30,7 +30,7 @@ pub fn shape_tensor_density(grad: [f64; 2]) -> [f64; 2] {
 }
 
 /// Cell i's contribution `φ_i S_i` to the nematic field `Q(x) = Σ_i φ_i(x) S_i`
-/// (MODEL.md §3), as `[Q_xx, Q_xy]`.
+/// (docs/model.md §3), as `[Q_xx, Q_xy]`.
 #[inline(always)]
 pub fn nematic_density(phi: f64, shape: [f64; 2]) -> [f64; 2] {
     [phi * shape[0], phi * shape[1]]
@@ -68,7 +68,7 @@ pub fn pressure_cell_part(
 }
 
 /// The tissue pressure `P` at a node from its sums `s1 = Σ φ_i`, `s2 = Σ φ_i²` and
-/// `U = Σ_i U_i` ([`pressure_cell_part`]) (MODEL.md §3):
+/// `U = Σ_i U_i` ([`pressure_cell_part`]) (docs/model.md §3):
 /// `P = (2κ/λ) s1 s2 + U` (paper) or `P = (2κ/λ) s2² + U` (interaction).
 ///
 /// This is the one formula of the pressure: the force kernel, [`crate::TissueFields`] and
@@ -110,7 +110,7 @@ pub fn pressure_self_part_with(c_self: f64, phi: f64) -> f64 {
     -(c_self * phi * (1.0 - phi) * (1.0 - 2.0 * phi))
 }
 
-/// The integrand of the interface force on cell i (MODEL.md §3), the divergence of the
+/// The integrand of the interface force on cell i (docs/model.md §3), the divergence of the
 /// stress `σ = −P𝕀 − ζQ` against `φ_i`, integrated by parts:
 ///
 /// ```text
@@ -129,13 +129,13 @@ pub fn force_density(p_cell: f64, zeta: f64, q: [f64; 2], grad: [f64; 2]) -> [f6
 }
 
 /// The velocity of a cell from the force on it, overdamped on the substrate:
-/// `ξ v_i = F_i` (MODEL.md §3).
+/// `ξ v_i = F_i` (docs/model.md §3).
 #[inline(always)]
 pub fn velocity(force: [f64; 2], xi: f64) -> [f64; 2] {
     [force[0] / xi, force[1] / xi]
 }
 
-/// The right-hand side of the dynamics at a node (MODEL.md §4):
+/// The right-hand side of the dynamics at a node (docs/model.md §4):
 /// `R_i = ∂_t φ_i = −v_i·∂φ_i − δF/δφ_i`, advection by the cell's velocity plus the
 /// relaxation of the free energy.
 ///
@@ -148,14 +148,14 @@ pub fn rhs(velocity: [f64; 2], grad: [f64; 2], dfdphi: f64) -> f64 {
     -velocity[0] * grad[0] - velocity[1] * grad[1] - dfdphi
 }
 
-/// The Heun predictor (a forward-Euler step): `φ* = φⁿ + Δt R(φⁿ)` (MODEL.md §4).
+/// The Heun predictor (a forward-Euler step): `φ* = φⁿ + Δt R(φⁿ)` (docs/model.md §4).
 #[inline(always)]
 pub fn heun_predictor(phi_old: f64, dt: f64, r_old: f64) -> f64 {
     phi_old + dt * r_old
 }
 
 /// The Heun corrector (the trapezoidal rule on the predicted state):
-/// `φⁿ⁺¹ = φⁿ + ½Δt [R(φⁿ) + R(φ*)]` (MODEL.md §4). Applied `npc` times, each on the latest
+/// `φⁿ⁺¹ = φⁿ + ½Δt [R(φⁿ) + R(φ*)]` (docs/model.md §4). Applied `npc` times, each on the latest
 /// state; with `npc = 0` the step is forward Euler.
 #[inline(always)]
 pub fn heun_corrector(phi_old: f64, dt: f64, r_old: f64, r_new: f64) -> f64 {

@@ -1,4 +1,4 @@
-//! Lattice fields of a state for analysis (MODEL.md §7), built by the same code as the step:
+//! Lattice fields of a state for analysis (docs/model.md §7), built by the same code as the step:
 //! the tissue velocity `v = Σ_i φ_i v_i`, the nematic field `Q = Σ_i φ_i S_i`, the pressure
 //! `P` and the stress `σ = −P𝕀 − ζQ`.
 

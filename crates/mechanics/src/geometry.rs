@@ -4,7 +4,7 @@
 use nalgebra::{Matrix2, SymmetricEigen, Vector2};
 
 /// A symmetric traceless 2×2 tensor `[[xx, xy], [xy, −xx]]`: the deformation tensor `S_i`
-/// of a cell or the nematic field `Q` at a node (MODEL.md §3).
+/// of a cell or the nematic field `Q` at a node (docs/model.md §3).
 ///
 /// Its eigenvalues are `±|T|` with `|T| = sqrt(xx² + xy²)`; the eigenvector of `+|T|` is the
 /// *axis* (a cell's long axis, the local director), defined up to sign, at angle

@@ -1,4 +1,4 @@
-//! One evaluation of the right-hand side `R(φ)` (MODEL.md §3–4) in three passes, built from
+//! One evaluation of the right-hand side `R(φ)` (docs/model.md §3–4) in three passes, built from
 //! the named functions of [`crate::equations`]:
 //! 1. per cell, in parallel: area `A_i = Σ φ_i²`, range and deformation tensor `S_i`;
 //! 2. scatter onto the lattice, stripe-parallel in cell order: `s1, s2`, `U`, `Q_xx, Q_xy`

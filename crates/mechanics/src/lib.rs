@@ -1,7 +1,7 @@
 //! # mechanics
 //!
 //! Turns a state of the multi-phase-field model (a [`phasefield::Cells`]) into forces and
-//! advances it in time (MODEL.md §3–4; Mueller, Yeomans & Doostmohammadi, PRL 122, 048004, 2019).
+//! advances it in time (docs/model.md §3–4; Mueller, Yeomans & Doostmohammadi, PRL 122, 048004, 2019).
 //!
 //! Principal types:
 //! - [`ModelParams`] (with [`PressureKind`]) and [`StepParams`]: the physics and the
@@ -11,7 +11,7 @@
 //! - [`Workspace`]: all scratch memory of a step, built once; the step allocates nothing.
 //! - [`Simulation`]: the driver, with stop criteria and scheduled [`Callback`]s and output
 //!   writers ([`Schedule`], [`Observation`]).
-//! - [`equations`]: each equation of MODEL.md §3–4 as one named function.
+//! - [`equations`]: each equation of docs/model.md §3–4 as one named function.
 //! - [`Observables`], [`TissueFields`]: what a state looks like, as scalars or lattice fields;
 //!   vectors are nalgebra [`Vector2`]s and `S_i`, `Q` are [`TracelessTensor`]s.
 //!

@@ -1,4 +1,4 @@
-//! Scalar observables of a state (MODEL.md §7) and the lattice fields they are built from.
+//! Scalar observables of a state (docs/model.md §7) and the lattice fields they are built from.
 
 use phasefield::Real;
 

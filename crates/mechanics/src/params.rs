@@ -3,7 +3,7 @@
 use phasefield::EnergyParams;
 use serde::{Deserialize, Serialize};
 
-/// Which definition of the tissue pressure `P` enters the stress `σ = −P𝕀 − ζQ` (MODEL.md §3).
+/// Which definition of the tissue pressure `P` enters the stress `σ = −P𝕀 − ζQ` (docs/model.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum PressureKind {
@@ -16,7 +16,7 @@ pub enum PressureKind {
     Interaction,
 }
 
-/// Everything that defines the dynamics (MODEL.md §2–3).
+/// Everything that defines the dynamics (docs/model.md §2–3).
 ///
 /// Start from [`ModelParams::paper`] (the [`Default`] is the paper at ζ = 0) and change the
 /// fields you need; the struct is `#[non_exhaustive]`.
@@ -124,7 +124,7 @@ impl ModelParams {
 /// The coefficient of [`ModelParams::activity_dt_limit`].
 pub const ACTIVITY_DT: f64 = 0.1;
 
-/// Time integration (MODEL.md §4).
+/// Time integration (docs/model.md §4).
 ///
 /// The [`Default`] is the tuned integrator of the work–precision study
 /// (`docs/performance.md`): dt 0.5, one Heun corrector. With the default patch margin

@@ -357,7 +357,7 @@ impl<T: Real> Simulation<T> {
     }
 
     /// Holds ζ = 0 until iteration `iteration` and switches to activity `zeta` there (the
-    /// relaxation protocol of MODEL.md §6). With `iteration = 0` the activity is on from the
+    /// relaxation protocol of docs/model.md §6). With `iteration = 0` the activity is on from the
     /// start.
     pub fn activity_from(mut self, iteration: u64, zeta: f64) -> Self {
         self.activity = Some((Switch::Iteration(iteration), zeta));

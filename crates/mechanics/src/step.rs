@@ -1,4 +1,4 @@
-//! The time step (Heun's predictor–corrector, MODEL.md §4), the check at its chokepoint, and
+//! The time step (Heun's predictor–corrector, docs/model.md §4), the check at its chokepoint, and
 //! the evaluations that observe a state without stepping it.
 
 use phasefield::Real;
@@ -15,7 +15,7 @@ use crate::StepError;
 /// How far outside `[0, 1]` a phase field may go before the step is declared unstable.
 ///
 /// Central-difference advection lets φ reach about −0.05 and 1.5 at ζ = 0.01 in stable runs
-/// (reference code, `../shared/reference`); a value beyond `−2` or `3` only occurs on the way
+/// (runs of the authors' reference code); a value beyond `−2` or `3` only occurs on the way
 /// to a blow-up.
 pub const PHI_BOUND: f64 = 2.0;
 

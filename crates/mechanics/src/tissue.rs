@@ -167,7 +167,7 @@ impl<T: Real> Tissue<T> {
     /// placed the patches).
     ///
     /// When a patch has just moved, its wrapped row or column carries far-edge values
-    /// (MODEL.md §5), so the centre of the stored values ([`crate::Workspace::centres`] after
+    /// (docs/model.md §5), so the centre of the stored values ([`crate::Workspace::centres`] after
     /// an observation) can differ from it by the neglected tail.
     pub fn centres(&self) -> &[[f64; 2]] {
         &self.centre

@@ -57,7 +57,7 @@ impl SumField {
 pub struct CellState {
     /// Area `A_i = Σ_x φ_i²`.
     pub area: f64,
-    /// Deformation tensor `S_i` (MODEL.md §3).
+    /// Deformation tensor `S_i` (docs/model.md §3).
     pub shape: TracelessTensor,
     /// Interface force `F_i`.
     pub force: Vector2<f64>,

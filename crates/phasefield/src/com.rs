@@ -1,4 +1,4 @@
-//! Centre of mass on a periodic lattice by Fourier phase (MODEL.md §5):
+//! Centre of mass on a periodic lattice by Fourier phase (docs/model.md §5):
 //! `c_s = L_s/(2π) · arg( Σ_x φ(x) e^{2πi s/L_s} )`, taken in `[0, L_s)`.
 //!
 //! For a field that is mirror-symmetric about a node or a half-node this is exact to

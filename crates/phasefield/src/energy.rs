@@ -1,5 +1,5 @@
 //! The free energy `F = F_CH + F_area + F_rep` and its functional derivatives
-//! (MODEL.md §2; the supplementary formulas of Mueller, Yeomans & Doostmohammadi, PRL 2019).
+//! (docs/model.md §2; the supplementary formulas of Mueller, Yeomans & Doostmohammadi, PRL 2019).
 //!
 //! The discrete free energy whose exact gradient these derivatives are:
 //!
@@ -160,7 +160,7 @@ impl EnergyCoefficients {
         self.repulsion * phi * others_sq
     }
 
-    /// The whole functional derivative of the free energy at one node (MODEL.md §2):
+    /// The whole functional derivative of the free energy at one node (docs/model.md §2):
     ///
     /// ```text
     /// δF/δφ_i = (8γ/λ) φ(1−φ)(1−2φ) − 2γλ ∇²φ − (4μ/πR²)(1 − A_i/πR²) φ + (2κ/λ) φ Σ_{k≠i} φ_k²

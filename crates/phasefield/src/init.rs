@@ -1,4 +1,4 @@
-//! Initial states (MODEL.md §6): cell positions (random, hexagonal or given) and discs with a
+//! Initial states (docs/model.md §6): cell positions (random, hexagonal or given) and discs with a
 //! tanh profile of width λ, smaller than the target radius.
 
 use rand::{Rng, SeedableRng};

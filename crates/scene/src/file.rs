@@ -55,7 +55,7 @@ pub struct CellsSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub from: Option<String>,
     /// Radius of the initial discs (default R/2: cells start smaller than their target and
-    /// grow during relaxation, MODEL.md §6).
+    /// grow during relaxation, docs/model.md §6).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub init_radius: Option<f64>,
 }

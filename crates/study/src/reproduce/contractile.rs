@@ -147,7 +147,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     }
     write_text(&dir.join("contractile_series.csv"), &csv)?;
     let settings = format!(
-        "- Paper scene (MODEL.md §8): 60 cells, L = 100, γ = 0.01, both pressure forms; ζ ∈ {{{}}}; seeds {}.\n\
+        "- Paper scene (docs/model.md §8): 60 cells, L = 100, γ = 0.01, both pressure forms; ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation at ζ = 0, then {t} TU; integrator {}; f32 storage.\n\
          - Verdict from the second half of the active phase; the series every 10 TU in `contractile_series.csv`, plotted in `contractile_v_rms_*.png` and `contractile_s_rms_*.png` (one per pressure form).",
         ZETAS.join(", "),

@@ -260,7 +260,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         "- Paper scene on L = 200 (240 cells), ζ = 0.005, γ = 0.014, both pressure forms; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {}; a frame every 10 TU, analysed from t = {from}.\n\
          - Each ±1/2 defect of the smoothed Q (3R box): the raw fields cropped {CROP}×{CROP} around it, rotated into its frame (u along its axis: for +1/2 the direction of ∇·Q, i.e. towards the tail; for −1/2 one of its arms) and averaged over every defect of every frame and run.\n\
-         - σ = −P·1 − ζQ (MODEL.md §3), so the isotropic stress is −P.\n\
+         - σ = −P·1 − ζQ (docs/model.md §3), so the isotropic stress is −P.\n\
          - Files: `defect_fields.csv` (every crop node, both charges and forms), `fig4a_plus_*.png`, `fig4b_minus_*.png`.",
         p.scale.seeds(),
         p.scale.integrator_name()

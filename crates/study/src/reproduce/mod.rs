@@ -1,6 +1,6 @@
 //! `monolayer reproduce FIGURE`: the paper's figures from the paper's scene, each with its
 //! data (CSV), its pictures (PNG, drawn by the `render` crate) and a verdict on every claim
-//! of MODEL.md §9 that it tests (`verdict.md`).
+//! of docs/model.md §9 that it tests (`verdict.md`).
 //!
 //! Every figure is one or more sweeps ([`crate::run_points`]) in `OUT/sweeps/NAME/`, so an
 //! interrupted `reproduce` resumes where it stopped and figures that share a sweep run it
@@ -32,7 +32,7 @@ use crate::{
 
 pub use table::Table;
 
-/// The paper's scene (MODEL.md §8): 60 cells of radius 8 in a periodic 100² box (15 cells per
+/// The paper's scene (docs/model.md §8): 60 cells of radius 8 in a periodic 100² box (15 cells per
 /// 50²), γ = 0.01, relaxed at ζ = 0 for 200 TU. Figures change the box, the activity and the
 /// run length with overrides.
 pub const PAPER_SCENE: &str = "\
@@ -206,10 +206,10 @@ impl fmt::Display for Verdict {
     }
 }
 
-/// One claim of MODEL.md §9, what was measured and the verdict.
+/// One claim of docs/model.md §9, what was measured and the verdict.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Claim {
-    /// The claim, with its number in MODEL.md §9.
+    /// The claim, with its number in docs/model.md §9.
     pub claim: String,
     /// The measured value, with its seed spread.
     pub measured: String,
@@ -397,7 +397,7 @@ fn write_verdict(
     wall_s: f64,
 ) -> Result<(), SweepError> {
     let mut s = format!(
-        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (MODEL.md §9) | measured (mean ± std over seeds) | verdict | reason |\n|---|---|---|---|\n",
+        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (docs/model.md §9) | measured (mean ± std over seeds) | verdict | reason |\n|---|---|---|---|\n",
         figure.title(),
         scale.name(),
         figure.name(),

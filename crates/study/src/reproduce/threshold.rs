@@ -361,7 +361,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
 
     let claims = verdicts(&all, &compare);
     let settings = format!(
-        "- Paper scene (MODEL.md §8), γ ∈ {{{}}}, boxes L = 100 (60 cells) and L = 200 (240 cells), both pressure forms; ζ ∈ {{{ZETAS}}}; seeds {}.\n\
+        "- Paper scene (docs/model.md §8), γ ∈ {{{}}}, boxes L = 100 (60 cells) and L = 200 (240 cells), both pressure forms; ζ ∈ {{{ZETAS}}}; seeds {}.\n\
          - Each run: 200 TU of relaxation at ζ = 0, then {t} TU at ζ; integrator {integ_name}, f32 storage.\n\
          - Protocol (`crates/study/src/threshold.rs`): the late growth rate r = d ln v_rms/dt, a least-squares slope over the second half of the active phase, of runs from the same relaxed states (seeds) at every ζ. ζ_cr (the *growth* estimate) is where the seed mean ⟨r(ζ)⟩ turns positive — the activity makes the flow grow against the relaxation — interpolated linearly between the bracketing activities. `zeta_cr_excess` is where ⟨r(ζ)⟩ − ⟨r(0)⟩ turns positive: a noise-limited lower bound (it is 0 at ζ = 0 and rises smoothly).\n\
          - `threshold_vs_run_length.csv`: the same protocol on the first T/4, T/2 and T of the same runs.{}\n\

@@ -1,0 +1,223 @@
+//! The shell blocks of the README and of `docs/gallery.md` cannot rot: every concrete
+//! `monolayer` command in them runs, in order, as written, on the shipped scenes at a small
+//! scale (the same scenes on a quarter of the area with a quarter of the cells: the same
+//! steps, times and frame numbers, a quarter of the cost); every flag of a synopsis line
+//! (`monolayer run SCENE --out DIR [--threads N] ...`) is one its subcommand accepts; every
+//! script, benchmark and example they name exists; and the README's test command is the one
+//! `.ci/run` runs. Nothing in the repository links to a file outside it.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The ```sh blocks of a Markdown file, each with its continuation lines joined.
+fn sh_blocks(path: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut blocks = Vec::new();
+    let mut current: Option<Vec<String>> = None;
+    for line in text.lines() {
+        match (&mut current, line.trim_start()) {
+            (None, l) if l.starts_with("```sh") => current = Some(Vec::new()),
+            (Some(_), l) if l.starts_with("```") => blocks.push(current.take().unwrap()),
+            (Some(b), _) => match b.last_mut() {
+                Some(last) if last.ends_with('\\') => {
+                    last.pop();
+                    last.push_str(line.trim_start());
+                }
+                // A synopsis continues on an indented line without a backslash.
+                Some(last) if line.starts_with("   ") && last.starts_with("monolayer") => {
+                    last.push(' ');
+                    last.push_str(line.trim());
+                }
+                _ => b.push(line.to_string()),
+            },
+            _ => {}
+        }
+    }
+    blocks
+}
+
+/// A synopsis line (placeholders in capitals, options in brackets) rather than a command.
+fn is_synopsis(line: &str) -> bool {
+    line.contains(" [")
+        || line
+            .split_whitespace()
+            .any(|w| ["SCENE", "DIR", "FIGURE"].contains(&w))
+}
+
+/// Checks that every `--flag` of a synopsis is in its subcommand's `--help`.
+fn check_synopsis(bin: &Path, line: &str) {
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let mut sub = vec![words[1]];
+    if words[1] == "export" {
+        sub.push(words[2]);
+    }
+    let help = Command::new(bin).args(&sub).arg("--help").output().unwrap();
+    assert!(help.status.success(), "monolayer {sub:?} --help");
+    let help = String::from_utf8_lossy(&help.stdout);
+    for w in &words {
+        let flag = w.trim_matches(|c| c == '[' || c == ']');
+        let flag = flag.split(['=', ']']).next().unwrap();
+        if flag.starts_with("--") && flag.len() > 2 {
+            assert!(
+                help.contains(&format!("{flag} ")) || help.contains(&format!("{flag}\n")),
+                "the documented `{line}` uses {flag}, which `monolayer {}` does not accept",
+                sub.join(" ")
+            );
+        }
+    }
+}
+
+/// Checks a line that is not run here: the script, bench or example it names exists, and
+/// the test command is `.ci/run`'s.
+fn check_named(line: &str) {
+    let line = line.split('#').next().unwrap().trim();
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let root = root();
+    if let Some(i) = words.iter().position(|w| *w == "--bench") {
+        let manifest = std::fs::read_to_string(root.join("benches/Cargo.toml")).unwrap();
+        let name = words[i + 1];
+        assert!(
+            manifest.contains(&format!("name = \"{name}\"")),
+            "`{line}`: no bench {name}"
+        );
+    } else if let Some(i) = words.iter().position(|w| *w == "--example") {
+        let path = root.join(format!("benches/examples/{}.rs", words[i + 1]));
+        assert!(path.exists(), "`{line}`: no {}", path.display());
+    } else if ["bash", "python3"].contains(&words[0]) {
+        assert!(root.join(words[1]).exists(), "`{line}`: no {}", words[1]);
+    } else if line.starts_with("cargo test") {
+        let ci = std::fs::read_to_string(root.join(".ci/run")).unwrap();
+        assert!(
+            ci.lines().any(|l| l.trim() == format!("{line} --locked")),
+            "the README's test command `{line}` is not what .ci/run runs"
+        );
+    }
+}
+
+/// The shipped scenes at a small scale: a quarter of the lattice and of the cells (the same
+/// density, steps and outputs).
+fn small_scenes(dir: &Path) {
+    let scenes = dir.join("scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    for e in std::fs::read_dir(root().join("scenes")).unwrap() {
+        let path = e.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut out = String::new();
+        for line in text.lines() {
+            let halved = |key: &str, div: usize| -> Option<String> {
+                let v = line.strip_prefix(key)?.trim().strip_prefix('=')?.trim();
+                let n: usize = v.parse().ok()?;
+                Some(format!("{key} = {}", (n / div).max(1)))
+            };
+            let l = halved("lx", 2)
+                .or_else(|| halved("ly", 2))
+                .or_else(|| halved("count", 4))
+                .unwrap_or_else(|| line.to_string());
+            out += &l;
+            out += "\n";
+        }
+        std::fs::write(scenes.join(path.file_name().unwrap()), out).unwrap();
+    }
+}
+
+fn run_doc(name: &str) {
+    let bin = PathBuf::from(env!("CARGO_BIN_EXE_monolayer"));
+    let dir = tempfile::tempdir().unwrap();
+    small_scenes(dir.path());
+    // `monolayer` on the PATH and at target/release/, as after a build.
+    let bin_dir = dir.path().join("target/release");
+    std::fs::create_dir_all(&bin_dir).unwrap();
+    std::os::unix::fs::symlink(&bin, bin_dir.join("monolayer")).unwrap();
+    std::fs::create_dir_all(dir.path().join("docs/gallery")).unwrap();
+    let mut script = String::from("set -euo pipefail\n");
+    let mut ran = 0;
+    for block in sh_blocks(&root().join(name)) {
+        for line in block {
+            let trimmed = line.trim();
+            if trimmed.is_empty() || trimmed.starts_with('#') {
+                continue;
+            }
+            if trimmed.starts_with("monolayer") && is_synopsis(trimmed) {
+                check_synopsis(&bin, trimmed);
+            } else if let Some(rest) = trimmed.strip_prefix("cargo run --release -- ") {
+                script += &format!("monolayer {rest}\n");
+                ran += 1;
+            } else if trimmed.starts_with("monolayer")
+                || trimmed.starts_with("for ")
+                || trimmed == "done"
+            {
+                script += &line;
+                script += "\n";
+                ran += 1;
+            } else if trimmed.starts_with("paraview") {
+                // A viewer: the files it opens must exist.
+                let file = trimmed.split_whitespace().nth(1).unwrap();
+                script += &format!("test -s {file}\n");
+            } else {
+                check_named(trimmed);
+            }
+        }
+    }
+    assert!(ran > 0, "{name} has no command to run");
+    let path = format!(
+        "{}:{}",
+        bin_dir.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let o = Command::new("bash")
+        .arg("-c")
+        .arg(&script)
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{name}'s commands failed:\n{script}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+#[test]
+fn the_readme_commands_run() {
+    run_doc("README.md");
+}
+
+#[test]
+fn the_gallery_commands_run() {
+    run_doc("docs/gallery.md");
+}
+
+/// No tracked text file points into `../shared` (or any path above the repository): a clone
+/// must be complete.
+#[test]
+fn nothing_links_outside_the_repository() {
+    let root = root();
+    let files = Command::new("git")
+        .args(["ls-files"])
+        .current_dir(&root)
+        .output()
+        .unwrap();
+    let mut bad = Vec::new();
+    for f in String::from_utf8_lossy(&files.stdout).lines() {
+        let Ok(text) = std::fs::read_to_string(root.join(f)) else {
+            continue; // binary
+        };
+        for (k, line) in text.lines().enumerate() {
+            if line.contains("../shared") || line.contains("](../") {
+                bad.push(format!("{f}:{}: {line}", k + 1));
+            }
+        }
+    }
+    // This file names the pattern it looks for.
+    bad.retain(|b| !b.starts_with("crates/cli/tests/docs.rs"));
+    assert!(
+        bad.is_empty(),
+        "links outside the repository:\n{}",
+        bad.join("\n")
+    );
+}
