@@ -26,8 +26,91 @@ pub fn parse_bytes(s: &str) -> Result<f64> {
 /// The memory available to a new process, from `/proc/meminfo` (`MemAvailable`); `None`
 /// where that cannot be read.
 pub fn available_memory() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    memory_limit().map(|(b, _)| b)
+}
+
+/// The memory this process can still use and what limits it: the smallest of the machine's
+/// `MemAvailable`, the address-space and data-size limits (`ulimit -v`, `ulimit -d`) less what
+/// the process already uses of them, and the memory limit of its cgroup and of each cgroup
+/// above it (SLURM's `--mem`, a container's limit) less their usage. `None` where none can be
+/// read.
+pub fn memory_limit() -> Option<(f64, String)> {
+    let mut best: Option<(f64, String)> = None;
+    let mut consider = |bytes: Option<f64>, what: &str| {
+        if let Some(b) = bytes {
+            if best.as_ref().is_none_or(|(m, _)| b < *m) {
+                best = Some((b.max(0.0), what.to_string()));
+            }
+        }
+    };
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+    consider(
+        kib_field(&meminfo, "MemAvailable:"),
+        "the memory available on this machine",
+    );
+    let limits = std::fs::read_to_string("/proc/self/limits").unwrap_or_default();
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let limit = |name: &str| -> Option<f64> {
+        let line = limits.lines().find(|l| l.starts_with(name))?;
+        line[name.len()..].split_whitespace().next()?.parse().ok()
+    };
+    if let (Some(max), Some(used)) = (limit("Max address space"), kib_field(&status, "VmSize:")) {
+        consider(
+            Some(max - used),
+            "the address-space limit (ulimit -v) less what this process already uses",
+        );
+    }
+    if let (Some(max), Some(used)) = (limit("Max data size"), kib_field(&status, "VmData:")) {
+        consider(
+            Some(max - used),
+            "the data-size limit (ulimit -d) less what this process already uses",
+        );
+    }
+    // cgroup v2: this process's cgroup and each one above it.
+    let cgroup = std::fs::read_to_string("/proc/self/cgroup").unwrap_or_default();
+    if let Some(path) = cgroup.lines().find_map(|l| l.strip_prefix("0::")) {
+        let mut dir = std::path::PathBuf::from("/sys/fs/cgroup").join(path.trim_start_matches('/'));
+        loop {
+            let read = |f: &str| -> Option<f64> {
+                std::fs::read_to_string(dir.join(f))
+                    .ok()?
+                    .trim()
+                    .parse()
+                    .ok()
+            };
+            if let (Some(max), Some(used)) = (read("memory.max"), read("memory.current")) {
+                consider(
+                    Some(max - used),
+                    "the memory limit of this process's cgroup less its usage",
+                );
+            }
+            if dir == std::path::Path::new("/sys/fs/cgroup") || !dir.pop() {
+                break;
+            }
+        }
+    }
+    // cgroup v1.
+    let v1 = std::path::Path::new("/sys/fs/cgroup/memory");
+    let read = |f: &str| -> Option<f64> {
+        std::fs::read_to_string(v1.join(f))
+            .ok()?
+            .trim()
+            .parse()
+            .ok()
+    };
+    if let (Some(max), Some(used)) = (read("memory.limit_in_bytes"), read("memory.usage_in_bytes"))
+    {
+        consider(
+            Some(max - used),
+            "the memory limit of this process's cgroup less its usage",
+        );
+    }
+    best
+}
+
+/// A `Name:   123 kB` field of a /proc file, in bytes.
+fn kib_field(text: &str, name: &str) -> Option<f64> {
+    let line = text.lines().find(|l| l.starts_with(name))?;
     let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     Some(kb * 1024.0)
 }
@@ -56,8 +139,8 @@ pub fn memory(scene: &Scene, max_memory: Option<&str>) -> Result<()> {
 pub fn memory_of(scene: &Scene, runs: usize, max_memory: Option<&str>) -> Result<()> {
     let (limit, what) = match max_memory {
         Some(m) => (parse_bytes(m)?, format!("--max-memory {m}")),
-        None => match available_memory() {
-            Some(a) => (a, "the memory available on this machine".to_string()),
+        None => match memory_limit() {
+            Some(limit) => limit,
             None => return Ok(()),
         },
     };

@@ -10,6 +10,7 @@
 #![deny(missing_docs)]
 
 pub mod guard;
+pub mod lines;
 pub mod reproduce;
 pub mod run;
 pub mod sweep;

@@ -18,7 +18,7 @@ struct Progress {
     bar: Mutex<Option<ProgressBar>>,
     done: AtomicU64,
     total: AtomicU64,
-    next_line: AtomicU64,
+    lines: Mutex<crate::lines::Lines>,
 }
 
 impl Reporter for Progress {
@@ -32,7 +32,7 @@ impl Reporter for Progress {
         }
         self.done.store(0, Ordering::Relaxed);
         self.total.store(steps, Ordering::Relaxed);
-        self.next_line.store(0, Ordering::Relaxed);
+        *self.lines.lock().unwrap_or_else(|e| e.into_inner()) = crate::lines::Lines::new();
         if runs == 0 {
             eprintln!("sweep {name}: every run is complete");
             return;
@@ -58,11 +58,12 @@ impl Reporter for Progress {
         let bar = self.bar.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(b) = bar.as_ref() {
             b.set_position(d);
-        } else if d >= self.next_line.load(Ordering::Relaxed) {
+        } else {
             let total = self.total.load(Ordering::Relaxed);
-            self.next_line
-                .store(d + total.div_ceil(10).max(1), Ordering::Relaxed);
-            eprintln!("  {d}/{total} steps");
+            let mut lines = self.lines.lock().unwrap_or_else(|e| e.into_inner());
+            if lines.due(d as f64, total as f64) {
+                eprintln!("  {d}/{total} steps");
+            }
         }
     }
 
@@ -100,7 +101,7 @@ pub fn run(
         bar: Mutex::new(None),
         done: AtomicU64::new(0),
         total: AtomicU64::new(0),
-        next_line: AtomicU64::new(0),
+        lines: Mutex::new(crate::lines::Lines::new()),
     });
     let params = ReproduceParams::new(
         out.to_path_buf(),

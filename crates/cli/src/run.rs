@@ -170,7 +170,7 @@ struct Progress {
     bar: Option<ProgressBar>,
     end: f64,
     quiet: bool,
-    next_line: f64,
+    lines: crate::lines::Lines,
 }
 
 /// Bar positions per run.
@@ -192,7 +192,7 @@ impl Progress {
             bar,
             end,
             quiet,
-            next_line: 0.0,
+            lines: crate::lines::Lines::new(),
         }
     }
 }
@@ -209,9 +209,8 @@ impl<T: Real> Callback<T> for Progress {
             };
             b.set_position((done * PROGRESS_TICKS as f64) as u64);
             b.set_message(format!("step {step}  t = {time:.1}  v_rms = {v_rms:.3e}"));
-        } else if !self.quiet && (time >= self.next_line || time >= end) {
+        } else if !self.quiet && self.lines.due(time, end) {
             eprintln!("step {step}  t = {time:.1}/{end}  v_rms = {v_rms:.3e}");
-            self.next_line = time + end / 10.0;
         }
         Ok(())
     }

@@ -163,15 +163,19 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
         b
     });
     let done = Arc::new(AtomicU64::new(0));
-    let next_line = Arc::new(AtomicU64::new(0));
-    let (quiet, tick) = (a.quiet, total.div_ceil(10).max(1));
+    let lines = std::sync::Mutex::new(crate::lines::Lines::new());
+    let quiet = a.quiet;
     let progress_bar = bar.clone();
     let progress = Arc::new(move |n: u64| {
         let d = done.fetch_add(n, Ordering::Relaxed) + n;
         if let Some(b) = &progress_bar {
             b.set_position(d);
-        } else if !quiet && d >= next_line.load(Ordering::Relaxed) {
-            next_line.store(d + tick, Ordering::Relaxed);
+        } else if !quiet
+            && lines
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .due(d as f64, total as f64)
+        {
             eprintln!("{d}/{total} steps");
         }
     });

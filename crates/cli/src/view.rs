@@ -9,7 +9,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 /// nothing when `quiet`. Call it with `(done, total)`.
 pub fn frames_progress(what: &'static str, quiet: bool) -> impl FnMut(usize, usize) {
     let mut bar: Option<ProgressBar> = None;
-    let mut next_line = 0;
+    let mut lines = crate::lines::Lines::new();
     move |done, total| {
         if quiet {
             return;
@@ -29,9 +29,8 @@ pub fn frames_progress(what: &'static str, quiet: bool) -> impl FnMut(usize, usi
             if done == total {
                 b.finish();
             }
-        } else if done >= next_line || done == total {
+        } else if lines.due(done as f64, total as f64) {
             eprintln!("{done}/{total} frames {what}");
-            next_line = done + total.div_ceil(10).max(1);
         }
     }
 }

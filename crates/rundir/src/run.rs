@@ -82,6 +82,16 @@ pub enum RunError {
         /// The run's active time.
         time: f64,
     },
+    /// `--resume --set run.time=T` with `T` at or before the newest checkpoint.
+    #[error("--set run.time would end the run at {end}, at or before its newest checkpoint {} (active time {time}); --resume only extends a run: give run.time above {time}, or start a new run", path.display())]
+    Shortened {
+        /// The checkpoint.
+        path: PathBuf,
+        /// Where the shortened run would end.
+        end: String,
+        /// The checkpoint's active time.
+        time: f64,
+    },
     /// `--resume` with an override other than `run.time`.
     #[error("--resume continues the run as it was: only --set run.time=T (to extend it) can change; {key} would make it another run (start a new scene instead)")]
     Override {
@@ -247,7 +257,9 @@ impl RunDir {
             });
         }
         let lock = lock(dir)?;
-        let own = std::fs::read_to_string(dir.join("scene.toml")).ok();
+        let own = std::fs::read_to_string(dir.join("scene.toml"))
+            .ok()
+            .map(|s| legacy(&s));
         let all = checkpoint::checkpoints(dir);
         if all.is_empty() {
             return Err(RunError::NoCheckpoint {
@@ -286,6 +298,17 @@ impl RunDir {
                 ),
                 None => (*step >= total, format!("step {step} of {total}")),
             };
+            if complete && !set.is_empty() {
+                let end = match scene.adaptive() {
+                    Some(_) => format!("t = {}", scene.end_time()),
+                    None => format!("step {total}"),
+                };
+                return Err(RunError::Shortened {
+                    path: path.clone(),
+                    end,
+                    time: (time - scene.file().run.relax_time).max(0.0),
+                });
+            }
             if complete {
                 return Err(RunError::Complete {
                     dir: dir.to_path_buf(),
@@ -480,9 +503,22 @@ fn scene_diff(own: &str, other: &str) -> String {
     out.join("; ")
 }
 
+/// A resolved scene written before `[integrator] tolerance` became adaptive-only: those carried
+/// the default `tolerance = 0.001` in every scene, which now would be refused without
+/// `adaptive = true` (where it had no effect).
+fn legacy(text: &str) -> String {
+    if !text.lines().any(|l| l.trim() == "adaptive = false") {
+        return text.to_string();
+    }
+    text.lines()
+        .filter(|l| l.trim() != "tolerance = 0.001")
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
+
 /// The scene a checkpoint carries, with `set` applied.
 fn read_scene(path: &Path, set: &[String]) -> Result<Scene> {
-    let text = checkpoint::checkpoint_scene(path)?;
+    let text = legacy(&checkpoint::checkpoint_scene(path)?);
     Scene::parse(&text, set).map_err(|e| RunError::Scene {
         context: format!("the scene in {}", path.display()),
         source: Box::new(e),

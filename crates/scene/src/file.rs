@@ -138,8 +138,10 @@ pub struct Integrator {
     pub adaptive: bool,
     /// With `adaptive`: the largest local error per step, max over cells and nodes of
     /// |φ_Heun − φ_Euler| (default 1e-3; the global error after 20 TU is about 0.1 × this at
-    /// the paper's parameters, `docs/performance.md`).
-    pub tolerance: f64,
+    /// the paper's parameters, `docs/performance.md`). Refused without `adaptive`, where it
+    /// would have no effect.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
     /// With `adaptive`: the largest step (default: the stability estimate of the active
     /// phase, as for a fixed `dt`).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -158,7 +160,7 @@ impl Default for Integrator {
             precision: Precision::default(),
             stability_check: true,
             adaptive: false,
-            tolerance: 1e-3,
+            tolerance: None,
             dt_max: None,
         }
     }
@@ -279,7 +281,17 @@ fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
         .ok_or_else(|| bad("the key needs a section"))?;
     let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {}", value.trim())) {
         Ok(mut t) => t.remove("v").expect("parsed"),
-        Err(_) => toml::Value::String(value.trim().to_string()),
+        Err(_) => {
+            let v = value.trim();
+            let digits = v.strip_prefix(['-', '+']).unwrap_or(v);
+            if !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit() || c == '_') {
+                return Err(bad(&format!(
+                    "{v} is out of range (integers in a scene are at most {})",
+                    i64::MAX
+                )));
+            }
+            toml::Value::String(v.to_string())
+        }
     };
     let sec = table
         .entry(section.to_string())

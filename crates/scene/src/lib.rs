@@ -196,7 +196,8 @@ impl Scene {
             return None;
         }
         let dt_max = it.dt_max.unwrap_or_else(|| self.file.stability_estimate());
-        let mut p = AdaptiveParams::new(it.tolerance, dt_max);
+        let mut p =
+            AdaptiveParams::new(it.tolerance.unwrap_or(validate::DEFAULT_TOLERANCE), dt_max);
         let r = &self.file.run;
         p.dt_min = ((r.relax_time + r.time) / MAX_STEPS).max(1e-9).min(dt_max);
         Some(p)

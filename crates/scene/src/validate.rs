@@ -47,6 +47,9 @@ pub const MAX_SIDE: usize = 65536;
 /// for the smallest scenes, and far below where the step counter or the clock lose precision.
 pub const MAX_STEPS: f64 = 1e9;
 
+/// The adaptive step's tolerance when `[integrator] tolerance` is not given.
+pub const DEFAULT_TOLERANCE: f64 = 1e-3;
+
 /// `v` with three significant digits, never rounded to 0.
 pub(crate) fn sig3(v: f64) -> String {
     if v != 0.0 && !(0.01..1e4).contains(&v.abs()) {
@@ -66,9 +69,19 @@ fn invalid(
     SceneError::Invalid {
         section,
         key,
-        value: value.to_string(),
+        value: readable(value.to_string()),
         problem: problem.into(),
         fix: fix.into(),
+    }
+}
+
+/// A number as a person reads it: `1e-300`, not three hundred zeros.
+fn readable(v: String) -> String {
+    match v.parse::<f64>() {
+        Ok(x) if x != 0.0 && x.is_finite() && (x.abs() < 1e-4 || x.abs() >= 1e12) => {
+            format!("{x:e}")
+        }
+        _ => v,
     }
 }
 
@@ -119,7 +132,25 @@ impl SceneFile {
                 "use a radius of a few nodes (paper: 8)",
             ));
         }
+        if c.radius.is_finite() && c.radius < 1.0 {
+            return Err(invalid(
+                "cells",
+                "radius",
+                c.radius,
+                "a cell smaller than one node cannot be resolved",
+                "use a radius of a few nodes (paper: 8)",
+            ));
+        }
         let r0 = self.init_radius();
+        if c.init_radius.is_none() && r0 < 1.0 {
+            return Err(invalid(
+                "cells",
+                "radius",
+                c.radius,
+                format!("the initial discs (radius R/2 = {r0} by default) must be at least one node wide"),
+                "use a radius of 2 or more (paper: 8), or set init_radius = 1",
+            ));
+        }
         if !(r0.is_finite() && r0 >= 1.0 && r0 <= c.radius) {
             return Err(invalid(
                 "cells",
@@ -132,15 +163,6 @@ impl SceneFile {
                 ),
             ));
         }
-        if c.radius.is_finite() && c.radius < 1.0 {
-            return Err(invalid(
-                "cells",
-                "radius",
-                c.radius,
-                "a cell smaller than one node cannot be resolved",
-                "use a radius of a few nodes (paper: 8)",
-            ));
-        }
         if let (InitKind::Positions, Some(p)) = (c.init, &c.positions) {
             if p.len() != c.count {
                 return Err(invalid(
@@ -150,6 +172,32 @@ impl SceneFile {
                     format!("count = {} cells but {} positions", c.count, p.len()),
                     "give one [x, y] pair per cell, or set count to the number of positions",
                 ));
+            }
+            // Two discs whose centres are closer than their radius start stacked: nothing
+            // separates two identical fields at one place (the force between them is zero by
+            // symmetry), so the run would go on with one cell on top of another.
+            let periodic = |a: f64, b: f64, l: usize| {
+                let l = l as f64;
+                let d = (a - b).rem_euclid(l);
+                d.min(l - d)
+            };
+            for i in 0..p.len() {
+                for j in 0..i {
+                    let dx = periodic(p[i][0], p[j][0], d.lx);
+                    let dy = periodic(p[i][1], p[j][1], d.ly);
+                    let dist = dx.hypot(dy);
+                    if dist < r0 {
+                        return Err(invalid(
+                            "cells",
+                            "positions",
+                            format!("[..., {:?}, ..., {:?}, ...]", p[j], p[i]),
+                            format!(
+                                "cells {j} and {i} are {dist:.3} nodes apart (periodically), closer than the initial radius {r0}: they would start stacked"
+                            ),
+                            format!("place the centres at least {r0} apart (2R = {} for cells that just touch)", 2.0 * c.radius),
+                        ));
+                    }
+                }
             }
         }
         match (c.init, &c.positions) {
@@ -263,11 +311,12 @@ impl SceneFile {
             return Err(invalid("integrator", "dt", it.dt, format!("the explicit scheme is unstable above dt ≈ {} for these parameters (a conservative estimate; docs/stability.csv)", sig3(dt_max)), format!("use dt ≤ {} (the paper uses 0.2), or set [integrator] stability_check = false to run above the estimate at your own risk", sig3(dt_max))));
         }
         if it.adaptive {
-            if !(it.tolerance.is_finite() && it.tolerance > 0.0 && it.tolerance < 1.0) {
+            let tolerance = it.tolerance.unwrap_or(DEFAULT_TOLERANCE);
+            if !(tolerance.is_finite() && tolerance > 0.0 && tolerance < 1.0) {
                 return Err(invalid(
                     "integrator",
                     "tolerance",
-                    it.tolerance,
+                    tolerance,
                     "the local error tolerance must lie between 0 and 1 (φ itself is of order 1)",
                     "use 1e-3 (about the default fixed step's error) or 1e-4 for more accuracy",
                 ));
@@ -282,6 +331,23 @@ impl SceneFile {
                         "leave it out (the stability estimate) or give a positive step",
                     ));
                 }
+                // The fixed step's bound on the number of steps, for the largest adaptive one.
+                let total = self.run.relax_time + self.run.time;
+                if total / v > MAX_STEPS {
+                    return Err(invalid(
+                        "integrator",
+                        "dt_max",
+                        v,
+                        format!(
+                            "relax_time + time = {total} with steps of at most {} is more than the {MAX_STEPS:.0e} steps a run may take",
+                            readable(v.to_string())
+                        ),
+                        format!(
+                            "leave dt_max out (the stability estimate) or give at least {}",
+                            sig3(total / MAX_STEPS)
+                        ),
+                    ));
+                }
             }
             if it.npc != 1 {
                 return Err(invalid(
@@ -292,14 +358,18 @@ impl SceneFile {
                     "set npc = 1 or adaptive = false",
                 ));
             }
-        } else if let Some(v) = it.dt_max {
-            return Err(invalid(
-                "integrator",
-                "dt_max",
-                v,
-                "dt_max is only read with adaptive = true",
-                "set adaptive = true or remove dt_max",
-            ));
+        } else {
+            for (key, v) in [("dt_max", it.dt_max), ("tolerance", it.tolerance)] {
+                if let Some(v) = v {
+                    return Err(invalid(
+                        "integrator",
+                        key,
+                        v,
+                        format!("{key} is only read with adaptive = true"),
+                        format!("set adaptive = true or remove {key}"),
+                    ));
+                }
+            }
         }
         if it.npc > 16 {
             return Err(invalid(

@@ -151,8 +151,15 @@ pub(crate) struct FrameList {
 /// counted and skipped, and the steps of the scene's frame schedule without a frame noted.
 pub(crate) fn list_frames(run_dir: &Path, scene: &Scene) -> Result<FrameList> {
     let dir = run_dir.join("frames");
-    let entries = std::fs::read_dir(&dir)
-        .map_err(|_| input(run_dir, "no frames/ directory: the run wrote no frame yet"))?;
+    let entries = std::fs::read_dir(&dir).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound if std::fs::symlink_metadata(&dir).is_err() => {
+            input(run_dir, "no frames/ directory: the run wrote no frame yet")
+        }
+        _ => input(
+            &dir,
+            format!("cannot be read ({e}); it should be the directory of frame_STEP.npz files the run wrote"),
+        ),
+    })?;
     let (mut frames, mut partial, mut stray) = (Vec::new(), 0, Vec::new());
     for e in entries {
         let p = e.map_err(|e| input(&dir, e.to_string()))?.path();
@@ -404,13 +411,34 @@ pub(crate) fn load_frame(
         step,
         (0..n).collect(),
     );
+    // The per-cell arrays must describe the cells of `phi`, in its order: each stored centre
+    // must be the centre of mass of its field (to a tenth of a node: f32 storage rounds it by
+    // about 1e-5), or pictures and ParaView files would put one cell's values on another.
+    let centres = pairs(&centre);
+    for (i, (c, m)) in centres.iter().zip(tissue.centres()).enumerate() {
+        let wrap = |d: f64, l: usize| {
+            let l = l as f64;
+            let d = d.rem_euclid(l);
+            d.min(l - d)
+        };
+        let off = wrap(c[0] - m[0], lattice.lx).hypot(wrap(c[1] - m[1], lattice.ly));
+        if off > 0.1 {
+            return Err(input(
+                path,
+                format!(
+                    "array 'centre' puts cell {i} at ({:.2}, {:.2}) but its phi has its centre of mass at ({:.2}, {:.2}): the per-cell arrays do not belong to the fields in this order (was the frame edited?); rewrite the frame or leave it out with --frames",
+                    c[0], c[1], m[0], m[1]
+                ),
+            ));
+        }
+    }
     Ok(LoadedFrame {
         tissue,
         step,
         origins,
         phi: phi.data,
         shapes: pairs(&shape_tensor),
-        centres: pairs(&centre),
+        centres,
         velocities: pairs(&velocity),
         areas: area.data,
     })

@@ -255,6 +255,17 @@ fn cell_means(frame: &LoadedFrame, nx: usize, ny: usize, field: &[f64]) -> Vec<f
 }
 
 /// Draws one frame.
+/// The least share of the smoothing box that cells must cover (box-smoothed `Σ φ_i`) for
+/// `render` to draw the director and defects there: half, so that the thin gaps at cell
+/// junctions count as tissue and the gaps between initial discs (a third covered at the
+/// paper's density and R/2 discs) do not.
+pub const TISSUE_COVER: f64 = 0.5;
+
+/// The least smoothed `|Q|` where `render` draws the director and defects: a twentieth of the
+/// deformation of a cell in a confluent tissue at the paper's parameters (`|S_i|` ≈ 1–2), far
+/// above that of the round initial discs (zero but for the lattice's anisotropy).
+pub const TISSUE_Q: f64 = 0.05;
+
 fn picture(
     run: &Run,
     frame: &LoadedFrame,
@@ -313,9 +324,31 @@ fn picture(
         if opts.director || opts.defects {
             let side = default_box(&run.scene);
             let smooth = |v: &[f64]| box_smooth(l, v, side).expect("the box fits the lattice");
-            let (qxx, qxy) = (smooth(&f.qxx), smooth(&f.qxy));
+            let (mut qxx, mut qxy) = (smooth(&f.qxx), smooth(&f.qxy));
+            // Only where there is tissue: the director of Q, and its defects, mean nothing in
+            // the empty gaps between cells (between the initial discs, |Q| ≈ 0 and its angle
+            // is noise). Tissue is where cells cover at least TISSUE_COVER of the smoothing box
+            // and the smoothed |Q| is at least TISSUE_Q.
+            let (phi_sum, _) = phi_sum_and_owner(frame, shape.nx, shape.ny);
+            let cover = smooth(&phi_sum.iter().map(|&v| f64::from(v)).collect::<Vec<_>>());
+            let tissue: Vec<bool> = (0..cover.len())
+                .map(|k| cover[k] >= TISSUE_COVER && qxx[k].hypot(qxy[k]) >= TISSUE_Q)
+                .collect();
             if opts.defects {
-                p.defects = detect(l, &qxx, &qxy);
+                p.defects = detect(l, &qxx, &qxy)
+                    .into_iter()
+                    .filter(|d| {
+                        let x = (d.x.round() as usize) % l.lx;
+                        let y = (d.y.round() as usize) % l.ly;
+                        tissue[x * l.ly + y]
+                    })
+                    .collect();
+            }
+            for k in 0..cover.len() {
+                if !tissue[k] {
+                    qxx[k] = 0.0;
+                    qxy[k] = 0.0;
+                }
             }
             if opts.director {
                 p.director = Some(LatticeVectors {
