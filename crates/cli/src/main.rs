@@ -299,6 +299,8 @@ fn main() -> ExitCode {
 /// What `run` prints at its end, and its exit status: 0, or 128 + the signal that stopped it.
 fn finished(info: &run::RunInfo, dir: &std::path::Path, quiet: bool) -> ExitCode {
     if let Some((step, time, signal)) = info.stopped {
+        // To nine digits: the clock sums steps (778.0000000000399 for 778).
+        let time = (time * 1e9).round() / 1e9;
         // Printed even with --quiet: the run did not do what was asked.
         eprintln!(
             "stopped at step {step} (t = {time}): resume with monolayer run --resume {}",

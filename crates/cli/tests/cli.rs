@@ -1368,3 +1368,272 @@ fn a_full_disk_stops_the_run_cleanly_and_it_resumes_bit_for_bit() {
         assert!(g == w, "{} differs", w.0);
     }
 }
+
+/// Issue 25's cases, each a regression test: every one ends in a clear error that names the
+/// key and a fix, before anything is written (where it gave exit 0 and a wrong run, an abort
+/// or a hang before).
+#[test]
+fn scenes_that_did_something_else_than_asked_are_refused_with_the_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &str); 8] = [
+        (
+            &["integrator.tolerance=-5"],
+            "[integrator] tolerance = -5: tolerance is only read with adaptive = true",
+        ),
+        (
+            &["integrator.tolerance=1e-4"],
+            "tolerance is only read with adaptive = true; set adaptive = true or remove tolerance",
+        ),
+        (
+            &["integrator.adaptive=true", "integrator.dt_max=1e-300"],
+            "[integrator] dt_max = 1e-300: relax_time + time = 1200 with steps of at most 1e-300 is more than the 1e9 steps",
+        ),
+        (
+            &["cells.count=18446744073709551615"],
+            "18446744073709551615 is out of range",
+        ),
+        (
+            &["cells.radius=0.5"],
+            "[cells] radius = 0.5: a cell smaller than one node",
+        ),
+        (
+            &["cells.radius=1.5"],
+            "[cells] radius = 1.5: the initial discs (radius R/2 = 0.75 by default)",
+        ),
+        (
+            &[
+                "cells.init=\"positions\"",
+                "cells.count=3",
+                "cells.positions=[[5,5],[5,5],[5,5]]",
+            ],
+            "cells 0 and 1 are 0.000 nodes apart (periodically), closer than the initial radius 4: they would start stacked",
+        ),
+        (
+            &[
+                "cells.init=\"positions\"",
+                "cells.count=2",
+                "cells.positions=[[1,50],[99.5,50]]",
+            ],
+            "cells 0 and 1 are 1.500 nodes apart (periodically)",
+        ),
+    ];
+    for (k, (set, needle)) in cases.iter().enumerate() {
+        let out = dir.path().join(format!("case{k}"));
+        let mut args = Vec::new();
+        for s in *set {
+            args.extend(["--set", s]);
+        }
+        let o = run(&scene_path("paper.toml"), &out, &args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{set:?}: {err}");
+        assert!(err.contains(needle), "{set:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(
+            !out.exists(),
+            "{set:?}: the refused run wrote {}",
+            out.display()
+        );
+    }
+}
+
+/// A checkpoint of another run (another ζ) put into a run directory is refused by `--resume`,
+/// which names the file and the key that differs and leaves the directory as it was; a
+/// `--resume --set run.time=T` that would end before the newest checkpoint says so.
+#[test]
+fn a_foreign_checkpoint_and_a_shortened_resume_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut args = SHORT.to_vec();
+    args.extend(["--set", "run.checkpoint_every=2"]);
+    let a = dir.path().join("a");
+    assert!(run(&scene_path("paper.toml"), &a, &args).status.success());
+    let mut other = args.clone();
+    other.extend(["--set", "model.zeta=0.01"]);
+    let b = dir.path().join("b");
+    assert!(run(&scene_path("paper.toml"), &b, &other).status.success());
+    let (_, newest) = rundir::checkpoint::checkpoints(&b).pop().unwrap();
+    let foreign = a.join("checkpoints/checkpoint_000000000999.npz");
+    std::fs::copy(newest, &foreign).unwrap();
+    let before = (
+        std::fs::read(a.join("series.csv")).unwrap(),
+        std::fs::read(a.join("scene.toml")).unwrap(),
+    );
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&a)
+        .args(["--set", "run.time=20"])
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{err}");
+    assert!(
+        err.contains("checkpoint_000000000999.npz was not written by the run in")
+            && err.contains("model.zeta is 0.01 there, 0.005 here"),
+        "{err}"
+    );
+    let after = (
+        std::fs::read(a.join("series.csv")).unwrap(),
+        std::fs::read(a.join("scene.toml")).unwrap(),
+    );
+    assert!(before == after, "the refused resume changed the run");
+    std::fs::remove_file(&foreign).unwrap();
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&a)
+        .args(["--set", "run.time=2"])
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(
+        !o.status.success()
+            && err.contains("--set run.time would end the run at step 30")
+            && err.contains("give run.time above 6"),
+        "{err}"
+    );
+}
+
+/// Frames whose per-cell arrays are rolled by one cell against `phi` (each cell given its
+/// neighbour's centre, velocity, ...) are refused by `render`, `export vtk` and `analyze`,
+/// naming the frame and the cell; a `frames/` that cannot be read (a symlink loop) is named as
+/// such, not as "no frame yet".
+#[test]
+fn frames_whose_cells_do_not_match_their_phi_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let rd = dir.path().join("run");
+    assert!(run(&scene_path("paper.toml"), &rd, &SHORT).status.success());
+    let f = rd.join("frames/frame_00000050.npz");
+    rewrite_frame(&f, |name, d| {
+        if ["centre", "velocity", "force", "area", "shape_tensor"].contains(&name) {
+            let per = if name == "area" { 1 } else { 2 };
+            d.rotate_left(per);
+        }
+    });
+    for args in [
+        vec!["render", "--frames", "50", "--out"],
+        vec!["export", "vtk", "--frames", "50", "--out"],
+    ] {
+        let o = bin()
+            .args(&args)
+            .arg(dir.path().join("view"))
+            .arg(&rd)
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert!(
+            !o.status.success()
+                && err.contains("frame_00000050.npz")
+                && err.contains("array 'centre' puts cell 0 at"),
+            "{args:?}: {err}"
+        );
+    }
+    let o = bin().arg("analyze").arg(&rd).output().unwrap();
+    assert!(
+        stderr(&o).contains("array 'centre' puts cell 0"),
+        "{}",
+        stderr(&o)
+    );
+    let frames = rd.join("frames");
+    std::fs::remove_dir_all(&frames).unwrap();
+    std::os::unix::fs::symlink(&frames, &frames).unwrap();
+    let o = bin().arg("analyze").arg(&rd).output().unwrap();
+    let err = stderr(&o);
+    assert!(
+        !o.status.success() && err.contains("cannot be read") && !err.contains("no frame yet"),
+        "{err}"
+    );
+}
+
+/// A redone sweep run drops its earlier analysis (it described another run) and is analysed
+/// afresh; `sweep --analyze` takes `analyze`'s options; on a lattice too small for the default
+/// crop, `analyze` fits the crop to it instead of refusing.
+#[test]
+fn a_redone_sweep_run_is_analysed_afresh_on_a_small_lattice() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = || {
+        bin()
+            .arg("sweep")
+            .arg(scene_path("paper.toml"))
+            .args(["--vary", "model.zeta=0,0.01", "--seeds", "1"])
+            .args([
+                "--set",
+                "domain.lx=40",
+                "--set",
+                "domain.ly=40",
+                "--set",
+                "cells.count=9",
+            ])
+            .args(SHORT)
+            .args(["--analyze", "--from", "4", "--box", "9", "--quiet", "--out"])
+            .arg(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = sweep();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let run0 = dir.path().join("runs/model.zeta=0_seed=1");
+    let opts = std::fs::read_to_string(run0.join("analysis/complete")).unwrap();
+    // Analysed with the sweep's --box, and the default crop fitted to the 40² lattice (101
+    // would be refused there).
+    assert!(opts.contains("box_side: Some(9)"), "{opts}");
+    assert!(run0.join("analysis/defect_averages.npz").exists());
+    std::fs::write(run0.join("analysis/stale"), "from the run before").unwrap();
+    std::fs::remove_file(run0.join("complete")).unwrap();
+    let o = sweep();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        !run0.join("analysis/stale").exists(),
+        "the old analysis was kept"
+    );
+    assert!(run0.join("analysis/complete").exists());
+    // Analysis options without --analyze are refused.
+    let o = bin()
+        .arg("sweep")
+        .arg(scene_path("paper.toml"))
+        .args(["--vary", "model.zeta=0", "--crop", "21", "--out"])
+        .arg(dir.path().join("x"))
+        .output()
+        .unwrap();
+    assert!(stderr(&o).contains("add --analyze"), "{}", stderr(&o));
+}
+
+/// Under an address-space limit (`ulimit -v`, as a batch system sets) a scene that does not
+/// fit is refused with the limit named, where it aborted on allocation; a run's log (stderr
+/// not a terminal) gets about ten progress lines.
+#[test]
+fn the_memory_guard_reads_the_process_limits_and_logs_are_short() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = format!(
+        "ulimit -v 6000000; exec {} run {} --out {} --set domain.lx=3000 --set domain.ly=3000 --set integrator.margin=0",
+        env!("CARGO_BIN_EXE_monolayer"),
+        scene_path("paper.toml").display(),
+        dir.path().join("big").display()
+    );
+    let o = Command::new("bash")
+        .arg("-c")
+        .arg(&script)
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the address-space limit (ulimit -v)") && err.contains("reduce [cells] count"),
+        "{err}"
+    );
+    let o = bin()
+        .arg("run")
+        .arg(scene_path("paper.toml"))
+        .arg("--out")
+        .arg(dir.path().join("log"))
+        .args(["--set", "run.time=100", "--set", "run.relax_time=20"])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let lines = stderr(&o)
+        .lines()
+        .filter(|l| l.starts_with("step "))
+        .count();
+    assert!(
+        (10..=13).contains(&lines),
+        "{lines} progress lines:\n{}",
+        stderr(&o)
+    );
+}

@@ -306,7 +306,8 @@ impl RunDir {
                 return Err(RunError::Shortened {
                     path: path.clone(),
                     end,
-                    time: (time - scene.file().run.relax_time).max(0.0),
+                    // To nine digits: the clock sums steps (5.9999999999999964 for 6).
+                    time: ((time - scene.file().run.relax_time).max(0.0) * 1e9).round() / 1e9,
                 });
             }
             if complete {
