@@ -188,3 +188,44 @@ fn a_second_writer_is_refused_and_a_second_signal_exits_at_once() {
     let o = child.wait_with_output().unwrap();
     assert_eq!(o.status.code(), Some(143), "{}", stderr(&o));
 }
+
+/// SIGTERM during a local sweep stops the run in progress after its step, with a checkpoint,
+/// lists it, and exits 143; the same command then continues it (and the runs not started), and
+/// the summary equals that of a sweep never stopped.
+#[test]
+fn a_signalled_sweep_stops_and_the_same_command_continues_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = |out: &Path| {
+        let mut c = bin();
+        c.arg("sweep")
+            .arg(paper())
+            .args(["--vary", "model.zeta=0.004,0.006", "--seeds", "1"])
+            .args(["--jobs", "1", "--threads", "1", "--quiet", "--out"])
+            .arg(out)
+            .args(&ARGS[..8]);
+        c
+    };
+    let whole = dir.path().join("whole");
+    let o = sweep(&whole).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let want = std::fs::read_to_string(whole.join("summary.csv")).unwrap();
+    let out = dir.path().join("stopped");
+    let child = sweep(&out).stderr(Stdio::piped()).spawn().unwrap();
+    wait_for_lock(&out.join("runs/model.zeta=0.004_seed=1"));
+    std::thread::sleep(Duration::from_millis(150));
+    send(&child, "TERM");
+    let o = child.wait_with_output().unwrap();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(143), "{err}");
+    assert!(
+        err.contains("stopped by signal 15")
+            && err.contains("model.zeta=0.004_seed=1 at step")
+            && err.contains("run the same sweep command again"),
+        "{err}"
+    );
+    assert!(!out.join("summary.csv").exists());
+    let o = sweep(&out).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let got = std::fs::read_to_string(out.join("summary.csv")).unwrap();
+    assert_eq!(got, want, "the continued sweep differs from the whole one");
+}
