@@ -2,14 +2,10 @@
 //! bit-identical for any thread count, and a resumed run (mid-run checkpoint, controller
 //! state included) ends byte-identical to the uninterrupted one.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
-use crate::common::run_files;
-
-fn paper() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")
-}
+use crate::common::{paper, run_files};
 
 /// `monolayer ARGS PATHS`.
 fn monolayer(args: &[&str], paths: &[&Path]) -> Output {

@@ -1,20 +1,10 @@
 //! The `monolayer` binary end to end: output files, reproducibility across thread counts, and
 //! every bad-scene case with its message and exit status.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
-use crate::common::run_files;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_monolayer"))
-}
-
-fn scene_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name)
-}
+use crate::common::{bin, run_files, scene_path, stderr};
 
 fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut c = bin();
@@ -23,10 +13,6 @@ fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
         c.arg(e);
     }
     c.output().expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// A short version of the paper scene: 4 TU relaxation, 6 TU activity.

@@ -2,12 +2,9 @@
 //! on any margin and precision, and a state that does not fit is refused before anything is
 //! written.
 
+use crate::common::paper;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn paper() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")
-}
 
 fn run(scene: &Path, out: &Path, set: &[&str], extra: &[&str]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_monolayer"));

@@ -2,23 +2,11 @@
 //! line that says how to resume; the resumed run ends byte-identical to an uninterrupted one.
 //! One process writes a run directory at a time.
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common::run_files;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_monolayer"))
-}
-
-fn paper() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/paper.toml")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use crate::common::{bin, paper, run_files, stderr};
 
 /// The paper scene for about a second, with the default checkpoint interval (a twentieth of
 /// the run, at least a minute of wall time apart): a run stopped by a signal has only the

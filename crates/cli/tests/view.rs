@@ -2,16 +2,9 @@
 //! scene: the files exist, decode, hold every frame, and carry the frame's values, checked
 //! by our own reader and by VTK's.
 
+use crate::common::{bin, stderr};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_monolayer"))
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use std::process::Command;
 
 /// A short run of the paper scene (4 TU relaxation, 6 TU activity at ζ = 0.01, a frame every
 /// 2 TU: 6 frames), into `dir/run`.

@@ -346,12 +346,7 @@ impl RunDir {
     /// # Errors
     /// [`RunError::Locked`]; I/O errors.
     pub fn resume_or_create(dir: &Path, scene: Scene, interrupt: Interrupt) -> Result<Self> {
-        let own = scene.to_toml();
-        let resumable = std::fs::read_to_string(dir.join("scene.toml")).is_ok_and(|s| s == own)
-            && checkpoint::checkpoints(dir)
-                .last()
-                .is_some_and(|(_, p)| checkpoint::checkpoint_scene(p).is_ok_and(|s| s == own));
-        if resumable {
+        if Self::resumable(dir, &scene) {
             match Self::resume(dir, &[], interrupt.clone()) {
                 Ok(r) => return Ok(r),
                 Err(e @ RunError::Locked { .. }) => return Err(e),
@@ -359,6 +354,16 @@ impl RunDir {
             }
         }
         Self::create(dir, scene, None, true, interrupt)
+    }
+
+    /// Whether `dir` holds a run of `scene` that [`RunDir::resume`] can continue: its
+    /// `scene.toml` and its newest checkpoint's scene are `scene`.
+    pub fn resumable(dir: &Path, scene: &Scene) -> bool {
+        let own = scene.to_toml();
+        std::fs::read_to_string(dir.join("scene.toml")).is_ok_and(|s| s == own)
+            && checkpoint::checkpoints(dir)
+                .last()
+                .is_some_and(|(_, p)| checkpoint::checkpoint_scene(p).is_ok_and(|s| s == own))
     }
 
     /// The directory.

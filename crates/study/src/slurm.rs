@@ -41,7 +41,12 @@ pub fn write_job_array(
     let script = slurm.join("sweep.sbatch");
     let mut list = String::new();
     for p in &todo {
-        let out = prepare_point(dir, p)?;
+        // A point stopped in an earlier submission keeps its checkpoint: its task resumes.
+        let out = if rundir::RunDir::resumable(&crate::sweep::run_dir(dir, p), &p.scene) {
+            crate::sweep::run_dir(dir, p)
+        } else {
+            prepare_point(dir, p)?
+        };
         list += &absolute(&out).display().to_string();
         list += "\n";
     }

@@ -1,6 +1,29 @@
 //! Helpers shared by the binary's test files.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `monolayer` binary cargo built for these tests.
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_monolayer"))
+}
+
+/// A shipped scene, `scenes/NAME`.
+pub fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+}
+
+/// The paper's scene, `scenes/paper.toml`.
+pub fn paper() -> PathBuf {
+    scene_path("paper.toml")
+}
+
+/// What a command wrote to stderr.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
 
 /// `series.csv` and every frame of a run directory, by name, in name order: what must be
 /// byte-identical between two runs that should agree.
