@@ -66,10 +66,12 @@ pub fn memory_limit() -> Option<(f64, String)> {
             "the data-size limit (ulimit -d) less what this process already uses",
         );
     }
-    // cgroup v2: this process's cgroup and each one above it.
+    // The memory cgroup of this process and each one above it: cgroup v2 (mounted at
+    // /sys/fs/cgroup, or at /sys/fs/cgroup/unified beside v1) and v1 (the memory controller).
     let cgroup = std::fs::read_to_string("/proc/self/cgroup").unwrap_or_default();
-    if let Some(path) = cgroup.lines().find_map(|l| l.strip_prefix("0::")) {
-        let mut dir = std::path::PathBuf::from("/sys/fs/cgroup").join(path.trim_start_matches('/'));
+    let mut walk = |base: &str, path: &str, max: &str, used: &str| {
+        let root = std::path::PathBuf::from(base);
+        let mut dir = root.join(path.trim_start_matches('/'));
         loop {
             let read = |f: &str| -> Option<f64> {
                 std::fs::read_to_string(dir.join(f))
@@ -78,32 +80,35 @@ pub fn memory_limit() -> Option<(f64, String)> {
                     .parse()
                     .ok()
             };
-            if let (Some(max), Some(used)) = (read("memory.max"), read("memory.current")) {
+            if let (Some(m), Some(u)) = (read(max), read(used)) {
                 consider(
-                    Some(max - used),
+                    Some(m - u),
                     "the memory limit of this process's cgroup less its usage",
                 );
             }
-            if dir == std::path::Path::new("/sys/fs/cgroup") || !dir.pop() {
+            if dir == root || !dir.pop() {
                 break;
             }
         }
-    }
-    // cgroup v1.
-    let v1 = std::path::Path::new("/sys/fs/cgroup/memory");
-    let read = |f: &str| -> Option<f64> {
-        std::fs::read_to_string(v1.join(f))
-            .ok()?
-            .trim()
-            .parse()
-            .ok()
     };
-    if let (Some(max), Some(used)) = (read("memory.limit_in_bytes"), read("memory.usage_in_bytes"))
-    {
-        consider(
-            Some(max - used),
-            "the memory limit of this process's cgroup less its usage",
-        );
+    for line in cgroup.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (_, controllers, path) = match (parts.next(), parts.next(), parts.next()) {
+            (Some(a), Some(b), Some(c)) => (a, b, c),
+            _ => continue,
+        };
+        if controllers.is_empty() {
+            for base in ["/sys/fs/cgroup", "/sys/fs/cgroup/unified"] {
+                walk(base, path, "memory.max", "memory.current");
+            }
+        } else if controllers.split(',').any(|c| c == "memory") {
+            walk(
+                "/sys/fs/cgroup/memory",
+                path,
+                "memory.limit_in_bytes",
+                "memory.usage_in_bytes",
+            );
+        }
     }
     best
 }

@@ -1,7 +1,7 @@
 //! The `monolayer` binary end to end: output files, reproducibility across thread counts, and
 //! every bad-scene case with its message and exit status.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use crate::common::{bin, run_files, scene_path, stderr};
@@ -1581,9 +1581,9 @@ fn a_redone_sweep_run_is_analysed_afresh_on_a_small_lattice() {
     assert!(stderr(&o).contains("add --analyze"), "{}", stderr(&o));
 }
 
-/// Under an address-space limit (`ulimit -v`, as a batch system sets) a scene that does not
-/// fit is refused with the limit named, where it aborted on allocation; a run's log (stderr
-/// not a terminal) gets about ten progress lines.
+/// Under an address-space limit (`ulimit -v`, as a batch system sets) or a cgroup's memory
+/// limit a scene that does not fit is refused with the limit named, where it aborted on
+/// allocation; a run's log (stderr not a terminal) gets about ten progress lines.
 #[test]
 fn the_memory_guard_reads_the_process_limits_and_logs_are_short() {
     let dir = tempfile::tempdir().unwrap();
@@ -1604,6 +1604,48 @@ fn the_memory_guard_reads_the_process_limits_and_logs_are_short() {
         err.contains("the address-space limit (ulimit -v)") && err.contains("reduce [cells] count"),
         "{err}"
     );
+    // A cgroup's memory limit (SLURM's --mem), where this machine lets the test make one (cgroup
+    // v1's memory controller, as root): a child cgroup of 2 GB and a scene of 4.4 GB.
+    let cgroup = std::fs::read_to_string("/proc/self/cgroup").unwrap_or_default();
+    let base = cgroup.lines().find_map(|l| {
+        let mut p = l.splitn(3, ':').skip(1);
+        let (controllers, path) = (p.next()?, p.next()?);
+        controllers
+            .split(',')
+            .any(|c| c == "memory")
+            .then(|| format!("/sys/fs/cgroup/memory{path}"))
+    });
+    let child =
+        base.map(|b| PathBuf::from(b).join(format!("monolayer-test-{}", std::process::id())));
+    match child.filter(|c| std::fs::create_dir(c).is_ok()) {
+        Some(cg) => {
+            std::fs::write(cg.join("memory.limit_in_bytes"), "2G").unwrap();
+            let script = format!(
+                "echo $$ > {}/cgroup.procs; exec {} run {} --out {} --set domain.lx=1500 --set domain.ly=1500 --set integrator.margin=0",
+                cg.display(),
+                env!("CARGO_BIN_EXE_monolayer"),
+                scene_path("paper.toml").display(),
+                dir.path().join("cgroup").display()
+            );
+            let o = Command::new("bash")
+                .arg("-c")
+                .arg(&script)
+                .output()
+                .unwrap();
+            let _ = std::fs::remove_dir(&cg);
+            let err = stderr(&o);
+            assert_eq!(o.status.code(), Some(1), "{err}");
+            assert!(
+                err.contains(
+                    "more than 2.0 GiB (the memory limit of this process's cgroup less its usage)"
+                ),
+                "{err}"
+            );
+        }
+        None => eprintln!(
+            "note: no cgroup v1 memory controller to write here; the cgroup limit is not tested"
+        ),
+    }
     let o = bin()
         .arg("run")
         .arg(scene_path("paper.toml"))
