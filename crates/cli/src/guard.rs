@@ -189,7 +189,7 @@ pub fn threads(n: usize) -> Result<usize> {
     }
     let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
     if n > cores {
-        eprintln!("note: --threads {n} capped at the {cores} cores of this machine (results do not depend on it)");
+        crate::say!("note: --threads {n} capped at the {cores} cores of this machine (results do not depend on it)");
         return Ok(cores);
     }
     Ok(n)

@@ -9,6 +9,17 @@
 //! progress of `study::view`'s pictures and ParaView files. Only this crate prints.
 #![deny(missing_docs)]
 
+/// Writes a line to stderr like `eprintln!`, but ignores a stderr that went away (a closed
+/// pipe, a terminal that hung up), where `eprintln!` would panic: losing a message must not
+/// change how a run ends.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 pub mod guard;
 pub mod lines;
 pub mod reproduce;

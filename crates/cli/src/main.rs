@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use monolayer_cli::run;
+use monolayer_cli::say;
 use monolayer_cli::sweep::{SweepAction, SweepOutcome};
 use scene::Scene;
 use study::analyze::{analyze, AnalyzeOptions};
@@ -284,11 +285,11 @@ fn main() -> ExitCode {
             });
             match stopped {
                 Some(signal) => {
-                    eprintln!("{e:#}");
+                    say!("{e:#}");
                     ExitCode::from((128 + signal).clamp(0, 255) as u8)
                 }
                 None => {
-                    eprintln!("error: {e:#}");
+                    say!("error: {e:#}");
                     ExitCode::FAILURE
                 }
             }
@@ -302,7 +303,7 @@ fn finished(info: &run::RunInfo, dir: &std::path::Path, quiet: bool) -> ExitCode
         // To nine digits: the clock sums steps (778.0000000000399 for 778).
         let time = (time * 1e9).round() / 1e9;
         // Printed even with --quiet: the run did not do what was asked.
-        eprintln!(
+        say!(
             "stopped at step {step} (t = {time}): resume with monolayer run --resume {}",
             dir.display()
         );
@@ -313,7 +314,7 @@ fn finished(info: &run::RunInfo, dir: &std::path::Path, quiet: bool) -> ExitCode
             .resumed_from
             .map(|s| format!("resumed at step {s}, "))
             .unwrap_or_default();
-        eprintln!(
+        say!(
             "done: {resumed}{} steps in {:.2} s, {} frames in {}",
             info.steps,
             info.wall_s,
@@ -415,7 +416,7 @@ fn real_main() -> Result<ExitCode> {
                 analyze: analyze.then(|| analysis.options()),
             };
             match monolayer_cli::sweep::sweep(&args)? {
-                SweepOutcome::Ran(info, n) if !quiet => eprintln!(
+                SweepOutcome::Ran(info, n) if !quiet => say!(
                     "done: {} of {n} runs taken ({} steps), {} already complete; summary in {}",
                     info.ran,
                     info.steps,
@@ -423,20 +424,20 @@ fn real_main() -> Result<ExitCode> {
                     out.join("summary.csv").display()
                 ),
                 SweepOutcome::JobArray(job, submitted) if !quiet => match (job.tasks, submitted) {
-                    (0, _) => eprintln!("every run is complete; build the summary with --collect"),
-                    (n, Some(s)) => eprintln!(
+                    (0, _) => say!("every run is complete; build the summary with --collect"),
+                    (n, Some(s)) => say!(
                         "{s}: {n} array tasks from {}; when they are done, run monolayer sweep --collect --out {}",
                         job.script.display(),
                         out.display()
                     ),
-                    (n, None) => eprintln!(
+                    (n, None) => say!(
                         "wrote {} ({n} array tasks); submit it with sbatch, then run monolayer sweep --collect --out {}",
                         job.script.display(),
                         out.display()
                     ),
                 },
                 SweepOutcome::Collected(n) if !quiet => {
-                    eprintln!("summary of {n} runs in {}", out.join("summary.csv").display())
+                    say!("summary of {n} runs in {}", out.join("summary.csv").display())
                 }
                 _ => {}
             }
@@ -475,7 +476,7 @@ fn real_main() -> Result<ExitCode> {
             std::fs::write(&out, &table)
                 .with_context(|| format!("cannot write {}", out.display()))?;
             print!("{table}");
-            eprintln!("written to {}", out.display());
+            say!("written to {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Render {
@@ -534,15 +535,15 @@ fn real_main() -> Result<ExitCode> {
                 note_skipped(&info.notes, &run_dir);
                 match &opts.movie {
                     Some(m) if no_pngs => {
-                        eprintln!("drew {} frames into {}", info.frames, m.display())
+                        say!("drew {} frames into {}", info.frames, m.display())
                     }
-                    Some(m) => eprintln!(
+                    Some(m) => say!(
                         "drew {} frames into {} and {}",
                         info.frames,
                         out.display(),
                         m.display()
                     ),
-                    None => eprintln!("drew {} frames into {}", info.frames, out.display()),
+                    None => say!("drew {} frames into {}", info.frames, out.display()),
                 }
             }
             Ok(ExitCode::SUCCESS)
@@ -564,7 +565,7 @@ fn real_main() -> Result<ExitCode> {
                 pool(threads)?.install(|| export_vtk(&run_dir, &out, &frames, &mut progress))?;
             if !quiet {
                 note_skipped(&info.notes, &run_dir);
-                eprintln!(
+                say!(
                     "exported {} frames; open {} (and cells.pvd) in ParaView",
                     info.frames,
                     out.join("fields.pvd").display()
@@ -580,7 +581,7 @@ fn real_main() -> Result<ExitCode> {
             let opts = analysis.options();
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
             note_skipped(&info.notes, &run_dir);
-            eprintln!(
+            say!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,
                 info.defects,
@@ -601,21 +602,21 @@ fn note_skipped(notes: &study::analyze::FrameNotes, run_dir: &std::path::Path) {
         complete,
     } = notes;
     if !complete {
-        eprintln!(
+        say!(
             "note: {} is not marked complete: the run is still being written or was killed (continue it with monolayer run --resume {0})",
             run_dir.display()
         );
     }
     if *partial > 0 {
-        eprintln!("note: skipped {partial} partially written frame(s)");
+        say!("note: skipped {partial} partially written frame(s)");
     }
     if let Some(first) = first_missing {
-        eprintln!(
+        say!(
             "note: {missing} frame(s) of the run's schedule are missing, the first at t ≈ {first:.3}: time differences and rates span the gap"
         );
     }
     if let Some(first) = stray.first() {
-        eprintln!(
+        say!(
             "note: ignored {} file(s) in frames/ that are not frame_STEP.npz (e.g. {first})",
             stray.len()
         );

@@ -34,10 +34,10 @@ impl Reporter for Progress {
         self.total.store(steps, Ordering::Relaxed);
         *self.lines.lock().unwrap_or_else(|e| e.into_inner()) = crate::lines::Lines::new();
         if runs == 0 {
-            eprintln!("sweep {name}: every run is complete");
+            crate::say!("sweep {name}: every run is complete");
             return;
         }
-        eprintln!("sweep {name}: {runs} runs, {steps} steps");
+        crate::say!("sweep {name}: {runs} runs, {steps} steps");
         if std::io::stderr().is_terminal() {
             let b = ProgressBar::new(steps);
             b.set_style(
@@ -62,7 +62,7 @@ impl Reporter for Progress {
             let total = self.total.load(Ordering::Relaxed);
             let mut lines = self.lines.lock().unwrap_or_else(|e| e.into_inner());
             if lines.due(d as f64, total as f64) {
-                eprintln!("  {d}/{total} steps");
+                crate::say!("  {d}/{total} steps");
             }
         }
     }
@@ -74,7 +74,7 @@ impl Reporter for Progress {
         if let Some(b) = self.bar.lock().unwrap_or_else(|e| e.into_inner()).take() {
             b.finish();
         }
-        eprintln!("{what}");
+        crate::say!("{what}");
     }
 }
 
@@ -115,14 +115,14 @@ pub fn run(
         let report = reproduce(f, &params)?;
         reporter.stage("");
         if !quiet {
-            eprintln!(
+            crate::say!(
                 "{} ({:.0} s): {}",
                 f.title(),
                 report.wall_s,
                 report.dir.join("verdict.md").display()
             );
             for c in &report.claims {
-                eprintln!("  {}: {}", c.verdict, c.claim);
+                crate::say!("  {}: {}", c.verdict, c.claim);
             }
         }
         reports.push(report);

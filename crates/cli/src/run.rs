@@ -41,7 +41,7 @@ pub fn run(
 ) -> Result<RunInfo> {
     let dir = RunDir::create(out, scene.clone(), state, overwrite, Interrupt::install()?)?;
     for w in scene.warnings() {
-        eprintln!("warning: {w}");
+        crate::say!("warning: {w}");
     }
     drive(&dir, quiet)
 }
@@ -95,7 +95,7 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<RunInfo> {
     let run = RunDir::resume(dir, set, Interrupt::install()?)?;
     if !quiet {
         for s in run.skipped() {
-            eprintln!("note: skipping {s}");
+            crate::say!("note: skipping {s}");
         }
     }
     drive(&run, quiet)
@@ -210,7 +210,7 @@ impl<T: Real> Callback<T> for Progress {
             b.set_position((done * PROGRESS_TICKS as f64) as u64);
             b.set_message(format!("step {step}  t = {time:.1}  v_rms = {v_rms:.3e}"));
         } else if !self.quiet && self.lines.due(time, end) {
-            eprintln!("step {step}  t = {time:.1}/{end}  v_rms = {v_rms:.3e}");
+            crate::say!("step {step}  t = {time:.1}/{end}  v_rms = {v_rms:.3e}");
         }
         Ok(())
     }

@@ -176,7 +176,7 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
                 .unwrap_or_else(|p| p.into_inner())
                 .due(d as f64, total as f64)
         {
-            eprintln!("{d}/{total} steps");
+            crate::say!("{d}/{total} steps");
         }
     });
     let params = SweepParams::new(a.jobs, a.threads);

@@ -30,7 +30,7 @@ pub fn frames_progress(what: &'static str, quiet: bool) -> impl FnMut(usize, usi
                 b.finish();
             }
         } else if lines.due(done as f64, total as f64) {
-            eprintln!("{done}/{total} frames {what}");
+            crate::say!("{done}/{total} frames {what}");
         }
     }
 }

@@ -217,3 +217,25 @@ fn a_signalled_sweep_stops_and_the_same_command_continues_it() {
     let got = std::fs::read_to_string(out.join("summary.csv")).unwrap();
     assert_eq!(got, want, "the continued sweep differs from the whole one");
 }
+
+/// A log that goes away (stderr a pipe whose reader has closed, as after `| head`, or a
+/// terminal that hung up) does not change how a run ends: it completes with status 0, where
+/// the first progress line after the close panicked.
+#[test]
+fn a_closed_stderr_does_not_stop_a_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let mut child = bin()
+        .arg("run")
+        .arg(paper())
+        .arg("--out")
+        .arg(&out)
+        .args(&ARGS[..8])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status}");
+    assert!(rundir::is_complete(&out));
+}
