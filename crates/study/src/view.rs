@@ -266,6 +266,39 @@ pub const TISSUE_COVER: f64 = 0.5;
 /// above that of the round initial discs (zero but for the lattice's anisotropy).
 pub const TISSUE_Q: f64 = 0.05;
 
+/// Where `render` draws the director (a mask over the nodes) and which defects of the smoothed
+/// `Q` (`qxx`, `qxy`) it draws: where cells cover at least [`TISSUE_COVER`] of the smoothing box
+/// of side `side` (`phi_sum` is `Σ φ_i`), and `|Q|` is at least [`TISSUE_Q`], at the node for the
+/// director and averaged over the box around a defect (`|Q|` vanishes at a defect's core).
+///
+/// # Errors
+/// A box that does not fit the lattice.
+pub fn in_tissue(
+    l: phasefield::Lattice,
+    side: usize,
+    phi_sum: &[f64],
+    qxx: &[f64],
+    qxy: &[f64],
+) -> Result<(Vec<bool>, Vec<analysis::defects::Defect>)> {
+    let smooth = |v: &[f64]| box_smooth(l, v, side).map_err(|e| ViewError::Options(e.to_string()));
+    let cover = smooth(phi_sum)?;
+    let q_mag: Vec<f64> = qxx.iter().zip(qxy).map(|(a, b)| a.hypot(*b)).collect();
+    let q_around = smooth(&q_mag)?;
+    let tissue = (0..cover.len())
+        .map(|k| cover[k] >= TISSUE_COVER && q_mag[k] >= TISSUE_Q)
+        .collect();
+    let defects = detect(l, qxx, qxy)
+        .into_iter()
+        .filter(|d| {
+            let x = (d.x.round() as usize) % l.lx;
+            let y = (d.y.round() as usize) % l.ly;
+            let k = x * l.ly + y;
+            cover[k] >= TISSUE_COVER && q_around[k] >= TISSUE_Q
+        })
+        .collect();
+    Ok((tissue, defects))
+}
+
 fn picture(
     run: &Run,
     frame: &LoadedFrame,
@@ -328,23 +361,15 @@ fn picture(
             // Only where there is tissue: the director of Q, and its defects, mean nothing in
             // the empty gaps between cells (between the initial discs, |Q| ≈ 0 and its angle
             // is noise). Tissue is where cells cover at least TISSUE_COVER of the smoothing box
-            // and the smoothed |Q| is at least TISSUE_Q.
+            // and |Q| is at least TISSUE_Q: at the node for a director segment, averaged over
+            // the box around it for a defect (|Q| vanishes at a defect's own core).
             let (phi_sum, _) = phi_sum_and_owner(frame, shape.nx, shape.ny);
-            let cover = smooth(&phi_sum.iter().map(|&v| f64::from(v)).collect::<Vec<_>>());
-            let tissue: Vec<bool> = (0..cover.len())
-                .map(|k| cover[k] >= TISSUE_COVER && qxx[k].hypot(qxy[k]) >= TISSUE_Q)
-                .collect();
+            let phi_sum: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
+            let (tissue, defects) = in_tissue(l, side, &phi_sum, &qxx, &qxy)?;
             if opts.defects {
-                p.defects = detect(l, &qxx, &qxy)
-                    .into_iter()
-                    .filter(|d| {
-                        let x = (d.x.round() as usize) % l.lx;
-                        let y = (d.y.round() as usize) % l.ly;
-                        tissue[x * l.ly + y]
-                    })
-                    .collect();
+                p.defects = defects;
             }
-            for k in 0..cover.len() {
+            for k in 0..tissue.len() {
                 if !tissue[k] {
                     qxx[k] = 0.0;
                     qxy[k] = 0.0;
@@ -621,4 +646,45 @@ pub fn export_vtk(
         notes: run.notes.clone(),
         files: vec![a, b],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use phasefield::Lattice;
+
+    /// A `+½` defect near the centre of a 40² lattice: `Q = s (cos 2θ, sin 2θ)` with
+    /// `θ = ½ atan2(y, x)` about it, `s` the magnitude.
+    fn plus_half(l: Lattice, s: f64) -> (Vec<f64>, Vec<f64>) {
+        let (mut qxx, mut qxy) = (vec![0.0; l.len()], vec![0.0; l.len()]);
+        for x in 0..l.lx {
+            for y in 0..l.ly {
+                let phi = (y as f64 - 20.3).atan2(x as f64 - 20.3);
+                qxx[x * l.ly + y] = s * phi.cos();
+                qxy[x * l.ly + y] = s * phi.sin();
+            }
+        }
+        (qxx, qxy)
+    }
+
+    /// The defect is drawn in covered, ordered tissue; not where cells cover a third of the
+    /// box (the gaps between initial discs), nor where `|Q|` is below the threshold (round
+    /// discs); the director mask follows the same rules node by node.
+    #[test]
+    fn defects_and_the_director_are_drawn_only_in_tissue() {
+        let l = Lattice::new(40, 40);
+        let full = vec![1.0; l.len()];
+        let sparse = vec![0.3; l.len()];
+        let (qxx, qxy) = plus_half(l, 1.0);
+        let (mask, d) = in_tissue(l, 9, &full, &qxx, &qxy).unwrap();
+        // Every defect of the field is kept (the periodic seams add three to the one placed).
+        assert_eq!(d, detect(l, &qxx, &qxy));
+        assert!(d.iter().any(|d| (d.x - 20.5).abs() < 1.0 && (d.charge - 0.5).abs() < 1e-12));
+        assert!(mask.iter().filter(|&&m| m).count() > l.len() - 10);
+        let (mask, d) = in_tissue(l, 9, &sparse, &qxx, &qxy).unwrap();
+        assert!(d.is_empty() && mask.iter().all(|&m| !m));
+        let (weak_xx, weak_xy) = plus_half(l, 0.5 * TISSUE_Q);
+        let (mask, d) = in_tissue(l, 9, &full, &weak_xx, &weak_xy).unwrap();
+        assert!(d.is_empty() && mask.iter().all(|&m| !m));
+    }
 }
