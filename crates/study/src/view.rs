@@ -679,7 +679,9 @@ mod tests {
         let (mask, d) = in_tissue(l, 9, &full, &qxx, &qxy).unwrap();
         // Every defect of the field is kept (the periodic seams add three to the one placed).
         assert_eq!(d, detect(l, &qxx, &qxy));
-        assert!(d.iter().any(|d| (d.x - 20.5).abs() < 1.0 && (d.charge - 0.5).abs() < 1e-12));
+        assert!(d
+            .iter()
+            .any(|d| (d.x - 20.5).abs() < 1.0 && (d.charge - 0.5).abs() < 1e-12));
         assert!(mask.iter().filter(|&&m| m).count() > l.len() - 10);
         let (mask, d) = in_tissue(l, 9, &sparse, &qxx, &qxy).unwrap();
         assert!(d.is_empty() && mask.iter().all(|&m| !m));
