@@ -14,6 +14,145 @@ use crate::SweepError;
 /// Bins per side of the creation-position test.
 const BINS: usize = 4;
 
+/// The side of the defects figure's box (the `lengths` ζ sweep: L = 200).
+const BOX: f64 = 200.0;
+
+/// The paper's cell radius, which sets the pairing distance 2R.
+const RADIUS: f64 = 8.0;
+
+/// The bin of `BINS × BINS` over the box that holds `(x, y)`.
+fn bin(x: f64, y: f64) -> usize {
+    let b = |v: f64| ((v.rem_euclid(BOX) / BOX * BINS as f64) as usize).min(BINS - 1);
+    b(x) * BINS + b(y)
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// The standard error of the mean (NaN for fewer than two values).
+fn se(v: &[f64]) -> f64 {
+    if v.len() < 2 {
+        return f64::NAN;
+    }
+    let m = mean(v);
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+    (var / v.len() as f64).sqrt()
+}
+
+/// A run's paired fraction of births and what independent births would give: `creations`
+/// pairs (two births each) and `unpaired` births and deaths without a partner (half of them
+/// births, as births and deaths balance in a steady state) over `frames` frames on `area`
+/// nodes. A birth at random has an opposite-charge birth within `2R` in the same frame interval
+/// with probability `1 − exp(−(b/2) π (2R)² / area)`, `b` the births per frame. `None` for a run
+/// with no birth.
+fn pairing(
+    creations: f64,
+    unpaired: f64,
+    frames: usize,
+    area: f64,
+    radius: f64,
+) -> Option<(f64, f64)> {
+    let births = 2.0 * creations + 0.5 * unpaired;
+    if births <= 0.0 || frames == 0 {
+        return None;
+    }
+    let per_frame = births / frames as f64;
+    let disc = std::f64::consts::PI * (2.0 * radius).powi(2);
+    let null = 1.0 - (-(0.5 * per_frame) * disc / area).exp();
+    Some((2.0 * creations / births, null))
+}
+
+/// The Pearson correlations of the creation maps of every pair of runs that each have at
+/// least one creation per two bins: near 0 when places are random, positive when runs share
+/// preferred places (fixed in the box, as a grid artefact would be).
+fn map_correlations(maps: &[[f64; BINS * BINS]]) -> Vec<f64> {
+    let used: Vec<&[f64; BINS * BINS]> = maps
+        .iter()
+        .filter(|m| m.iter().sum::<f64>() >= (BINS * BINS / 2) as f64)
+        .collect();
+    let mut r = Vec::new();
+    for i in 0..used.len() {
+        for j in 0..i {
+            let (a, b) = (used[i], used[j]);
+            let (ma, mb) = (mean(a), mean(b));
+            let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+            let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+            let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+            if va > 0.0 && vb > 0.0 {
+                r.push(cov / (va * vb).sqrt());
+            }
+        }
+    }
+    r
+}
+
+/// The least excess of the paired fraction over chance that counts as "in pairs": a tenth of
+/// the births. Below it (with two s.e.), births are not paired.
+const PAIRING_EFFECT: f64 = 0.1;
+
+/// The verdict on "±½ defects appear in pairs at random places" from each run's paired
+/// fraction of births `f` and its null expectation `q`, and the correlations `r` of the
+/// creation maps of pairs of runs. Pairs: the mean of `f − q` over runs against twice its
+/// standard error, and its upper bound (mean + 2 s.e.) against [`PAIRING_EFFECT`]. Places: the
+/// mean of `r` against twice its standard error (an upper bound
+/// below 0.5 is needed to call them random: with it the test could have seen a strong shared
+/// preference). Holds when births are paired beyond chance and no shared place shows; does not
+/// hold when births are not paired beyond chance (`f − q` below [`PAIRING_EFFECT`] within two
+/// s.e.) or runs
+/// share places (`r` above 0 by two s.e.); inconclusive otherwise, and with fewer than three
+/// runs or three pairs of runs.
+fn pairs_at_random_places(f: &[f64], q: &[f64], r: &[f64]) -> (Verdict, String) {
+    if f.len() < 3 || r.len() < 3 {
+        return (
+            Verdict::Inconclusive,
+            format!(
+                "{} runs with births and {} pairs of runs with creation maps: too few to test (three of each needed)",
+                f.len(),
+                r.len()
+            ),
+        );
+    }
+    let excess: Vec<f64> = f.iter().zip(q).map(|(f, q)| f - q).collect();
+    let (e, e_se) = (mean(&excess), se(&excess));
+    let (rm, r_se) = (mean(r), se(r));
+    let paired = e - 2.0 * e_se > 0.0;
+    let unpaired = e + 2.0 * e_se < PAIRING_EFFECT;
+    let shared = rm - 2.0 * r_se > 0.0;
+    let random = !shared && rm + 2.0 * r_se < 0.5;
+    let pairs = format!(
+        "the paired fraction exceeds chance by {} ± {} (s.e.)",
+        g(e),
+        g(e_se)
+    );
+    let places = format!(
+        "the creation maps of two runs correlate by {} ± {} (s.e.)",
+        g(rm),
+        g(r_se)
+    );
+    if unpaired {
+        (
+            Verdict::DoesNotHold,
+            format!("births are not paired beyond chance: {pairs}, below {PAIRING_EFFECT} within two s.e."),
+        )
+    } else if shared {
+        (
+            Verdict::DoesNotHold,
+            format!("runs share preferred places: {places}, above 0 by more than two s.e."),
+        )
+    } else if paired && random {
+        (
+            Verdict::Holds,
+            format!("{pairs}, more than two s.e.; {places}, within two s.e. of 0 and below 0.5"),
+        )
+    } else {
+        (
+            Verdict::Inconclusive,
+            format!("{pairs}; {places}: not beyond two s.e. either way"),
+        )
+    }
+}
+
 /// The figure's tables, plots and claims for one pressure form.
 fn one_form(
     p: &ReproduceParams,
@@ -73,6 +212,8 @@ fn one_form(
     );
     let (mut frames, mut charged, mut max_charge) = (0usize, 0usize, 0.0f64);
     let (mut creations, mut unpaired) = (Vec::new(), 0.0f64);
+    // Per active run: paired fraction of births, its null expectation, bin counts of creations.
+    let (mut fractions, mut nulls, mut maps) = (Vec::new(), Vec::new(), Vec::new());
     for r in &recs {
         let t = Table::read(&r.run.join("analysis/observables.csv"))?;
         let (time, np, nm, dens, net, un) = (
@@ -115,11 +256,21 @@ fn one_form(
         if r.values[1].parse::<f64>().unwrap_or(0.0) > 0.0 {
             let ev = Table::read(&r.run.join("analysis/defect_events.csv"))?;
             let (kind, x, y) = (ev.strs("kind")?, ev.f64s("x")?, ev.f64s("y")?);
+            let mut map = [0.0f64; BINS * BINS];
+            let mut made = 0.0;
             for k in 0..kind.len() {
                 if kind[k] == "creation" {
                     creations.push((x[k], y[k]));
+                    map[bin(x[k], y[k])] += 1.0;
+                    made += 1.0;
                 }
             }
+            let run_unpaired: f64 = un.iter().filter(|x| x.is_finite()).sum();
+            if let Some((f, q)) = pairing(made, run_unpaired, time.len(), BOX * BOX, RADIUS) {
+                fractions.push(f);
+                nulls.push(q);
+            }
+            maps.push(map);
         }
     }
     write_text(
@@ -129,21 +280,13 @@ fn one_form(
     drawn(pt.save_png(&dir.join(format!("defect_density_in_time_{pressure}.png"))))?;
     drawn(pq.save_png(&dir.join(format!("net_charge_in_time_{pressure}.png"))))?;
 
-    // Where pairs are created: counts in BINS × BINS cells of the box against uniform.
-    let lx = 200.0;
+    // Where pairs are created: counts in BINS × BINS cells of the box.
     let mut counts = [0usize; BINS * BINS];
     for &(x, y) in &creations {
-        let b = |v: f64| ((v.rem_euclid(lx) / lx * BINS as f64) as usize).min(BINS - 1);
-        counts[b(x) * BINS + b(y)] += 1;
+        counts[bin(x, y)] += 1;
     }
-    let n = creations.len() as f64;
-    let expect = n / (BINS * BINS) as f64;
-    let chi2: f64 = counts
-        .iter()
-        .map(|&c| (c as f64 - expect).powi(2) / expect.max(1e-300))
-        .sum();
-    // 99th percentile of χ² with 15 degrees of freedom.
-    let chi2_crit = 30.58;
+    let correlations = map_correlations(&maps);
+    let (v_pairs, why_pairs) = pairs_at_random_places(&fractions, &nulls, &correlations);
     let mut pos_csv = String::from("bin_x,bin_y,creations\n");
     for (k, c) in counts.iter().enumerate() {
         pos_csv += &format!("{},{},{c}\n", k / BINS, k % BINS);
@@ -176,25 +319,20 @@ fn one_form(
         Claim::new(
             format!("9.5 ({pressure} pressure): ±1/2 defects appear in pairs at random places"),
             format!(
-                "{} pair creations at ζ > 0; {} births or deaths without a partner within 2R; creation positions in {BINS}×{BINS} bins: χ² = {} (15 degrees of freedom, 1 % critical value {chi2_crit})",
+                "{} pair creations at ζ > 0, {} births or deaths without a partner within 2R; paired fraction of births {} ± {} (s.e. over {} runs) against {} ± {} for independent births at the same rate; creation maps ({BINS}×{BINS} bins) of two runs correlate by r = {} ± {} (s.e. over {} pairs of runs)",
                 creations.len(),
                 unpaired,
-                g(chi2)
+                g(mean(&fractions)),
+                g(se(&fractions)),
+                fractions.len(),
+                g(mean(&nulls)),
+                g(se(&nulls)),
+                g(mean(&correlations)),
+                g(se(&correlations)),
+                correlations.len()
             ),
-            if creations.len() < 5 * BINS * BINS {
-                Verdict::Inconclusive
-            } else if chi2 < chi2_crit {
-                Verdict::Holds
-            } else {
-                Verdict::Inconclusive
-            },
-            if creations.len() < 5 * BINS * BINS {
-                format!("fewer than {} creations: too few to test where they happen", 5 * BINS * BINS)
-            } else if chi2 < chi2_crit {
-                "births are paired +1/2 with −1/2, and the pair positions are consistent with uniform over the box".into()
-            } else {
-                "χ² exceeds the 1 % value, but the creations of one run are not independent (one flow pattern makes several), so the test cannot tell clustering in time from preferred places".into()
-            },
+            v_pairs,
+            why_pairs,
         ),
         Claim::new(
             format!("9.5 ({pressure} pressure): the defect density grows with ζ"),
@@ -231,9 +369,82 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let settings = format!(
         "- The ζ sweep of `reproduce lengths` (L = 200, 240 cells, γ = 0.01, both pressure forms, ζ ∈ {{{}}}, seeds {}), 200 TU of relaxation then {t} TU; frames every 10 TU analysed from t = {from}.\n\
          - Defects: ±1/2 of the box-smoothed Q (3R box); tracked between frames (links within R), births and deaths paired within 2R into creations and annihilations. Density = defects per node; creation rate = pair creations per node per TU, averaged over the frames.\n\
+         - In pairs at random places (per active run, then over runs): the paired fraction of births `2C / (2C + U/2)` (C creations, U unpaired births and deaths, half of them births) against independent births at the same rate, `1 − exp(−(b/2) π (2R)² / L²)` with b births per frame; and the Pearson correlation of the creation counts in {BINS}×{BINS} bins between every two runs (near 0 for random places, positive for places the runs share). Holds: the paired excess above 0 by two s.e. and the correlation within two s.e. of 0 and below 0.5; does not hold: the paired excess below 0.1 within two s.e., or the correlation above 0 by two s.e.; otherwise inconclusive.\n\
          - Files (one of each per pressure form, `_paper` and `_interaction`): `defects_vs_zeta_*.csv`, `defects_in_time_*.csv`, `creation_positions_*.csv`, `defect_density_vs_zeta_*.png`, `creation_rate_vs_zeta_*.png`, `defect_density_in_time_*.png`, `net_charge_in_time_*.png`.",
         ZETAS.join(", "),
         p.scale.seeds()
     );
     Ok((claims, settings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 9.5 rule gives each outcome on synthetic statistics.
+    #[test]
+    fn the_pairing_rule_gives_each_outcome() {
+        let q = [0.05, 0.06, 0.05, 0.04];
+        let paired = [0.7, 0.75, 0.68, 0.72];
+        let random_r = [0.05, -0.1, 0.02, -0.04, 0.08, -0.02];
+        assert_eq!(
+            pairs_at_random_places(&paired, &q, &random_r).0,
+            Verdict::Holds
+        );
+        // Births no more paired than chance.
+        let chance = [0.05, 0.04, 0.06, 0.05];
+        assert_eq!(
+            pairs_at_random_places(&chance, &q, &random_r).0,
+            Verdict::DoesNotHold
+        );
+        // Every run creates its pairs in the same bins.
+        let shared = [0.8, 0.7, 0.75, 0.85, 0.9, 0.78];
+        assert_eq!(
+            pairs_at_random_places(&paired, &q, &shared).0,
+            Verdict::DoesNotHold
+        );
+        // Correlations too spread to bound, pairing too noisy to tell.
+        let wide = [0.9, -0.8, 0.7, -0.6, 0.2, -0.1];
+        let noisy = [0.9, 0.0, 0.5, 0.1];
+        assert_eq!(
+            pairs_at_random_places(&noisy, &q, &wide).0,
+            Verdict::Inconclusive
+        );
+        // Too few runs.
+        assert_eq!(
+            pairs_at_random_places(&paired[..2], &q[..2], &random_r).0,
+            Verdict::Inconclusive
+        );
+    }
+
+    /// The null expectation of pairing is small for sparse births and tends to 1 for dense
+    /// ones; a run of pairs only has a paired fraction 1, one of lone births 0.
+    #[test]
+    fn pairing_fractions_and_their_null() {
+        let (f, q) = pairing(10.0, 0.0, 10, 40000.0, 8.0).unwrap();
+        assert_eq!(f, 1.0);
+        // 2 births per frame, half opposite: 1 × π·16² / 40000 = 0.0201.
+        assert!((q - (1.0 - (-std::f64::consts::PI * 256.0 / 40000.0f64).exp())).abs() < 1e-12);
+        let (f, _) = pairing(0.0, 40.0, 10, 40000.0, 8.0).unwrap();
+        assert_eq!(f, 0.0);
+        let (_, dense) = pairing(1e5, 0.0, 10, 40000.0, 8.0).unwrap();
+        assert!(dense > 0.999);
+        assert!(pairing(0.0, 0.0, 10, 40000.0, 8.0).is_none());
+    }
+
+    /// Identical maps correlate by 1, a map and its mirror by −1; maps with too few
+    /// creations are left out.
+    #[test]
+    fn creation_maps_correlate() {
+        let mut a = [0.0; BINS * BINS];
+        for (k, v) in a.iter_mut().enumerate() {
+            *v = k as f64;
+        }
+        let mut b = a;
+        b.reverse();
+        let r = map_correlations(&[a, a, b]);
+        assert_eq!(r.len(), 3);
+        assert!((r[0] - 1.0).abs() < 1e-12 && (r[1] + 1.0).abs() < 1e-12);
+        assert!(map_correlations(&[[0.1; BINS * BINS], a]).is_empty());
+    }
 }
