@@ -63,18 +63,22 @@ fn pairing(
     Some((2.0 * creations / births, null))
 }
 
-/// The Pearson correlations of the creation maps of every pair of runs that each have at
-/// least one creation per two bins: near 0 when places are random, positive when runs share
-/// preferred places (fixed in the box, as a grid artefact would be).
-fn map_correlations(maps: &[[f64; BINS * BINS]]) -> Vec<f64> {
-    let used: Vec<&[f64; BINS * BINS]> = maps
+/// The Pearson correlations of the creation maps of every pair of runs from different seeds
+/// (runs of one seed start from the same packing, so they share their early defects) that
+/// each have at least one creation per two bins: near 0 when places are random, positive when
+/// runs share preferred places (fixed in the box, as a grid artefact would be).
+fn map_correlations<S: PartialEq>(maps: &[(S, [f64; BINS * BINS])]) -> Vec<f64> {
+    let used: Vec<&(S, [f64; BINS * BINS])> = maps
         .iter()
-        .filter(|m| m.iter().sum::<f64>() >= (BINS * BINS / 2) as f64)
+        .filter(|m| m.1.iter().sum::<f64>() >= (BINS * BINS / 2) as f64)
         .collect();
     let mut r = Vec::new();
     for i in 0..used.len() {
         for j in 0..i {
-            let (a, b) = (used[i], used[j]);
+            if used[i].0 == used[j].0 {
+                continue;
+            }
+            let (a, b) = (&used[i].1, &used[j].1);
             let (ma, mb) = (mean(a), mean(b));
             let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
             let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
@@ -270,7 +274,7 @@ fn one_form(
                 fractions.push(f);
                 nulls.push(q);
             }
-            maps.push(map);
+            maps.push((r.seed, map));
         }
     }
     write_text(
@@ -319,7 +323,7 @@ fn one_form(
         Claim::new(
             format!("9.5 ({pressure} pressure): ±1/2 defects appear in pairs at random places"),
             format!(
-                "{} pair creations at ζ > 0, {} births or deaths without a partner within 2R; paired fraction of births {} ± {} (s.e. over {} runs) against {} ± {} for independent births at the same rate; creation maps ({BINS}×{BINS} bins) of two runs correlate by r = {} ± {} (s.e. over {} pairs of runs)",
+                "{} pair creations at ζ > 0, {} births or deaths without a partner within 2R; paired fraction of births {} ± {} (s.e. over {} runs) against {} ± {} for independent births at the same rate; creation maps ({BINS}×{BINS} bins) of two runs of different seeds correlate by r = {} ± {} (s.e. over {} pairs of runs, an underestimate, since the pairs share runs)",
                 creations.len(),
                 unpaired,
                 g(mean(&fractions)),
@@ -369,7 +373,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let settings = format!(
         "- The ζ sweep of `reproduce lengths` (L = 200, 240 cells, γ = 0.01, both pressure forms, ζ ∈ {{{}}}, seeds {}), 200 TU of relaxation then {t} TU; frames every 10 TU analysed from t = {from}.\n\
          - Defects: ±1/2 of the box-smoothed Q (3R box); tracked between frames (links within R), births and deaths paired within 2R into creations and annihilations. Density = defects per node; creation rate = pair creations per node per TU, averaged over the frames.\n\
-         - In pairs at random places (per active run, then over runs): the paired fraction of births `2C / (2C + U/2)` (C creations, U unpaired births and deaths, half of them births) against independent births at the same rate, `1 − exp(−(b/2) π (2R)² / L²)` with b births per frame; and the Pearson correlation of the creation counts in {BINS}×{BINS} bins between every two runs (near 0 for random places, positive for places the runs share). Holds: the paired excess above 0 by two s.e. and the correlation within two s.e. of 0 and below 0.5; does not hold: the paired excess below 0.1 within two s.e., or the correlation above 0 by two s.e.; otherwise inconclusive.\n\
+         - In pairs at random places (per active run, then over runs): the paired fraction of births `2C / (2C + U/2)` (C creations, U unpaired births and deaths, half of them births) against independent births at the same rate, `1 − exp(−(b/2) π (2R)² / L²)` with b births per frame; and the Pearson correlation of the creation counts in {BINS}×{BINS} bins between every two runs of different seeds (runs of one seed share their starting packing; near 0 for random places, positive for places the runs share). Holds: the paired excess above 0 by two s.e. and the correlation within two s.e. of 0 and below 0.5; does not hold: the paired excess below 0.1 within two s.e., or the correlation above 0 by two s.e.; otherwise inconclusive.\n\
          - Files (one of each per pressure form, `_paper` and `_interaction`): `defects_vs_zeta_*.csv`, `defects_in_time_*.csv`, `creation_positions_*.csv`, `defect_density_vs_zeta_*.png`, `creation_rate_vs_zeta_*.png`, `defect_density_in_time_*.png`, `net_charge_in_time_*.png`.",
         ZETAS.join(", "),
         p.scale.seeds()
@@ -433,7 +437,7 @@ mod tests {
     }
 
     /// Identical maps correlate by 1, a map and its mirror by −1; maps with too few
-    /// creations are left out.
+    /// creations, and pairs of runs of one seed, are left out.
     #[test]
     fn creation_maps_correlate() {
         let mut a = [0.0; BINS * BINS];
@@ -442,9 +446,10 @@ mod tests {
         }
         let mut b = a;
         b.reverse();
-        let r = map_correlations(&[a, a, b]);
+        let r = map_correlations(&[(1, a), (2, a), (3, b)]);
         assert_eq!(r.len(), 3);
         assert!((r[0] - 1.0).abs() < 1e-12 && (r[1] + 1.0).abs() < 1e-12);
-        assert!(map_correlations(&[[0.1; BINS * BINS], a]).is_empty());
+        assert!(map_correlations(&[(1, [0.1; BINS * BINS]), (2, a)]).is_empty());
+        assert!(map_correlations(&[(1, a), (1, a)]).is_empty());
     }
 }
