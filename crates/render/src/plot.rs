@@ -300,7 +300,15 @@ fn range(v: &[f64], log: bool) -> (f64, f64) {
     if log {
         let (l, h) = (lo.log10(), hi.log10());
         let pad = ((h - l) * 0.05).max(0.05);
-        (10f64.powf(l - pad), 10f64.powf(h + pad))
+        let (a, b) = ((l - pad).floor(), (h + pad).ceil());
+        // Data within two decades: the axis runs between whole decades, so that it carries at
+        // least two labelled ticks (a log axis labels powers of ten; one that spans less than a
+        // decade can show a single label, as the threshold figure's v_rms axis did).
+        if b - a <= 2.0 {
+            (10f64.powf(a), 10f64.powf(b))
+        } else {
+            (10f64.powf(l - pad), 10f64.powf(h + pad))
+        }
     } else if hi == lo {
         let w = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
         (lo - w, hi + w)
@@ -341,6 +349,11 @@ mod tests {
         let (lo, hi) = range(&[1e-3, 1e-1], true);
         assert!((lo.log10() + 3.1).abs() < 1e-12 && (hi.log10() + 0.9).abs() < 1e-12);
         assert_eq!(range(&[2.0], false), (1.8, 2.2));
+        // Within two decades: whole decades, so at least two labelled ticks.
+        let (lo, hi) = range(&[2e-3, 5e-2], true);
+        assert!((lo.log10() + 3.0).abs() < 1e-12 && (hi.log10() + 1.0).abs() < 1e-12);
+        let (lo, hi) = range(&[0.0021, 0.0027], true);
+        assert!((lo.log10() + 3.0).abs() < 1e-12 && (hi.log10() + 2.0).abs() < 1e-12);
         assert_eq!(tick(0.0050), "0.005");
         assert_eq!(tick(0.00115), "0.00115");
         assert_eq!(tick(20.0), "20");
