@@ -200,11 +200,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .collect()
         };
         let (vu, vv) = (mean_std(&per_run(true, 0)), mean_std(&per_run(true, 1)));
-        let runs_n = per_run(true, 0).len() as f64;
-        let se = vu.1 / runs_n.max(1.0).sqrt();
-        let along = vu.0.abs() > 3.0 * vv.0.abs() && vu.0.abs() > 2.0 * se;
+        let (v_dir, why_dir) = propulsion(&per_run(true, 0), &per_run(true, 1));
         claims.push(Claim::new(
-            format!("9.6 ({pressure} pressure): a +1/2 defect self-propels along its axis"),
+            format!("9.6 ({pressure} pressure): a +1/2 defect self-propels along its axis, towards its head"),
             format!(
                 "core (r ≤ R) velocity over {np} defects: along the axis v_u = {}, across v_v = {} (per-run spread); v_u {} 0: towards the {}",
                 pm(vu),
@@ -212,12 +210,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 if vu.0 < 0.0 { "<" } else { ">" },
                 if vu.0 < 0.0 { "head (−∇·Q), as in extensile active nematics" } else { "tail (+∇·Q), as in contractile active nematics" }
             ),
-            if np == 0.0 { Verdict::Inconclusive } else if along { Verdict::Holds } else { Verdict::DoesNotHold },
-            if along {
-                "the core velocity along the axis is more than 3× the one across it and more than two standard errors from 0"
-            } else {
-                "the core velocity along the axis is not clearly larger than across it"
-            },
+            if np == 0.0 { Verdict::Inconclusive } else { v_dir },
+            why_dir,
         ));
         let modes = ring_modes(&minus[0], &minus[1], 1.5 * R);
         let three = modes[3] > modes[1] && modes[3] > modes[2] && modes[3] > modes[4];
@@ -237,22 +231,25 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 "another mode than m = 3 dominates"
             },
         ));
-        // The isotropic stress −P at the head and the tail of +1/2 (u = ∓1.5R).
+        // The isotropic stress −P at the head and the tail of +1/2 (u = ∓1.5R), pooled and
+        // per run (the verdict reads the runs' signs).
         let (head, tail) = (at(&plus[5], -1.5 * R, 0.0), at(&plus[5], 1.5 * R, 0.0));
-        let compressive_head = head > tail;
+        let diffs: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.0 > 0.0)
+            .map(|r| at(&r.2[5], -1.5 * R, 0.0) - at(&r.2[5], 1.5 * R, 0.0))
+            .collect();
+        let (v_head, why_head) = same_sign(&diffs);
         claims.push(Claim::new(
             format!("9.6 ({pressure} pressure): the isotropic stress around +1/2 follows the continuum and experimental pattern"),
             format!(
-                "pressure P (isotropic stress −P) at 1.5R from the core along the axis: head side {} vs tail side {}",
+                "pressure P (isotropic stress −P) at 1.5R from the core along the axis, pooled: head side {} vs tail side {}; head − tail per run: {}",
                 g(head),
-                g(tail)
+                g(tail),
+                diffs.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", ")
             ),
-            if np == 0.0 { Verdict::Inconclusive } else if compressive_head { Verdict::Holds } else { Verdict::DoesNotHold },
-            if compressive_head {
-                "more compressive at the head than at the tail, the sign Saw et al. (2017) measured in MDCK monolayers, which the paper cites; no continuum magnitude is checked"
-            } else {
-                "the head is less compressed than the tail, the opposite of Saw et al. (2017)"
-            },
+            if np == 0.0 { Verdict::Inconclusive } else { v_head },
+            why_head,
         ));
     }
     write_text(&dir.join("defect_fields.csv"), &csv)?;
@@ -268,8 +265,102 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     Ok((claims, settings))
 }
 
+/// The verdict on "a +½ defect self-propels along its axis, towards its head" from each run's
+/// mean core velocity along the axis `vu` (positive towards the tail, `∇·Q`) and across it `vv`.
+/// Holds when `vu` is negative by more than two standard errors over runs and its mean is more
+/// than 3× the mean `|vv|`; does not hold when it is positive by more than two s.e. (towards the
+/// tail: contractile behaviour), or when it is clear of 0 but not 3× the crossing speed
+/// (the motion is not along the axis); inconclusive otherwise, and with fewer than two runs.
+fn propulsion(vu: &[f64], vv: &[f64]) -> (Verdict, String) {
+    if vu.len() < 2 {
+        return (
+            Verdict::Inconclusive,
+            format!("{} runs with +1/2 defects: too few for a spread", vu.len()),
+        );
+    }
+    let (mu, su) = mean_std(vu);
+    let (mv, _) = mean_std(vv);
+    let se = su / (vu.len() as f64).sqrt();
+    let clear = mu.abs() > 2.0 * se;
+    let along = mu.abs() > 3.0 * mv.abs();
+    let (v, why) = if clear && mu > 0.0 {
+        (Verdict::DoesNotHold, "the core moves towards the tail (+∇·Q) by more than two standard errors, as a contractile defect would")
+    } else if clear && !along {
+        (Verdict::DoesNotHold, "the core velocity along the axis is clear of 0 but not 3× the one across it: the motion is not along the axis")
+    } else if clear {
+        (Verdict::Holds, "the core moves towards the head (−∇·Q) by more than two standard errors over runs, more than 3× faster than across the axis")
+    } else {
+        (
+            Verdict::Inconclusive,
+            "the core velocity along the axis is within two standard errors of 0",
+        )
+    };
+    (v, why.to_string())
+}
+
+/// The verdict on a sign claim measured once per run (`d` > 0 claimed): holds when every run
+/// (at least three) has the sign and the mean is above 0 by two standard errors; does not hold
+/// when the mean is below 0 by two standard errors; inconclusive otherwise (runs disagree, or
+/// too few).
+fn same_sign(d: &[f64]) -> (Verdict, String) {
+    if d.len() < 3 {
+        return (
+            Verdict::Inconclusive,
+            format!(
+                "{} runs: too few to judge the sign run by run (three needed)",
+                d.len()
+            ),
+        );
+    }
+    let (m, s) = mean_std(d);
+    let se = s / (d.len() as f64).sqrt();
+    let positive = d.iter().filter(|x| **x > 0.0).count();
+    if positive == d.len() && m > 2.0 * se {
+        (Verdict::Holds, format!("more compressive at the head than at the tail in every one of {} runs (the sign Saw et al. (2017) measured in MDCK monolayers, which the paper cites); no continuum magnitude is checked", d.len()))
+    } else if m < -2.0 * se {
+        (Verdict::DoesNotHold, "the head is less compressed than the tail, by more than two standard errors over runs: the opposite of Saw et al. (2017)".to_string())
+    } else {
+        (Verdict::Inconclusive, format!("{positive} of {} runs have the head more compressed: the runs disagree, or the mean is within two standard errors of 0", d.len()))
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    /// The +½ rule gives each outcome on synthetic per-run core velocities.
+    #[test]
+    fn the_propulsion_rule_gives_each_outcome() {
+        use super::{propulsion, Verdict};
+        let across = [0.001, -0.001, 0.0005];
+        assert_eq!(
+            propulsion(&[-0.02, -0.025, -0.022], &across).0,
+            Verdict::Holds
+        );
+        assert_eq!(
+            propulsion(&[0.02, 0.025, 0.022], &across).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            propulsion(&[-0.02, -0.025, -0.022], &[0.02, 0.02, 0.02]).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            propulsion(&[-0.02, 0.025, -0.002], &across).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(propulsion(&[-0.02], &[0.0]).0, Verdict::Inconclusive);
+    }
+
+    /// The per-run sign rule: all runs agree and clear of 0 holds; one run against is
+    /// inconclusive (the pooled mean could still be positive); clearly negative does not hold.
+    #[test]
+    fn the_sign_rule_gives_each_outcome() {
+        use super::{same_sign, Verdict};
+        assert_eq!(same_sign(&[0.01, 0.012, 0.011]).0, Verdict::Holds);
+        assert_eq!(same_sign(&[0.03, 0.02, -0.005]).0, Verdict::Inconclusive);
+        assert_eq!(same_sign(&[-0.01, -0.012, -0.011]).0, Verdict::DoesNotHold);
+        assert_eq!(same_sign(&[0.01, 0.02]).0, Verdict::Inconclusive);
+    }
+
     use super::*;
 
     /// A purely radial flow v_r = cos 3φ (the linear active flow of a −½ defect) has all its
