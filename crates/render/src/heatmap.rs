@@ -22,6 +22,8 @@ pub struct Heatmap {
     pub arrows: Option<(Vec<f64>, Vec<f64>)>,
     /// Nodes between arrows.
     pub arrow_every: usize,
+    /// The names of the horizontal (`u`) and vertical (`v`) axes; empty draws none.
+    pub axes: (String, String),
 }
 
 impl Heatmap {
@@ -33,7 +35,14 @@ impl Heatmap {
             values,
             arrows: None,
             arrow_every: (side / 12).max(1),
+            axes: (String::new(), String::new()),
         }
+    }
+
+    /// With names on the horizontal (`u`) and vertical (`v`) axes.
+    pub fn with_axes(mut self, u: impl Into<String>, v: impl Into<String>) -> Self {
+        self.axes = (u.into(), v.into());
+        self
     }
 
     /// With arrows of the vector field `(a_u, a_v)` over the colours.
@@ -130,13 +139,16 @@ fn draw_panel(p: &Heatmap, main: &Area<'_>, bar: &Area<'_>) -> Result<(), String
     let mut chart = ChartBuilder::on(main)
         .caption(&p.title, (FONT, 18))
         .margin(6)
-        .x_label_area_size(28)
-        .y_label_area_size(36)
+        .x_label_area_size(if p.axes.0.is_empty() { 28 } else { 46 })
+        .y_label_area_size(if p.axes.1.is_empty() { 36 } else { 54 })
         .build_cartesian_2d(-half - 0.5..half + 0.5, -half - 0.5..half + 0.5)
         .map_err(e)?;
     chart
         .configure_mesh()
         .disable_mesh()
+        .x_desc(&p.axes.0)
+        .y_desc(&p.axes.1)
+        .axis_desc_style((FONT, 13))
         .label_style((FONT, 12))
         .x_labels(5)
         .y_labels(5)

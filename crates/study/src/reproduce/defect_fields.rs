@@ -165,20 +165,33 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             let m = v.iter().sum::<f64>() / v.len() as f64;
             v.iter().map(|x| x - m).collect()
         };
-        let panels = |f: &[Vec<f64>], name: &str| {
+        let panels = |f: &[Vec<f64>], name: &str, u: &str| {
+            let axes = |h: Heatmap| h.with_axes(u, "v, nodes");
             vec![
-                Heatmap::new("Q_xx (defect frame)", CROP, f[6].clone()),
-                Heatmap::new("σ_xx − mean", CROP, less_mean(&f[2])),
-                Heatmap::new("σ_xy", CROP, f[4].clone()),
-                Heatmap::new("flow: v_u, arrows v", CROP, f[0].clone())
-                    .with_arrows(f[0].clone(), f[1].clone()),
-                Heatmap::new("σ_yy − mean", CROP, less_mean(&f[3])),
-                Heatmap::new(format!("P − mean ({name} form)"), CROP, less_mean(&f[5])),
+                axes(Heatmap::new("Q_xx (defect frame)", CROP, f[6].clone())),
+                axes(Heatmap::new("σ_xx − mean", CROP, less_mean(&f[2]))),
+                axes(Heatmap::new("σ_xy", CROP, f[4].clone())),
+                axes(
+                    Heatmap::new("flow: v_u, arrows v", CROP, f[0].clone())
+                        .with_arrows(f[0].clone(), f[1].clone()),
+                ),
+                axes(Heatmap::new("σ_yy − mean", CROP, less_mean(&f[3]))),
+                axes(Heatmap::new(
+                    format!("P − mean ({name} form)"),
+                    CROP,
+                    less_mean(&f[5]),
+                )),
             ]
         };
-        for (file, title, f, n) in [
-            ("fig4a_plus", "+1/2", &plus, np),
-            ("fig4b_minus", "−1/2", &minus, nm),
+        for (file, title, f, n, u) in [
+            (
+                "fig4a_plus",
+                "+1/2",
+                &plus,
+                np,
+                "u, nodes (towards the tail, ∇·Q)",
+            ),
+            ("fig4b_minus", "−1/2", &minus, nm, "u, nodes (along an arm)"),
         ] {
             if n == 0.0 {
                 continue;
@@ -186,7 +199,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             drawn(save_heatmaps(
                 &dir.join(format!("{file}_{pressure}.png")),
                 &format!("Fig. 4: averages around {n} {title} defects (ζ = 0.005, γ = 0.014, {pressure} pressure; u along the defect axis)"),
-                &panels(f, pressure),
+                &panels(f, pressure, u),
                 3,
                 380,
             ))?;
