@@ -210,3 +210,36 @@ fn a_state_that_does_not_fit_is_refused_with_the_key_and_the_fix() {
         assert!(!out.exists(), "{set:?} made {}", out.display());
     }
 }
+
+/// A sweep's points start from the saved state of `[cells] from` too: each point's run is the
+/// run `monolayer run` makes of the same scene, byte for byte.
+#[test]
+fn a_sweep_starts_its_points_from_a_saved_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = source(dir.path());
+    let from = format!(
+        "cells.from={}",
+        src.join("frames/frame_00000100.npz").display()
+    );
+    let sweep = dir.path().join("sweep");
+    let mut c = Command::new(env!("CARGO_BIN_EXE_monolayer"));
+    c.arg("sweep")
+        .arg(paper())
+        .args(["--vary", "model.zeta=0,0.005", "--seeds", "1", "--quiet"])
+        .arg("--out")
+        .arg(&sweep);
+    for s in CONTINUE.iter().map(|s| s.to_string()).chain([from.clone()]) {
+        c.arg("--set").arg(s);
+    }
+    ok(&c.output().unwrap());
+    let mut set: Vec<&str> = CONTINUE.to_vec();
+    set.extend([from.as_str(), "model.zeta=0.005", "run.seed=1"]);
+    let single = dir.path().join("single");
+    ok(&run(&paper(), &single, &set, &[]));
+    let point = sweep.join("runs/model.zeta=0.005_seed=1");
+    assert_eq!(
+        crate::common::run_files(&point),
+        crate::common::run_files(&single),
+        "the sweep's point differs from the same scene run alone"
+    );
+}

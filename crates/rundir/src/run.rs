@@ -99,7 +99,7 @@ pub enum RunError {
         key: String,
     },
     /// The scene in a checkpoint, or the initial tissue, is not valid.
-    #[error("{context}: {source}")]
+    #[error("{context}")]
     Scene {
         /// Where.
         context: String,
@@ -159,11 +159,6 @@ impl Interrupt {
             s => Some(s as i32),
         }
     }
-
-    /// Records `signal` as caught, as the handler does (for tests of what follows).
-    pub fn raise(&self, signal: i32) {
-        self.signal.store(signal as usize, Ordering::SeqCst);
-    }
 }
 
 /// How a run ended.
@@ -220,7 +215,7 @@ impl RunDir {
         std::fs::create_dir_all(dir).map_err(|e| RunDirError::io("create", dir, e))?;
         let lock = lock(dir)?;
         crate::prepare(dir, overwrite)?;
-        let _ = std::fs::remove_file(dir.join(crate::COMPLETE));
+        // Also removes an earlier run's `complete` mark.
         crate::write_scene(dir, &scene)?;
         Ok(Self {
             dir: dir.to_path_buf(),
@@ -272,7 +267,13 @@ impl RunDir {
             let scene = match read_scene(path, set) {
                 Ok(s) => s,
                 Err(e) => {
-                    skipped.push(format!("{}: {e}", path.display()));
+                    let mut why = e.to_string();
+                    let mut cause = std::error::Error::source(&e);
+                    while let Some(c) = cause {
+                        why += &format!(": {c}");
+                        cause = c.source();
+                    }
+                    skipped.push(format!("{}: {why}", path.display()));
                     last_err = Some(e);
                     continue;
                 }
@@ -397,12 +398,6 @@ impl RunDir {
     pub fn simulation<T: Real>(&self) -> Result<(Simulation<T>, Written)> {
         let scene = &self.scene;
         let schedules = scene.output_schedules();
-        let bad = |context: String| {
-            move |e: Box<dyn std::error::Error + Send + Sync>| RunError::Scene {
-                context,
-                source: e,
-            }
-        };
         let (mut sim, written) = match &self.start {
             Start::Checkpoint { path, .. } => {
                 let tissue = checkpoint::read_checkpoint::<T>(path, scene)?;
@@ -414,12 +409,19 @@ impl RunDir {
                 let w = add_writers_resumed(&mut sim, &self.dir, &schedules, step)?;
                 (sim, w)
             }
-            start => {
-                let tissue = match start {
-                    Start::State(state) => scene.tissue_from_state::<T>(state),
-                    _ => scene.tissue::<T>(),
-                }
-                .map_err(|e| bad("the initial state".into())(Box::new(e)))?;
+            Start::State(state) => {
+                let tissue = scene
+                    .tissue_from_state::<T>(state)
+                    .map_err(|e| initial_state(Box::new(e)))?;
+                let mut sim = scene.simulation_from(tissue);
+                let w = add_writers(&mut sim, &self.dir, &schedules)?;
+                (sim, w)
+            }
+            Start::Scene => {
+                // The scene's discs, or the saved state its `[cells] from` names (a sweep's
+                // point reads it here; `monolayer run` reads it before `--overwrite`).
+                let tissue =
+                    crate::initial_tissue::<T>(scene).map_err(|e| initial_state(Box::new(e)))?;
                 let mut sim = scene.simulation_from(tissue);
                 let w = add_writers(&mut sim, &self.dir, &schedules)?;
                 (sim, w)
@@ -467,9 +469,17 @@ impl RunDir {
     }
 }
 
-/// The lines of two resolved scenes that differ, `run.time` aside (`key: a → b`).
+fn initial_state(source: Box<dyn std::error::Error + Send + Sync>) -> RunError {
+    RunError::Scene {
+        context: "the initial state".into(),
+        source,
+    }
+}
+
+/// The keys of two resolved scenes whose values differ, `run.time` aside, as
+/// `key is B there, A here` (`other` is "there").
 fn scene_diff(own: &str, other: &str) -> String {
-    let norm = |s: &str| -> Vec<String> {
+    let entries = |s: &str| -> Vec<(String, String)> {
         let mut section = String::new();
         s.lines()
             .filter_map(|l| {
@@ -480,29 +490,26 @@ fn scene_diff(own: &str, other: &str) -> String {
                 }
                 let (k, v) = l.split_once('=')?;
                 let key = format!("{section}.{}", k.trim());
-                (key != "run.time").then(|| format!("{key} = {}", v.trim()))
+                (key != "run.time").then(|| (key, v.trim().to_string()))
             })
             .collect()
     };
-    let (a, b) = (norm(own), norm(other));
+    let (here, there) = (entries(own), entries(other));
+    let value = |list: &[(String, String)], key: &str| {
+        list.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone())
+    };
     let mut out = Vec::new();
-    for l in &b {
-        if !a.contains(l) {
-            let key = l.split(" = ").next().unwrap_or("");
-            let was = a
-                .iter()
-                .find(|m| m.split(" = ").next() == Some(key))
-                .and_then(|m| m.split(" = ").nth(1))
-                .unwrap_or("(none)");
-            out.push(format!(
-                "{key} is {} there, {was} here",
-                l.split(" = ").nth(1).unwrap_or("")
-            ));
+    for (key, v) in &there {
+        match value(&here, key) {
+            Some(h) if &h == v => {}
+            h => out.push(format!(
+                "{key} is {v} there, {} here",
+                h.as_deref().unwrap_or("(none)")
+            )),
         }
     }
-    for l in &a {
-        let key = l.split(" = ").next().unwrap_or("");
-        if !b.iter().any(|m| m.split(" = ").next() == Some(key)) {
+    for (key, _) in &here {
+        if value(&there, key).is_none() {
             out.push(format!("{key} is not set there"));
         }
     }

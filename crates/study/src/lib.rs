@@ -88,15 +88,6 @@ pub enum SweepError {
         #[source]
         source: Box<scene::SceneError>,
     },
-    /// The saved state a point starts from (`init = "frame"`) cannot be read or does not fit.
-    #[error("sweep point {point}: the initial state")]
-    State {
-        /// The point.
-        point: String,
-        /// The error.
-        #[source]
-        source: Box<rundir::StateError>,
-    },
     /// A run directory could not be written.
     #[error("sweep point {point}")]
     RunDir {
