@@ -23,12 +23,6 @@ pub fn parse_bytes(s: &str) -> Result<f64> {
     }
 }
 
-/// The memory available to a new process, from `/proc/meminfo` (`MemAvailable`); `None`
-/// where that cannot be read.
-pub fn available_memory() -> Option<f64> {
-    memory_limit().map(|(b, _)| b)
-}
-
 /// The memory this process can still use and what limits it: the smallest of the machine's
 /// `MemAvailable`, the address-space and data-size limits (`ulimit -v`, `ulimit -d`) less what
 /// the process already uses of them, and the memory limit of its cgroup and of each cgroup

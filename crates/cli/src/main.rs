@@ -242,12 +242,7 @@ impl AnalysisArgs {
     }
 
     fn given(&self) -> bool {
-        self.from.is_some()
-            || self.box_side.is_some()
-            || self.crop.is_some()
-            || self.max_link.is_some()
-            || self.max_pair.is_some()
-            || self.s_rms_baseline.is_some()
+        self.options() != AnalyzeOptions::default()
     }
 }
 
@@ -286,7 +281,7 @@ fn main() -> ExitCode {
             match stopped {
                 Some(signal) => {
                     say!("{e:#}");
-                    ExitCode::from((128 + signal).clamp(0, 255) as u8)
+                    signal_exit(signal)
                 }
                 None => {
                     say!("error: {e:#}");
@@ -295,6 +290,11 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// The exit status of a process stopped by `signal`: 128 + its number, as a shell reports it.
+fn signal_exit(signal: i32) -> ExitCode {
+    ExitCode::from((128 + signal).clamp(0, 255) as u8)
 }
 
 /// What `run` prints at its end, and its exit status: 0, or 128 + the signal that stopped it.
@@ -307,7 +307,7 @@ fn finished(info: &run::RunInfo, dir: &std::path::Path, quiet: bool) -> ExitCode
             "stopped at step {step} (t = {time}): resume with monolayer run --resume {}",
             dir.display()
         );
-        return ExitCode::from((128 + signal).clamp(0, 255) as u8);
+        return signal_exit(signal);
     }
     if !quiet {
         let resumed = info

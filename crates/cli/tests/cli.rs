@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{bin, run_files, scene_path, stderr};
+use crate::common::{bin, resume_matches, run_files, scene_path, stderr};
 
 fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut c = bin();
@@ -1155,22 +1155,7 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
             "{}",
             stderr(&a)
         );
-        let o = bin()
-            .args(["run", "--resume"])
-            .arg(&out)
-            .args(["--quiet", "--threads", "2"])
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", stderr(&o));
-        let got = run_files(&out);
-        assert_eq!(got.len(), want.len(), "kill at {ms} ms: file count");
-        for (g, w) in got.iter().zip(&want) {
-            assert!(g == w, "kill at {ms} ms: {} differs", w.0);
-        }
-        assert!(
-            rundir::is_complete(&out),
-            "the resumed run is marked complete"
-        );
+        resume_matches(&out, &want, &format!("kill at {ms} ms"));
         resumed += 1;
     }
     assert!(

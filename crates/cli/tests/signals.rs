@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::common::{bin, paper, run_files, stderr};
+use crate::common::{bin, paper, resume_matches, run_files, stderr};
 
 /// The paper scene for about a second, with the default checkpoint interval (a twentieth of
 /// the run, at least a minute of wall time apart): a run stopped by a signal has only the
@@ -123,19 +123,7 @@ fn a_signalled_run_stops_with_a_checkpoint_and_resumes_bit_for_bit() {
             Some(step),
             "the checkpoint is at the stop"
         );
-        let o = bin()
-            .args(["run", "--resume"])
-            .arg(&out)
-            .args(["--quiet", "--threads", "2"])
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", stderr(&o));
-        let got = run_files(&out);
-        assert_eq!(got.len(), want.len(), "SIG{signal} at {ms} ms: file count");
-        for (g, w) in got.iter().zip(&want) {
-            assert!(g == w, "SIG{signal} at {ms} ms: {} differs", w.0);
-        }
-        assert!(rundir::is_complete(&out));
+        resume_matches(&out, &want, &format!("SIG{signal} at {ms} ms"));
         stopped += 1;
     }
     assert!(stopped >= 3, "only {stopped} of 4 signals stopped the run");

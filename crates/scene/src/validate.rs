@@ -176,16 +176,10 @@ impl SceneFile {
             // Two discs whose centres are closer than their radius start stacked: nothing
             // separates two identical fields at one place (the force between them is zero by
             // symmetry), so the run would go on with one cell on top of another.
-            let periodic = |a: f64, b: f64, l: usize| {
-                let l = l as f64;
-                let d = (a - b).rem_euclid(l);
-                d.min(l - d)
-            };
+            let periodic = Lattice::new(d.lx, d.ly);
             for i in 0..p.len() {
                 for j in 0..i {
-                    let dx = periodic(p[i][0], p[j][0], d.lx);
-                    let dy = periodic(p[i][1], p[j][1], d.ly);
-                    let dist = dx.hypot(dy);
+                    let dist = periodic.distance(p[i], p[j]);
                     if dist < r0 {
                         return Err(invalid(
                             "cells",

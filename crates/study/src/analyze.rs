@@ -89,8 +89,8 @@ pub struct AnalyzeOptions {
     pub from: Option<f64>,
     /// Side of the smoothing box (odd; default: the odd side nearest 3R).
     pub box_side: Option<usize>,
-    /// Side of the defect-centred crops (odd; default [`DEFAULT_CROP`], or the largest odd
-    /// side below the lattice's shorter side when that is smaller).
+    /// Side of the defect-centred crops (odd; default [`default_crop`]: [`DEFAULT_CROP`], or
+    /// twice the lattice's shorter side plus one when that is smaller).
     pub crop_side: Option<usize>,
     /// Longest link of a defect between frames (default R).
     pub max_link: Option<f64>,
@@ -416,13 +416,7 @@ pub(crate) fn load_frame(
     // about 1e-5), or pictures and ParaView files would put one cell's values on another.
     let centres = pairs(&centre);
     for (i, (c, m)) in centres.iter().zip(tissue.centres()).enumerate() {
-        let wrap = |d: f64, l: usize| {
-            let l = l as f64;
-            let d = d.rem_euclid(l);
-            d.min(l - d)
-        };
-        let off = wrap(c[0] - m[0], lattice.lx).hypot(wrap(c[1] - m[1], lattice.ly));
-        if off > 0.1 {
+        if lattice.distance(*c, *m) > 0.1 {
             return Err(input(
                 path,
                 format!(

@@ -45,3 +45,25 @@ pub fn run_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     }
     v
 }
+
+/// Continues the stopped or killed run in `dir` with `--resume` on 2 threads and checks that
+/// it ends byte-identical to `want` (the [`run_files`] of the uninterrupted run) and marked
+/// complete; `what` names the interruption in a failure.
+pub fn resume_matches(dir: &Path, want: &[(String, Vec<u8>)], what: &str) {
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(dir)
+        .args(["--quiet", "--threads", "2"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{what}: {}", stderr(&o));
+    let got = run_files(dir);
+    assert_eq!(got.len(), want.len(), "{what}: file count");
+    for (g, w) in got.iter().zip(want) {
+        assert!(g == w, "{what}: {} differs", w.0);
+    }
+    assert!(
+        rundir::is_complete(dir),
+        "{what}: the resumed run is marked complete"
+    );
+}

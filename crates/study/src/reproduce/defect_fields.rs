@@ -6,7 +6,9 @@ use std::path::Path;
 use analysis::crop::COMPONENTS;
 use render::{save_heatmaps, Heatmap};
 
-use super::{drawn, g, mean_std, pm, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::{
+    drawn, g, mean_se, mean_std, pm, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict,
+};
 use crate::analyze::AnalyzeOptions;
 use crate::SweepError;
 
@@ -291,9 +293,8 @@ fn propulsion(vu: &[f64], vv: &[f64]) -> (Verdict, String) {
             format!("{} runs with +1/2 defects: too few for a spread", vu.len()),
         );
     }
-    let (mu, su) = mean_std(vu);
+    let (mu, se) = mean_se(vu);
     let (mv, _) = mean_std(vv);
-    let se = su / (vu.len() as f64).sqrt();
     let clear = mu.abs() > 2.0 * se;
     let along = mu.abs() > 3.0 * mv.abs();
     let (v, why) = if clear && mu > 0.0 {
@@ -325,8 +326,7 @@ fn same_sign(d: &[f64]) -> (Verdict, String) {
             ),
         );
     }
-    let (m, s) = mean_std(d);
-    let se = s / (d.len() as f64).sqrt();
+    let (m, se) = mean_se(d);
     let positive = d.iter().filter(|x| **x > 0.0).count();
     if positive == d.len() && m > 2.0 * se {
         (Verdict::Holds, format!("more compressive at the head than at the tail in every one of {} runs (the sign Saw et al. (2017) measured in MDCK monolayers, which the paper cites); no continuum magnitude is checked", d.len()))

@@ -7,7 +7,8 @@ use render::{Plot, Series};
 
 use super::lengths::{by_value, times, trend, turbulence, PRESSURES, ZETAS};
 use super::{
-    drawn, g, write_text, AtValue, Claim, Rec, ReproduceParams, SweepResult, Table, Verdict,
+    drawn, g, mean_se, mean_std, write_text, AtValue, Claim, Rec, ReproduceParams, SweepResult,
+    Table, Verdict,
 };
 use crate::SweepError;
 
@@ -24,20 +25,6 @@ const RADIUS: f64 = 8.0;
 fn bin(x: f64, y: f64) -> usize {
     let b = |v: f64| ((v.rem_euclid(BOX) / BOX * BINS as f64) as usize).min(BINS - 1);
     b(x) * BINS + b(y)
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
-}
-
-/// The standard error of the mean (NaN for fewer than two values).
-fn se(v: &[f64]) -> f64 {
-    if v.len() < 2 {
-        return f64::NAN;
-    }
-    let m = mean(v);
-    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
-    (var / v.len() as f64).sqrt()
 }
 
 /// A run's paired fraction of births and what independent births would give: `creations`
@@ -79,7 +66,7 @@ fn map_correlations<S: PartialEq>(maps: &[(S, [f64; BINS * BINS])]) -> Vec<f64> 
                 continue;
             }
             let (a, b) = (&used[i].1, &used[j].1);
-            let (ma, mb) = (mean(a), mean(b));
+            let (ma, mb) = (mean_std(a).0, mean_std(b).0);
             let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
             let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
             let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
@@ -118,8 +105,8 @@ fn pairs_at_random_places(f: &[f64], q: &[f64], r: &[f64]) -> (Verdict, String) 
         );
     }
     let excess: Vec<f64> = f.iter().zip(q).map(|(f, q)| f - q).collect();
-    let (e, e_se) = (mean(&excess), se(&excess));
-    let (rm, r_se) = (mean(r), se(r));
+    let (e, e_se) = mean_se(&excess);
+    let (rm, r_se) = mean_se(r);
     let paired = e - 2.0 * e_se > 0.0;
     let unpaired = e + 2.0 * e_se < PAIRING_EFFECT;
     let shared = rm - 2.0 * r_se > 0.0;
@@ -326,13 +313,13 @@ fn one_form(
                 "{} pair creations at ζ > 0, {} births or deaths without a partner within 2R; paired fraction of births {} ± {} (s.e. over {} runs) against {} ± {} for independent births at the same rate; creation maps ({BINS}×{BINS} bins) of two runs of different seeds correlate by r = {} ± {} (s.e. over {} pairs of runs, an underestimate, since the pairs share runs)",
                 creations.len(),
                 unpaired,
-                g(mean(&fractions)),
-                g(se(&fractions)),
+                g(mean_se(&fractions).0),
+                g(mean_se(&fractions).1),
                 fractions.len(),
-                g(mean(&nulls)),
-                g(se(&nulls)),
-                g(mean(&correlations)),
-                g(se(&correlations)),
+                g(mean_se(&nulls).0),
+                g(mean_se(&nulls).1),
+                g(mean_se(&correlations).0),
+                g(mean_se(&correlations).1),
                 correlations.len()
             ),
             v_pairs,

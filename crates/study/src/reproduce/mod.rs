@@ -451,6 +451,21 @@ pub(crate) fn mean_std(v: &[f64]) -> (f64, f64) {
     (m, var.sqrt())
 }
 
+/// The mean of `v` and its standard error (the sample standard deviation over √n), from
+/// [`mean_std`]; the error is NaN for fewer than two values.
+pub(crate) fn mean_se(v: &[f64]) -> (f64, f64) {
+    let (m, s) = mean_std(v);
+    let n = v.iter().filter(|x| x.is_finite()).count();
+    (
+        m,
+        if n < 2 {
+            f64::NAN
+        } else {
+            s / (n as f64).sqrt()
+        },
+    )
+}
+
 /// A short number for tables and verdicts: 3 significant digits.
 pub(crate) fn g(v: f64) -> String {
     if !v.is_finite() {

@@ -12,7 +12,7 @@ use std::path::Path;
 
 use render::{Plot, Series};
 
-use super::{drawn, g, write_text, Claim, ReproduceParams, Scale, Verdict, PAPER_SCENE};
+use super::{drawn, g, mean_std, write_text, Claim, ReproduceParams, Scale, Verdict, PAPER_SCENE};
 use crate::SweepError;
 
 /// Timings per point.
@@ -99,19 +99,6 @@ fn run_steps(
     Ok((used / steps as f64, mem))
 }
 
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
-}
-
-/// The sample standard deviation (0 for one value).
-fn sd(v: &[f64]) -> f64 {
-    if v.len() < 2 {
-        return 0.0;
-    }
-    let m = mean(v);
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
-}
-
 /// The verdict on `cost ∝ N^k` with `k` in `[lo, hi]`, from the time exponents of the repeats
 /// `kt` and the memory exponent `km` (deterministic): the time exponent's interval is its mean
 /// ± 2 standard deviations of the repeats (at least ± 0.05, the fit's resolution over a
@@ -119,7 +106,8 @@ fn sd(v: &[f64]) -> f64 {
 /// interval lies wholly outside it, or `km` does; inconclusive otherwise (the spread straddles
 /// a bound).
 fn rule(kt: &[f64], km: f64, lo: f64, hi: f64) -> (Verdict, String) {
-    let (m, half) = (mean(kt), (2.0 * sd(kt)).max(0.05));
+    let (m, sd) = mean_std(kt);
+    let half = (2.0 * sd).max(0.05);
     let (a, b) = (m - half, m + half);
     let inside = |x: f64| (lo..=hi).contains(&x);
     if !inside(km) {
@@ -250,8 +238,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             format!("9.7: {method} cost {want} in time and memory"),
             format!(
                 "time ∝ N^k with k = {} ± {} over {} repeats (CPU time), memory ∝ N^{}",
-                g(mean(kt)),
-                g(sd(kt)),
+                g(mean_std(kt).0),
+                g(mean_std(kt).1),
                 kt.len(),
                 g(*km)
             ),
