@@ -1,0 +1,51 @@
+//! Exploration: ζ_cr of a hexagonal packing by both methods, with timings.
+//!
+//! `cargo run --release -p stability --example explore -- COLS ROWS GAMMA PRESSURE`
+use mechanics::{ModelParams, PressureKind, StepParams};
+use stability::*;
+use std::time::Instant;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let cols: usize = args.get(1).map_or(6, |s| s.parse().unwrap());
+    let rows: usize = args.get(2).map_or(10, |s| s.parse().unwrap());
+    let gamma: f64 = args.get(3).map_or(0.01, |s| s.parse().unwrap());
+    let pressure = if args.get(4).map_or("paper", |s| s) == "paper" {
+        PressureKind::Paper
+    } else {
+        PressureKind::Interaction
+    };
+    let hex = HexBox::new(cols, rows, 100.0 * 100.0 / 60.0)?;
+    let mut params = ModelParams::paper(0.0).with_pressure(pressure);
+    params.energy.gamma = gamma;
+    let t0 = Instant::now();
+    let rest = rest_state(&hex, &params, &Relaxation::default())?;
+    println!(
+        "box {}x{} relaxed t={} v_max={:.2e} phi_rate={:.2e} s_rms={:.4} in {:.1}s",
+        hex.lx, hex.ly, rest.time, rest.v_max, rest.phi_rate, rest.s_rms,
+        t0.elapsed().as_secs_f64()
+    );
+    let opts = ThresholdOptions {
+        step: StepParams::new(0.5, 1),
+        steps: 100,
+        lo: 0.0,
+        hi: 0.008,
+        tol: 5e-5,
+        narrow: 3e-4,
+    };
+    for method in [
+        Method::Arnoldi(ArnoldiOptions { krylov: 20, eps: 1e-5, seed: 1 }),
+        Method::Growth(GrowthOptions { amplitude: 1e-5, intervals: 20, seed: 1 }),
+    ] {
+        let t0 = Instant::now();
+        let t = threshold(&rest.tissue, &params, &method, &opts)?;
+        println!(
+            "{}: zeta_cr {:.5} ± {:.5} slope {:.3} in {:.1}s",
+            method.name(), t.zeta_cr, t.err, t.slope, t0.elapsed().as_secs_f64()
+        );
+        for e in &t.evaluations {
+            println!("   zeta {:.5} sigma {:+.4e} ± {:.1e}", e.zeta, e.sigma, e.sigma_err);
+        }
+    }
+    Ok(())
+}
