@@ -72,6 +72,10 @@ pub struct Plot {
     pub log_x: bool,
     /// Logarithmic y axis (non-positive values are left out).
     pub log_y: bool,
+    /// A linear x axis that reaches 0 (for a claim about an intercept or proportionality).
+    pub zero_x: bool,
+    /// A linear y axis that reaches 0.
+    pub zero_y: bool,
     /// The curves.
     pub series: Vec<Series>,
     /// Horizontal reference lines `(y, label)`, drawn dashed.
@@ -109,6 +113,8 @@ impl Plot {
             y_label: y_label.into(),
             log_x: false,
             log_y: false,
+            zero_x: false,
+            zero_y: false,
             series: Vec::new(),
             hlines: Vec::new(),
             size: (800, 560),
@@ -151,8 +157,14 @@ impl Plot {
                 why: format!("\"{}\" has no finite point to draw", self.title),
             });
         }
-        let xs: Vec<f64> = all.iter().map(|p| p.0).collect();
+        let mut xs: Vec<f64> = all.iter().map(|p| p.0).collect();
         let mut ys: Vec<f64> = all.iter().flat_map(|p| [p.1 - p.2, p.1 + p.2]).collect();
+        if self.zero_x && !self.log_x {
+            xs.push(0.0);
+        }
+        if self.zero_y && !self.log_y {
+            ys.push(0.0);
+        }
         ys.extend(self.hlines.iter().map(|h| h.0).filter(|v| v.is_finite()));
         if self.log_y {
             let floor = all.iter().map(|p| p.1).fold(f64::INFINITY, f64::min) * 0.5;

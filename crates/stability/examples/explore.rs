@@ -22,7 +22,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rest = rest_state(&hex, &params, &Relaxation::default())?;
     println!(
         "box {}x{} relaxed t={} v_max={:.2e} phi_rate={:.2e} s_rms={:.4} in {:.1}s",
-        hex.lx, hex.ly, rest.time, rest.v_max, rest.phi_rate, rest.s_rms,
+        hex.lx,
+        hex.ly,
+        rest.time,
+        rest.v_max,
+        rest.phi_rate,
+        rest.s_rms,
         t0.elapsed().as_secs_f64()
     );
     let opts = ThresholdOptions {
@@ -34,17 +39,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         narrow: 3e-4,
     };
     for method in [
-        Method::Arnoldi(ArnoldiOptions { krylov: 20, eps: 1e-5, seed: 1 }),
-        Method::Growth(GrowthOptions { amplitude: 1e-5, intervals: 20, seed: 1 }),
+        Method::Arnoldi(ArnoldiOptions {
+            krylov: 20,
+            eps: 1e-5,
+            seed: 1,
+        }),
+        Method::Growth(GrowthOptions {
+            amplitude: 1e-5,
+            intervals: 24,
+            vectors: 4,
+            seed: 1,
+        }),
     ] {
         let t0 = Instant::now();
         let t = threshold(&rest.tissue, &params, &method, &opts)?;
         println!(
             "{}: zeta_cr {:.5} ± {:.5} slope {:.3} in {:.1}s",
-            method.name(), t.zeta_cr, t.err, t.slope, t0.elapsed().as_secs_f64()
+            method.name(),
+            t.zeta_cr,
+            t.err,
+            t.slope,
+            t0.elapsed().as_secs_f64()
         );
         for e in &t.evaluations {
-            println!("   zeta {:.5} sigma {:+.4e} ± {:.1e}", e.zeta, e.sigma, e.sigma_err);
+            println!(
+                "   zeta {:.5} sigma {:+.4e} ± {:.1e}",
+                e.zeta, e.sigma, e.sigma_err
+            );
         }
     }
     Ok(())

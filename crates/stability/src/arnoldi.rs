@@ -3,7 +3,7 @@
 
 use faer::Mat;
 
-use crate::growth::random_direction;
+use crate::growth::start_vector;
 use crate::map::{dot, norm, StepMap};
 use crate::StabilityError;
 
@@ -63,7 +63,8 @@ impl Spectrum {
 
 /// Arnoldi on `J` (the map's Jacobian at its base, the uniform translations projected out
 /// before and after), from `start` (on the reference layout, e.g. the leading mode at a nearby
-/// activity) or, without one, from a random vector from `opts.seed`.
+/// activity, with a random part mixed in: [`crate::start_vector`]) or, without one, from a
+/// random vector from `opts.seed`.
 ///
 /// # Errors
 /// [`StabilityError::Step`] when a step fails, [`StabilityError::Eigen`] when faer's
@@ -75,16 +76,7 @@ pub fn arnoldi(
 ) -> Result<Spectrum, StabilityError> {
     let n = map.len();
     let k = opts.krylov.max(1);
-    let first = match start {
-        Some(s) if s.len() == n => {
-            let mut v = s.to_vec();
-            map.project(&mut v);
-            let size = norm(&v);
-            v.iter_mut().for_each(|x| *x /= size);
-            v
-        }
-        _ => random_direction(map, opts.seed),
-    };
+    let first = start_vector(map, start, opts.seed);
     let mut basis: Vec<Vec<f64>> = vec![first];
     let mut h = Mat::<f64>::zeros(k + 1, k);
     let mut w = vec![0.0; n];

@@ -31,7 +31,9 @@ pub fn poly(x: &[f64], y: &[f64], err: Option<&[f64]>, degree: usize) -> Option<
     let a = Mat::<f64>::from_fn(p, p, |r, c| {
         (0..n).map(|i| w[i] * x[i].powi((r + c) as i32)).sum()
     });
-    let b = Mat::<f64>::from_fn(p, 1, |r, _| (0..n).map(|i| w[i] * x[i].powi(r as i32) * y[i]).sum());
+    let b = Mat::<f64>::from_fn(p, 1, |r, _| {
+        (0..n).map(|i| w[i] * x[i].powi(r as i32) * y[i]).sum()
+    });
     let lu = a.partial_piv_lu();
     let inv = lu.inverse();
     if (0..p).any(|k| !inv[(k, k)].is_finite()) {
@@ -41,7 +43,11 @@ pub fn poly(x: &[f64], y: &[f64], err: Option<&[f64]>, degree: usize) -> Option<
     let coef: Vec<f64> = (0..p).map(|k| sol[(k, 0)]).collect();
     let chi2: f64 = (0..n)
         .map(|i| {
-            let f: f64 = coef.iter().enumerate().map(|(k, c)| c * x[i].powi(k as i32)).sum();
+            let f: f64 = coef
+                .iter()
+                .enumerate()
+                .map(|(k, c)| c * x[i].powi(k as i32))
+                .sum();
             w[i] * (y[i] - f) * (y[i] - f)
         })
         .sum();

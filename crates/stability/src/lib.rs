@@ -26,10 +26,12 @@ mod rest;
 mod threshold;
 
 pub use arnoldi::{arnoldi, ArnoldiOptions, Ritz, Spectrum};
-pub use growth::{growth_rate, random_direction, Growth, GrowthOptions};
+pub use growth::{growth_rate, random_direction, settle, start_vector, Growth, GrowthOptions};
 pub use map::{dot, norm, transfer, StepMap};
 pub use rest::{rest_state, HexBox, Relaxation, RestState};
-pub use threshold::{bisect, threshold, Bisection, Evaluation, Method, Threshold, ThresholdOptions};
+pub use threshold::{
+    bisect, threshold, Bisection, Evaluation, Method, Threshold, ThresholdOptions,
+};
 
 /// Why a stability computation failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -48,8 +48,8 @@ pub fn transfer(from_cells: &Cells<f64>, from: &[f64], to: &Cells<f64>, out: &mu
         let ys = to.map().cell_y(shape, i);
         for (a, &x) in xs.iter().enumerate() {
             for (b, &y) in ys.iter().enumerate() {
-                dst[a * shape.ny + b] = index_in(from_cells, i, x as usize, y as usize)
-                    .map_or(0.0, |k| from[k]);
+                dst[a * shape.ny + b] =
+                    index_in(from_cells, i, x as usize, y as usize).map_or(0.0, |k| from[k]);
             }
         }
     }

@@ -2,7 +2,12 @@
 
 use mechanics::{ModelParams, StepParams, Tissue};
 
-use crate::{arnoldi, growth_rate, ArnoldiOptions, GrowthOptions, Spectrum, StabilityError, StepMap};
+use crate::{
+    arnoldi, growth_rate, ArnoldiOptions, GrowthOptions, Spectrum, StabilityError, StepMap,
+};
+
+/// Narrowing rounds of [`bisect`] before plain halving.
+pub const NARROWING_ROUNDS: usize = 3;
 
 /// A threshold found by bisection.
 #[derive(Debug, Clone, PartialEq)]
@@ -18,10 +23,11 @@ pub struct Bisection {
 /// The ζ in `[lo, hi]` where `sigma(ζ)` changes sign from negative to positive, to within
 /// `tol` (half the final bracket).
 ///
-/// When `narrow > 0`, the first bracket is narrowed before bisecting: σ is evaluated at the
-/// root of the straight line through the two ends, ± `narrow`, and the bracket becomes the
-/// smallest interval between evaluated points across which σ changes sign (σ(ζ) is nearly
-/// straight, so this saves several halvings; it is still a bracket, never an extrapolation).
+/// When `narrow > 0`, the bracket is first narrowed, up to [`NARROWING_ROUNDS`] times while it
+/// is wider than `4·narrow`: σ is evaluated at the root of the straight line through the
+/// bracket's ends, ± `narrow`, and the bracket becomes the smallest interval between evaluated
+/// points across which σ changes sign (σ(ζ) is nearly straight, so this saves several halvings;
+/// it is still a bracket, never an extrapolation). Then it is halved.
 ///
 /// # Errors
 /// [`StabilityError::NoCrossing`] when σ has the same sign at both ends, and whatever `sigma`
@@ -46,29 +52,31 @@ pub fn bisect(
             sigma_hi: sb,
         });
     }
-    let (mut a, mut b) = (lo, hi);
-    if narrow > 0.0 {
-        let guess = lo - sa * (hi - lo) / (sb - sa);
-        for z in [guess - narrow, guess + narrow] {
-            if z > a && z < b && 0.5 * (b - a) > tol {
-                let s = sigma(z)?;
-                evaluations.push((z, s));
-                if s < 0.0 {
-                    a = z;
-                } else {
-                    b = z;
-                }
-            }
-        }
-    }
+    let (mut a, mut b, mut sa, mut sb) = (lo, hi, sa, sb);
+    let mut rounds = 0;
     while 0.5 * (b - a) > tol {
-        let m = 0.5 * (a + b);
-        let s = sigma(m)?;
-        evaluations.push((m, s));
-        if s < 0.0 {
-            a = m;
+        let points: Vec<f64> = if narrow > 0.0 && rounds < NARROWING_ROUNDS && b - a > 4.0 * narrow
+        {
+            rounds += 1;
+            let guess = a - sa * (b - a) / (sb - sa);
+            [guess - narrow, guess + narrow]
+                .into_iter()
+                .filter(|z| *z > a && *z < b)
+                .collect()
         } else {
-            b = m;
+            vec![0.5 * (a + b)]
+        };
+        for z in points {
+            if z <= a || z >= b {
+                continue;
+            }
+            let s = sigma(z)?;
+            evaluations.push((z, s));
+            if s < 0.0 {
+                (a, sa) = (z, s);
+            } else {
+                (b, sb) = (z, s);
+            }
         }
     }
     Ok(Bisection {
@@ -82,7 +90,7 @@ pub fn bisect(
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// Perturbation growth ([`growth_rate`]), each evaluation started from the last one's
-    /// final direction.
+    /// final direction (the first, from a random one, runs three times as many intervals).
     Growth(GrowthOptions),
     /// Arnoldi ([`arnoldi`]), each evaluation started from the last one's leading mode.
     Arnoldi(ArnoldiOptions),
@@ -122,8 +130,8 @@ pub struct Evaluation {
     pub zeta: f64,
     /// The leading growth rate.
     pub sigma: f64,
-    /// Its error: the Ritz residual (Arnoldi), or the standard error and the drift of the
-    /// settled rates in quadrature (growth).
+    /// Its error: the Ritz residual (Arnoldi), or the tail of the rates' approach
+    /// ([`crate::settle`], growth).
     pub sigma_err: f64,
 }
 
@@ -160,12 +168,22 @@ pub fn threshold(
     let mut spectrum = None;
     let b = bisect(
         |zeta| {
-            let mut map = StepMap::new(base, &params.clone().with_zeta(zeta), opts.step, opts.steps)?;
+            let mut map =
+                StepMap::new(base, &params.clone().with_zeta(zeta), opts.step, opts.steps)?;
             let (sigma, err) = match method {
                 Method::Growth(g) => {
-                    let r = growth_rate(&mut map, g, start.as_deref())?;
+                    // A cold start runs three times as long: it begins far from the mode.
+                    let g = GrowthOptions {
+                        intervals: if start.is_none() {
+                            3 * g.intervals
+                        } else {
+                            g.intervals
+                        },
+                        ..*g
+                    };
+                    let r = growth_rate(&mut map, &g, start.as_deref())?;
                     start = Some(r.direction);
-                    (r.sigma, r.sigma_err.hypot(r.drift))
+                    (r.sigma, r.sigma_err)
                 }
                 Method::Arnoldi(a) => {
                     let s = arnoldi(&mut map, a, start.as_deref())?;
@@ -220,7 +238,14 @@ mod tests {
         let narrowed = bisect(|z| Ok((z - root) * 7.0), 0.0, 0.016, 1e-5, 4e-4).unwrap();
         assert!(narrowed.evaluations.len() < plain.evaluations.len());
         // A curved σ still ends in a true bracket.
-        let b = bisect(|z| Ok((z - root) * (1.0 + 300.0 * z)), 0.0, 0.016, 1e-5, 4e-4).unwrap();
+        let b = bisect(
+            |z| Ok((z - root) * (1.0 + 300.0 * z)),
+            0.0,
+            0.016,
+            1e-5,
+            4e-4,
+        )
+        .unwrap();
         assert!((b.zeta - root).abs() <= b.err);
     }
 

@@ -15,7 +15,10 @@ mod contractile;
 mod defect_fields;
 mod defects;
 mod lengths;
+mod rules;
+mod run_length;
 mod scaling;
+mod stability;
 mod table;
 mod threshold;
 
@@ -131,17 +134,23 @@ pub enum Figure {
     Contractile,
     /// Cost of subdomains against the full domain.
     Scaling,
+    /// The threshold as the linear instability of an ordered rest state.
+    Stability,
+    /// The threshold of the random packing against the run length.
+    RunLength,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 6] = [
+    pub const ALL: [Figure; 8] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
         Self::DefectFields,
         Self::Contractile,
         Self::Scaling,
+        Self::Stability,
+        Self::RunLength,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -153,6 +162,8 @@ impl Figure {
             Self::DefectFields => "defect-fields",
             Self::Contractile => "contractile",
             Self::Scaling => "scaling",
+            Self::Stability => "stability",
+            Self::RunLength => "run-length",
         }
     }
 
@@ -165,6 +176,12 @@ impl Figure {
             Self::DefectFields => "Flow and stress around ±1/2 defects (Fig. 4)",
             Self::Contractile => "Contractile activity stays at rest (supplement)",
             Self::Scaling => "Cost of subdomains against the full domain (supplement)",
+            Self::Stability => {
+                "The threshold as the linear instability of a hexagonal rest state (issue 26)"
+            }
+            Self::RunLength => {
+                "The threshold of the random packing against the run length (issue 26)"
+            }
         }
     }
 }
@@ -377,6 +394,8 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::DefectFields => defect_fields::make(p, &dir)?,
         Figure::Contractile => contractile::make(p, &dir)?,
         Figure::Scaling => scaling::make(p, &dir)?,
+        Figure::Stability => stability::make(p, &dir)?,
+        Figure::RunLength => run_length::make(p, &dir)?,
     };
     let wall_s = start.elapsed().as_secs_f64();
     write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;

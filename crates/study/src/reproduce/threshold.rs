@@ -7,8 +7,10 @@ use std::path::Path;
 
 use render::{Plot, Series};
 
+use super::rules::{rule_box, rule_converged, rule_linear, rule_proportional};
 use super::{
-    drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict,
+    drawn, g, mean_se, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob,
+    Verdict,
 };
 use crate::threshold::{csv_fields, growth_threshold, threshold, RatePoint, Threshold};
 use crate::SweepError;
@@ -46,6 +48,18 @@ struct Group {
     seeds: usize,
     /// The growth rate at ζ = 0 (mean, std over seeds).
     rate0: (f64, f64),
+    /// The growth estimate of each seed on its own (`None` where its bracket is open), by seed.
+    per_seed: Vec<(u64, Option<f64>)>,
+}
+
+impl Group {
+    /// Mean and standard error of the per-seed ζ_cr over the seeds whose bracket closed, and
+    /// their number.
+    fn seed_zeta(&self) -> (f64, f64, usize) {
+        let z: Vec<f64> = self.per_seed.iter().filter_map(|p| p.1).collect();
+        let (m, se) = mean_se(&z);
+        (m, se, z.len())
+    }
 }
 
 /// Groups the records of a sweep whose axes are `[pressure, gamma, zeta]` (gamma given
@@ -109,6 +123,27 @@ fn groups(recs: &[Rec], lx: usize, integrator: &str, gamma_axis: bool) -> Vec<Gr
                 threshold(&baseline, &points)
             };
             let threshold = growth_threshold(&points);
+            let mut seeds: Vec<u64> = mine.iter().map(|r| r.seed).collect();
+            seeds.sort_unstable();
+            seeds.dedup();
+            let per_seed = seeds
+                .iter()
+                .map(|&seed| {
+                    let own: Vec<RatePoint> = mine
+                        .iter()
+                        .filter(|r| r.seed == seed && zeta_of(r) != 0.0)
+                        .map(|r| RatePoint {
+                            zeta: zeta_of(r),
+                            rates: vec![r.summary.growth_rate],
+                        })
+                        .collect();
+                    let z = match growth_threshold(&own) {
+                        Threshold::Bracketed { zeta_cr, .. } => Some(zeta_cr),
+                        _ => None,
+                    };
+                    (seed, z)
+                })
+                .collect();
             Group {
                 lx,
                 pressure,
@@ -123,6 +158,7 @@ fn groups(recs: &[Rec], lx: usize, integrator: &str, gamma_axis: bool) -> Vec<Gr
                 excess,
                 seeds: baseline.len(),
                 rate0: mean_std(&baseline),
+                per_seed,
             }
         })
         .collect()
@@ -135,19 +171,6 @@ fn bracket(t: Threshold) -> (f64, f64, f64) {
         Threshold::Below { hi } => (f64::NAN, f64::NAN, hi),
         Threshold::Above { lo } => (f64::NAN, lo, f64::NAN),
     }
-}
-
-/// A least-squares line `y = a + b x`: `(a, b, largest |residual|)`.
-fn line(x: &[f64], y: &[f64]) -> (f64, f64, f64) {
-    let b = crate::summary::slope(x, y);
-    let n = x.len() as f64;
-    let a = (y.iter().sum::<f64>() - b * x.iter().sum::<f64>()) / n;
-    let res = x
-        .iter()
-        .zip(y)
-        .map(|(x, y)| (y - a - b * x).abs())
-        .fold(0.0, f64::max);
-    (a, b, res)
 }
 
 pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
@@ -206,11 +229,12 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
 
     // threshold.csv
     let mut csv = String::from(
-        "gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities,run_time,integrator\n",
+        "gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities,run_time,integrator,zeta_cr_seed_mean,zeta_cr_seed_se,seeds_bracketed\n",
     );
     for gr in all.iter().chain(&compare) {
+        let (m, se, n) = gr.seed_zeta();
         csv += &format!(
-            "{},{},{},{},{},{},{},{t},{}\n",
+            "{},{},{},{},{},{},{},{t},{},{m:e},{se:e},{n}\n",
             gr.gamma,
             gr.lx,
             gr.pressure,
@@ -332,8 +356,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let mut b = Plot::new(
         "Fig. 2b: threshold against γ",
         "interface stiffness γ",
-        "ζ_cr (bar: ± half the bracket)",
+        "ζ_cr (per-seed mean ± s.e.)",
     );
+    // The claim is about proportionality: both axes reach zero.
+    b.zero_x = true;
+    b.zero_y = true;
     for pressure in PRESSURES {
         for (lx, _) in BOXES {
             let mut pts = Vec::new();
@@ -341,9 +368,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .iter()
                 .filter(|gr| gr.lx == lx && gr.pressure == pressure)
             {
-                let (z, lo, hi) = bracket(gr.threshold);
-                let (mid, half) = mid_half(z, lo, hi);
-                pts.push((gr.gamma, mid, half));
+                let (m, se, _) = gr.seed_zeta();
+                pts.push((gr.gamma, m, se));
             }
             let mut sr = Series::new(format!("L = {lx}, {pressure} pressure"));
             sr.points = pts;
@@ -359,7 +385,12 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     rl.series.extend(length_series);
     drawn(rl.save_png(&dir.join("threshold_vs_run_length.png")))?;
 
-    let claims = verdicts(&all, &compare);
+    // The same runs cut at T/2, for 9.1's test of whether ζ_cr has settled.
+    let mut half = Vec::new();
+    for (lx, _, res) in &long_recs {
+        half.extend(groups(&res.records(Some(0.5 * t))?, *lx, &integ_name, true));
+    }
+    let claims = verdicts(&all, &half, &compare);
     let settings = format!(
         "- Paper scene (docs/model.md §8), γ ∈ {{{}}}, boxes L = 100 (60 cells) and L = 200 (240 cells), both pressure forms; ζ ∈ {{{ZETAS}}}; seeds {}.\n\
          - Each run: 200 TU of relaxation at ζ = 0, then {t} TU at ζ; integrator {integ_name}, f32 storage.\n\
@@ -394,168 +425,160 @@ fn describe(t: Threshold) -> String {
     }
 }
 
-fn verdicts(all: &[Group], compare: &[Group]) -> Vec<Claim> {
+/// The per-seed ζ_cr of a group as `mean ± se (n of m seeds)`.
+fn seed_text(gr: &Group) -> String {
+    let (m, se, n) = gr.seed_zeta();
+    format!("{} ± {} ({n} of {} seeds)", g(m), g(se), gr.per_seed.len())
+}
+
+/// The verdicts of the figure. `half` holds the same groups from the first half of the runs
+/// (T/2), for 9.1's test of whether ζ_cr has settled.
+fn verdicts(all: &[Group], half: &[Group], compare: &[Group]) -> Vec<Claim> {
     let mut claims = Vec::new();
     for pressure in PRESSURES {
         let mine: Vec<&Group> = all.iter().filter(|g| g.pressure == pressure).collect();
-        // 9.1: rest below, flow and order above.
+        // 9.1: flow and order above; rest below a threshold that does not move with T.
         let at = |gr: &Group, z: f64| gr.zetas.iter().position(|&x| x == z);
         let mut measured = Vec::new();
-        let mut ok = true;
+        let mut flows = true;
+        let mut settled: Vec<(Verdict, String)> = Vec::new();
         for gr in mine.iter().filter(|g| g.gamma == 0.01) {
             let (Some(k0), Some(k1)) = (at(gr, 0.0), Some(gr.zetas.len() - 1)) else {
                 continue;
             };
             let ratio = gr.v_rms[k1].0 / gr.v_rms[k0].0;
             let (se, ss) = gr.s_excess[k1];
-            let decays = gr.rate0.0 < 0.0;
-            ok &= ratio > 3.0 && se > 2.0 * ss && decays;
+            flows &= ratio > 3.0 && se > 2.0 * ss;
+            let early = half
+                .iter()
+                .find(|h| h.lx == gr.lx && h.gamma == gr.gamma && h.pressure == gr.pressure);
+            // Paired per seed: ζ_cr(T) − ζ_cr(T/2).
+            let diffs: Vec<f64> = early.map_or(Vec::new(), |h| {
+                gr.per_seed
+                    .iter()
+                    .filter_map(|(seed, z)| {
+                        let e = h.per_seed.iter().find(|p| p.0 == *seed)?.1?;
+                        Some((*z)? - e)
+                    })
+                    .collect()
+            });
+            let (v, why) = rule_converged(&diffs, gr.seed_zeta().0);
+            settled.push((v, format!("L = {}: {why}", gr.lx)));
             measured.push(format!(
-                "L = {}: v_rms(ζ = {}) / v_rms(0) = {}; S_rms − S_rms(0) = {}; at ζ = 0 v_rms = {} and d ln v_rms/dt = {} /TU",
+                "L = {}: v_rms(ζ = {}) / v_rms(0) = {}; S_rms − S_rms(0) = {}; at ζ = 0 d ln v_rms/dt = {} /TU; ζ_cr per seed {} at T, {} at T/2",
                 gr.lx,
                 gr.zetas[k1],
                 g(ratio),
                 pm((se, ss)),
-                pm(gr.v_rms[k0]),
-                pm(gr.rate0)
+                pm(gr.rate0),
+                seed_text(gr),
+                early.map_or("–".into(), seed_text)
             ));
         }
+        let (verdict, reason) = if !flows {
+            (
+                Verdict::DoesNotHold,
+                "at γ = 0.01 the largest ζ does not raise v_rms 3× and S_rms by 2 seed spreads over ζ = 0".to_string(),
+            )
+        } else if !settled.is_empty() && settled.iter().all(|s| s.0 == Verdict::Holds) {
+            (
+                Verdict::Holds,
+                format!(
+                    "flow and order rise above ζ_cr, and ζ_cr has settled: {}",
+                    settled
+                        .iter()
+                        .map(|s| s.1.clone())
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ),
+            )
+        } else {
+            (
+                Verdict::Inconclusive,
+                format!(
+                    "flow and order rise with ζ, but the threshold is not established at this run length: {}. `reproduce run-length` fits ζ_cr(T) to 3200 TU and `reproduce stability` gives the linear threshold of an ordered rest state",
+                    settled.iter().map(|s| s.1.clone()).collect::<Vec<_>>().join("; ")
+                ),
+            )
+        };
         claims.push(Claim::new(
             format!("9.1 ({pressure} pressure): below ζ_cr the tissue relaxes to rest; above it flow and extra nematic order persist"),
             measured.join("; "),
-            if ok { Verdict::Holds } else { Verdict::DoesNotHold },
-            if ok {
-                "v_rms rises by more than 3× over the ζ = 0 level and S_rms by more than 2 seed spreads; at ζ = 0 the flow decays (negative growth rate), and below ζ_cr it decays too. The paper's criterion (v_rms > 1e-7) would call every run flowing: the passive packing still moves at v_rms(0)."
-            } else {
-                "at γ = 0.01 the largest ζ does not raise v_rms 3× and S_rms by 2 seed spreads over ζ = 0, or the passive flow does not decay"
-            },
+            verdict,
+            reason,
         ));
-        // 9.2: linear in γ, independent of L.
+        // 9.2a: linear in γ, and proportional, from the per-seed ζ_cr.
         let mut lin = Vec::new();
-        let mut verdict = Verdict::Holds;
-        let mut reasons = Vec::new();
+        let mut verdict_lin = Vec::new();
+        let mut verdict_prop = Vec::new();
         for (lx, _) in BOXES {
-            let gs: Vec<&&Group> = mine.iter().filter(|g| g.lx == lx).collect();
-            let pts: Vec<(f64, f64, f64, f64)> = gs
+            let pts: Vec<(f64, (f64, f64, usize))> = mine
                 .iter()
-                .map(|gr| {
-                    let (z, lo, hi) = bracket(gr.threshold);
-                    (gr.gamma, z, lo, hi)
-                })
+                .filter(|g| g.lx == lx)
+                .map(|gr| (gr.gamma, gr.seed_zeta()))
+                .filter(|p| p.1 .0.is_finite() && p.1 .1.is_finite())
                 .collect();
-            if pts.iter().any(|p| !p.1.is_finite()) {
-                verdict = Verdict::Inconclusive;
-                reasons.push(format!(
-                    "L = {lx}: an open bracket ({})",
-                    gs.iter()
-                        .map(|g| describe(g.threshold))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ));
-                continue;
-            }
             let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
-            let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
-            let (a, b, res) = line(&x, &y);
-            let half = pts
-                .iter()
-                .map(|p| 0.5 * (p.3 - p.2))
-                .fold(f64::INFINITY, f64::min);
+            let y: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
+            let e: Vec<f64> = pts.iter().map(|p| p.1 .1.max(1e-9)).collect();
             lin.push(format!(
-                "L = {lx}: ζ_cr = {} + {}·γ (largest residual {}; ζ_cr at γ = {}: {})",
-                g(a),
-                g(b),
-                g(res),
-                x.iter()
-                    .map(|v| v.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                gs.iter()
-                    .map(|g| describe(g.threshold))
+                "L = {lx}: {}",
+                mine.iter()
+                    .filter(|g| g.lx == lx)
+                    .map(|gr| format!("γ = {}: {}", gr.gamma, seed_text(gr)))
                     .collect::<Vec<_>>()
                     .join(", ")
             ));
-            let increasing = y.windows(2).all(|w| w[1] >= w[0]);
-            if !(b > 0.0 && increasing) {
-                verdict = Verdict::DoesNotHold;
-                reasons.push(format!("L = {lx}: ζ_cr does not rise with γ"));
-            } else if res > half {
-                if verdict == Verdict::Holds {
-                    verdict = Verdict::Inconclusive;
-                }
-                reasons.push(format!(
-                    "L = {lx}: a residual exceeds the half-bracket {}",
-                    g(half)
-                ));
+            let falls = stability::fit::line(&x, &y, Some(&e))
+                .is_some_and(|f| f.coef[1] + 2.0 * f.se[1] < 0.0);
+            if falls {
+                verdict_lin.push((Verdict::DoesNotHold, format!("L = {lx}: ζ_cr falls with γ")));
             } else {
-                reasons.push(format!(
-                    "L = {lx}: rises, residuals within the half-bracket; the line {} zero (intercept {})",
-                    if a.abs() > half { "does not pass through" } else { "passes near" },
-                    g(a)
-                ));
+                let (v, why) = rule_linear(&x, &y, &e);
+                verdict_lin.push((v, format!("L = {lx}: {why}")));
             }
+            let (v, why) = rule_proportional(&x, &y, &e);
+            verdict_prop.push((v, format!("L = {lx}: {why}")));
         }
-        claims.push(Claim::new(
-            format!("9.2a ({pressure} pressure): ζ_cr grows linearly with γ"),
-            lin.join("; "),
-            verdict,
-            reasons.join("; "),
-        ));
-        // Independence of L: brackets overlap at every γ.
+        for (claim, v) in [
+            (
+                format!("9.2a ({pressure} pressure): ζ_cr grows linearly with γ"),
+                verdict_lin,
+            ),
+            (
+                format!("9.2a ({pressure} pressure): ζ_cr ∝ γ, a line through zero"),
+                verdict_prop,
+            ),
+        ] {
+            claims.push(Claim::new(
+                claim,
+                format!("per-seed ζ_cr, mean ± s.e.: {}", lin.join("; ")),
+                combine(&v),
+                v.iter().map(|x| x.1.clone()).collect::<Vec<_>>().join("; "),
+            ));
+        }
+        // 9.2b: the box, at every γ, from the per-seed ζ_cr.
         let mut same = Vec::new();
-        let mut shifts = Vec::new();
-        let mut verdict = Verdict::Holds;
         for gamma in GAMMAS {
-            let b: Vec<(f64, f64, f64)> = BOXES
+            let pts: Vec<(f64, f64, f64)> = BOXES
                 .iter()
                 .filter_map(|(lx, _)| {
-                    mine.iter()
-                        .find(|g| g.lx == *lx && g.gamma == gamma)
-                        .map(|g| bracket(g.threshold))
+                    let gr = mine.iter().find(|g| g.lx == *lx && g.gamma == gamma)?;
+                    let (m, se, _) = gr.seed_zeta();
+                    (m.is_finite() && se.is_finite()).then_some((*lx as f64, m, se))
                 })
                 .collect();
-            if b.len() < 2 {
-                continue;
-            }
-            let lo = |x: &(f64, f64, f64)| {
-                if x.1.is_finite() {
-                    x.1
-                } else {
-                    f64::NEG_INFINITY
-                }
-            };
-            let hi = |x: &(f64, f64, f64)| if x.2.is_finite() { x.2 } else { f64::INFINITY };
-            // Touching brackets agree within the grid's resolution.
-            let overlap = lo(&b[0]) <= hi(&b[1]) && lo(&b[1]) <= hi(&b[0]);
-            if !overlap {
-                verdict = Verdict::DoesNotHold;
-            } else if !(b[0].0.is_finite() && b[1].0.is_finite()) && verdict == Verdict::Holds {
-                verdict = Verdict::Inconclusive;
-            }
-            if b[0].0.is_finite() && b[1].0.is_finite() {
-                shifts.push(b[1].0 - b[0].0);
-            }
-            same.push(format!(
-                "γ = {gamma}: L = 100 {} vs L = 200 {}",
-                describe_b(b[0]),
-                describe_b(b[1])
-            ));
-        }
-        if !shifts.is_empty() {
-            same.push(format!(
-                "mean shift ζ_cr(200) − ζ_cr(100) = {}",
-                pm(mean_std(&shifts))
-            ));
+            let (v, why) = rule_box(&pts);
+            same.push((v, format!("γ = {gamma}: {why}")));
         }
         claims.push(Claim::new(
             format!("9.2b ({pressure} pressure): ζ_cr does not depend on the domain size"),
-            same.join("; "),
-            verdict,
-            match verdict {
-                Verdict::Holds => "the brackets of L = 100 and L = 200 overlap (or touch: agree within the ζ grid) at every γ",
-                Verdict::DoesNotHold => "at some γ the brackets of the two boxes are disjoint",
-                Verdict::Inconclusive => "the brackets overlap, but some are open",
-            },
+            format!("per-seed ζ_cr, mean ± s.e.: {}", lin.join("; ")),
+            combine(&same),
+            same.iter()
+                .map(|x| x.1.clone())
+                .collect::<Vec<_>>()
+                .join("; "),
         ));
     }
     // The pressure form.
@@ -639,12 +662,15 @@ fn verdicts(all: &[Group], compare: &[Group]) -> Vec<Claim> {
     claims
 }
 
-fn describe_b(b: (f64, f64, f64)) -> String {
-    match (b.0.is_finite(), b.1.is_finite(), b.2.is_finite()) {
-        (true, _, _) => format!("{} [{}, {}]", g(b.0), b.1, b.2),
-        (false, false, true) => format!("< {}", b.2),
-        (false, true, false) => format!("> {}", b.1),
-        _ => "–".into(),
+/// One verdict from several: does not hold if any does not, holds if all hold, else
+/// inconclusive.
+fn combine(v: &[(Verdict, String)]) -> Verdict {
+    if v.iter().any(|x| x.0 == Verdict::DoesNotHold) {
+        Verdict::DoesNotHold
+    } else if !v.is_empty() && v.iter().all(|x| x.0 == Verdict::Holds) {
+        Verdict::Holds
+    } else {
+        Verdict::Inconclusive
     }
 }
 
@@ -712,16 +738,28 @@ mod tests {
             let (z, _, _) = bracket(gr.threshold);
             assert!((z - cr(gr.gamma, &gr.pressure)).abs() < 1e-12, "{z}");
         }
-        let claims = verdicts(&all, &[]);
-        assert_eq!(verdict_of(&claims, "9.2a"), [Verdict::Holds; 2]);
+        let claims = verdicts(&all, &all, &[]);
+        // Three γ cannot show a line (a parabola needs four); the intercept 0.001 (paper) and
+        // 0.0008 (interaction) is resolved and ≥ 10 % of ζ_cr: not proportional.
+        assert_eq!(
+            verdict_of(&claims, "9.2a"),
+            [
+                Verdict::Inconclusive,
+                Verdict::DoesNotHold,
+                Verdict::Inconclusive,
+                Verdict::DoesNotHold
+            ]
+        );
         assert_eq!(verdict_of(&claims, "9.2b"), [Verdict::Holds; 2]);
+        // The same runs at T/2: ζ_cr has settled; the synthetic flow rises < 3×, so 9.1 fails.
+        assert_eq!(verdict_of(&claims, "9.1"), [Verdict::DoesNotHold; 2]);
         assert_eq!(verdict_of(&claims, "Pressure form"), [Verdict::Holds]);
         let falling = recs(|gamma, _| 0.004 - 0.1 * gamma);
         let all: Vec<Group> = BOXES
             .iter()
             .flat_map(|(lx, _)| groups(&falling, *lx, "test", true))
             .collect();
-        let claims = verdicts(&all, &[]);
-        assert_eq!(verdict_of(&claims, "9.2a"), [Verdict::DoesNotHold; 2]);
+        let claims = verdicts(&all, &all, &[]);
+        assert_eq!(verdict_of(&claims, "9.2a ("), [Verdict::DoesNotHold; 4]);
     }
 }

@@ -1,0 +1,322 @@
+//! Verdict rules shared by figures: each takes measured values with their errors and returns
+//! a verdict that can come out each way, with the statistic in words. Each rule is unit-tested
+//! on synthetic data for every outcome.
+
+use stability::fit;
+
+use super::{g, Verdict};
+
+/// Agreement of the two methods: holds when every configuration measured by both has
+/// `|ζ_growth − ζ_arnoldi| ≤ 2√(e_g² + e_a²)`; does not hold when one differs by more than that
+/// and by more than 10 % of ζ_cr; inconclusive otherwise (a difference beyond the errors but
+/// small).
+pub(crate) fn rule_agree(pairs: &[(f64, f64, f64, f64)]) -> (Verdict, String) {
+    if pairs.is_empty() {
+        return (
+            Verdict::Inconclusive,
+            "no configuration was measured by both methods".into(),
+        );
+    }
+    let mut worst: (f64, String) = (0.0, String::new());
+    let mut material = false;
+    for &(za, ea, zg, eg) in pairs {
+        let d = zg - za;
+        let e = ea.hypot(eg);
+        let sig = d.abs() / e.max(1e-300);
+        if sig > worst.0 {
+            worst = (sig, format!("ζ_growth − ζ_arnoldi = {} ± {}", g(d), g(e)));
+        }
+        if d.abs() > 2.0 * e && d.abs() > 0.1 * za.abs() {
+            material = true;
+        }
+    }
+    if worst.0 <= 2.0 {
+        (
+            Verdict::Holds,
+            format!(
+                "all {} pairs agree within 2σ of their combined error (worst {})",
+                pairs.len(),
+                worst.1
+            ),
+        )
+    } else if material {
+        (
+            Verdict::DoesNotHold,
+            format!("{}: beyond 2σ and 10 % of ζ_cr", worst.1),
+        )
+    } else {
+        (
+            Verdict::Inconclusive,
+            format!("{}: beyond 2σ but within 10 % of ζ_cr", worst.1),
+        )
+    }
+}
+
+/// Linearity in γ: a weighted parabola through the points; `t = c₂/se(c₂)`. The test's
+/// resolution is the curvature it can see, `2 se(c₂) (Δγ/2)²` at the ends of the range, as a
+/// fraction of the change of ζ_cr over the range. Holds when `|t| < 2` and that resolution is
+/// under 25 %; does not hold when `|t| ≥ 3`; inconclusive otherwise (too few points, a weak
+/// test, or 2 ≤ |t| < 3).
+pub(crate) fn rule_linear(x: &[f64], y: &[f64], e: &[f64]) -> (Verdict, String) {
+    if x.len() < 4 {
+        return (
+            Verdict::Inconclusive,
+            format!(
+                "{} values of γ: a parabola needs four to leave a residual",
+                x.len()
+            ),
+        );
+    }
+    let Some(f) = fit::poly(x, y, Some(e), 2) else {
+        return (Verdict::Inconclusive, "the fit is singular".into());
+    };
+    let span = x.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - x.iter().copied().fold(f64::INFINITY, f64::min);
+    let change = (y.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+        - y.iter().copied().fold(f64::INFINITY, f64::min))
+    .max(1e-300);
+    let t = f.coef[2] / f.se[2];
+    let resolution = 2.0 * f.se[2] * (span / 2.0).powi(2) / change;
+    let what = format!(
+        "curvature c₂ = {} ± {} (t = {}); the test resolves a bend of {} % of the change of ζ_cr",
+        g(f.coef[2]),
+        g(f.se[2]),
+        g(t),
+        g(100.0 * resolution)
+    );
+    if t.abs() >= 3.0 {
+        (
+            Verdict::DoesNotHold,
+            format!("{what}: significant curvature"),
+        )
+    } else if t.abs() < 2.0 && resolution < 0.25 {
+        (Verdict::Holds, what)
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
+/// Proportionality `ζ_cr = aγ`: the weighted line's intercept `b ± se`, against ζ_cr at the
+/// middle γ. Holds when `|b| < 2 se` and `2 se` is under 20 % of ζ_cr (the test could see an
+/// intercept of that size); does not hold when `|b| ≥ 3 se` and `|b|` exceeds 10 % of ζ_cr;
+/// inconclusive otherwise.
+pub(crate) fn rule_proportional(x: &[f64], y: &[f64], e: &[f64]) -> (Verdict, String) {
+    let Some(f) = fit::line(x, y, Some(e)) else {
+        return (Verdict::Inconclusive, "fewer than two values of γ".into());
+    };
+    let mid = x.iter().sum::<f64>() / x.len() as f64;
+    let z_mid = f.coef[0] + f.coef[1] * mid;
+    let (b, se) = (f.coef[0], f.se[0]);
+    let what = format!(
+        "intercept {} ± {} = {} % of ζ_cr at γ = {}; slope {} ± {}",
+        g(b),
+        g(se),
+        g(100.0 * b / z_mid),
+        g(mid),
+        g(f.coef[1]),
+        g(f.se[1])
+    );
+    if b.abs() >= 3.0 * se && b.abs() > 0.1 * z_mid.abs() {
+        (Verdict::DoesNotHold, what)
+    } else if b.abs() < 2.0 * se && 2.0 * se < 0.2 * z_mid.abs() {
+        (Verdict::Holds, what)
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
+/// Independence of the box: the difference Δ between ζ_cr on the largest and the smallest box,
+/// with its error e. Holds when `|Δ| < 2e` and `2e` is under 10 % of ζ_cr (the test could see a
+/// 10 % change); does not hold when `|Δ| ≥ 3e` and `|Δ|` exceeds 5 % of ζ_cr; inconclusive
+/// otherwise.
+pub(crate) fn rule_box(points: &[(f64, f64, f64)]) -> (Verdict, String) {
+    if points.len() < 2 {
+        return (Verdict::Inconclusive, "one box size".into());
+    }
+    let mut p = points.to_vec();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (s, l) = (p[0], p[p.len() - 1]);
+    let d = l.1 - s.1;
+    let e = s.2.hypot(l.2);
+    let z = 0.5 * (s.1 + l.1);
+    let what = format!(
+        "ζ_cr(L = {}) − ζ_cr(L = {}) = {} ± {} ({} % of ζ_cr)",
+        l.0,
+        s.0,
+        g(d),
+        g(e),
+        g(100.0 * d / z)
+    );
+    if d.abs() >= 3.0 * e && d.abs() > 0.05 * z.abs() {
+        (Verdict::DoesNotHold, what)
+    } else if d.abs() < 2.0 * e && 2.0 * e < 0.1 * z.abs() {
+        (Verdict::Holds, what)
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
+/// The continuum prediction `ζ_cr → 0` as `L → ∞`: a weighted fit `ζ_cr = ζ_∞ + c/L²` (the
+/// slowest elastic mode of a box decays as `q² ∝ 1/L²`). Holds when `c > 2 se(c)` and
+/// `|ζ_∞| < 2 se(ζ_∞)`; does not hold when `ζ_∞ ≥ 3 se(ζ_∞)` (a finite limit); inconclusive
+/// otherwise, and with fewer than three sizes (two cannot tell a limit from a trend).
+pub(crate) fn rule_continuum(points: &[(f64, f64, f64)]) -> (Verdict, String) {
+    if points.len() < 3 {
+        return (
+            Verdict::Inconclusive,
+            format!(
+                "{} box sizes: a limit L → ∞ needs three (the paper scale has them)",
+                points.len()
+            ),
+        );
+    }
+    let x: Vec<f64> = points.iter().map(|p| 1.0 / (p.0 * p.0)).collect();
+    let y: Vec<f64> = points.iter().map(|p| p.1).collect();
+    let e: Vec<f64> = points.iter().map(|p| p.2).collect();
+    let Some(f) = fit::line(&x, &y, Some(&e)) else {
+        return (Verdict::Inconclusive, "the fit is singular".into());
+    };
+    let what = format!(
+        "ζ_cr = ζ_∞ + c/L²: ζ_∞ = {} ± {}, c = {} ± {}, χ² = {} for {} dof",
+        g(f.coef[0]),
+        g(f.se[0]),
+        g(f.coef[1]),
+        g(f.se[1]),
+        g(f.chi2),
+        f.dof
+    );
+    if f.coef[0] >= 3.0 * f.se[0] {
+        (Verdict::DoesNotHold, format!("{what}: a finite limit"))
+    } else if f.coef[1] > 2.0 * f.se[1] && f.coef[0].abs() < 2.0 * f.se[0] {
+        (Verdict::Holds, what)
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
+/// A threshold that has settled with the run length: the paired per-seed differences
+/// `ζ_cr(T) − ζ_cr(T/2)`, mean ± s.e. Holds when `|mean| < 2 se` and `2 se` is under 10 % of
+/// ζ_cr (the test could see a 10 % drift); does not hold (it moves) when `|mean| ≥ 2 se` and
+/// `|mean|` exceeds 5 % of ζ_cr; inconclusive otherwise (fewer than two seeds, or too weak).
+pub(crate) fn rule_converged(diffs: &[f64], zeta: f64) -> (Verdict, String) {
+    if diffs.len() < 2 {
+        return (
+            Verdict::Inconclusive,
+            format!(
+                "{} seeds with ζ_cr bracketed at both T and T/2",
+                diffs.len()
+            ),
+        );
+    }
+    let (m, se) = super::mean_se(diffs);
+    let what = format!(
+        "ζ_cr(T) − ζ_cr(T/2) = {} ± {} over {} seeds ({} % of ζ_cr)",
+        g(m),
+        g(se),
+        diffs.len(),
+        g(100.0 * m / zeta)
+    );
+    if m.abs() >= 2.0 * se && m.abs() > 0.05 * zeta.abs() {
+        (
+            Verdict::DoesNotHold,
+            format!("{what}: it moves with the run length"),
+        )
+    } else if m.abs() < 2.0 * se && 2.0 * se < 0.1 * zeta.abs() {
+        (Verdict::Holds, format!("{what}: settled"))
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn agreement_rule_gives_each_outcome() {
+        assert_eq!(rule_agree(&[(1e-3, 2e-5, 1.02e-3, 3e-5)]).0, Verdict::Holds);
+        assert_eq!(
+            rule_agree(&[(1e-3, 2e-5, 1.5e-3, 3e-5)]).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            rule_agree(&[(1e-3, 1e-6, 1.02e-3, 1e-6)]).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(rule_agree(&[]).0, Verdict::Inconclusive);
+    }
+
+    #[test]
+    fn linearity_rule_gives_each_outcome() {
+        let x = [0.006, 0.008, 0.01, 0.012, 0.014];
+        let e = [1e-5; 5];
+        let line: Vec<f64> = x.iter().map(|g| 2e-4 + 0.1 * g).collect();
+        assert_eq!(rule_linear(&x, &line, &e).0, Verdict::Holds);
+        let bent: Vec<f64> = x.iter().map(|g| 2e-4 + 0.1 * g + 40.0 * g * g).collect();
+        assert_eq!(rule_linear(&x, &bent, &e).0, Verdict::DoesNotHold);
+        // Errors as large as the whole trend: too weak to tell.
+        assert_eq!(rule_linear(&x, &line, &[4e-4; 5]).0, Verdict::Inconclusive);
+        assert_eq!(
+            rule_linear(&x[..3], &line[..3], &e[..3]).0,
+            Verdict::Inconclusive
+        );
+    }
+
+    #[test]
+    fn proportionality_rule_gives_each_outcome() {
+        let x = [0.006, 0.008, 0.01, 0.012, 0.014];
+        let e = [1e-5; 5];
+        let through_zero: Vec<f64> = x.iter().map(|g| 0.1 * g).collect();
+        assert_eq!(rule_proportional(&x, &through_zero, &e).0, Verdict::Holds);
+        let offset: Vec<f64> = x.iter().map(|g| 5e-4 + 0.05 * g).collect();
+        assert_eq!(rule_proportional(&x, &offset, &e).0, Verdict::DoesNotHold);
+        assert_eq!(
+            rule_proportional(&x, &through_zero, &[5e-4; 5]).0,
+            Verdict::Inconclusive
+        );
+    }
+
+    #[test]
+    fn box_rule_gives_each_outcome() {
+        assert_eq!(
+            rule_box(&[(83.0, 1e-3, 1e-5), (333.0, 1.01e-3, 1e-5)]).0,
+            Verdict::Holds
+        );
+        assert_eq!(
+            rule_box(&[(83.0, 1e-3, 1e-5), (333.0, 5e-4, 1e-5)]).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            rule_box(&[(83.0, 1e-3, 1e-4), (333.0, 1.1e-3, 1e-4)]).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(rule_box(&[(83.0, 1e-3, 1e-5)]).0, Verdict::Inconclusive);
+    }
+
+    #[test]
+    fn continuum_rule_gives_each_outcome() {
+        let l = [83.0, 166.0, 333.0];
+        let to_zero: Vec<(f64, f64, f64)> = l.iter().map(|&l| (l, 4.0 / (l * l), 1e-6)).collect();
+        assert_eq!(rule_continuum(&to_zero).0, Verdict::Holds);
+        let finite: Vec<(f64, f64, f64)> =
+            l.iter().map(|&l| (l, 5e-4 + 4.0 / (l * l), 1e-6)).collect();
+        assert_eq!(rule_continuum(&finite).0, Verdict::DoesNotHold);
+        assert_eq!(rule_continuum(&finite[..2]).0, Verdict::Inconclusive);
+        let noisy: Vec<(f64, f64, f64)> = l.iter().map(|&l| (l, 4.0 / (l * l), 1e-3)).collect();
+        assert_eq!(rule_continuum(&noisy).0, Verdict::Inconclusive);
+    }
+
+    #[test]
+    fn convergence_rule_gives_each_outcome() {
+        assert_eq!(rule_converged(&[1e-5, -1e-5, 2e-5], 2e-3).0, Verdict::Holds);
+        assert_eq!(
+            rule_converged(&[-7e-4, -6e-4, -8e-4], 2e-3).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            rule_converged(&[-7e-4, 6e-4, 1e-4], 2e-3).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(rule_converged(&[1e-5], 2e-3).0, Verdict::Inconclusive);
+    }
+}

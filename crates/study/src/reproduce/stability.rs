@@ -1,0 +1,831 @@
+//! `reproduce stability`: the activity threshold as a linear-stability threshold of an ordered
+//! rest state (the `stability` crate), against γ, the box size and the pressure form, by two
+//! independent methods.
+//!
+//! The random packings of the threshold figure keep coarsening at ζ = 0, so the growth rate of
+//! their v_rms is never a clean baseline, and their ζ_cr falls with the run length. Here the
+//! rest state is a hexagonal packing on a box commensurate with it, relaxed at ζ = 0 until its
+//! fields stop changing; ζ_cr is where the leading growth rate σ of small perturbations about
+//! it crosses zero. σ is measured by Arnoldi on the step map's Jacobian and by perturbation
+//! growth (simultaneous power iteration in time); the two must agree.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use mechanics::{ModelParams, PressureKind, StepParams, Tissue};
+use render::{CellAxes, Fill, LatticeVectors, Patches, Plot, Series, TissuePicture};
+use stability::{
+    rest_state, threshold, ArnoldiOptions, GrowthOptions, HexBox, Method, Relaxation, RestState,
+    StabilityError, StepMap, Threshold, ThresholdOptions,
+};
+
+use super::rules::{rule_agree, rule_box, rule_continuum, rule_linear, rule_proportional};
+use super::{drawn, g, write_text, Claim, ReproduceParams, Scale, Verdict};
+use crate::SweepError;
+
+/// The γ of the study: five values, so that a line and its curvature can be told apart.
+const GAMMAS: [f64; 5] = [0.006, 0.008, 0.01, 0.012, 0.014];
+
+/// The paper's density: 60 cells on 100 × 100 nodes.
+const AREA_PER_CELL: f64 = 100.0 * 100.0 / 60.0;
+
+/// The time step of the maps: the fixed points of Heun are those of the equations whatever
+/// the step, and the slow modes that decide σ are integrated far inside Heun's accuracy (the
+/// convergence table compares dt 0.2).
+const DT: f64 = 0.5;
+
+/// Steps per application of the map: τ = 50 TU, which damps the fast modes (σ ≲ −0.05) by
+/// e⁻² or more per application, so that Krylov and power iteration see the slow band.
+const STEPS: usize = 100;
+
+/// Half the final bisection bracket, by method.
+const TOL_ARNOLDI: f64 = 2e-5;
+const TOL_GROWTH: f64 = 5e-5;
+
+/// The bracket: σ < 0 at ζ = 0 (a relaxed state is stable) and σ > 0 at ζ = 0.008 (the top of
+/// the threshold figure's ζ grid).
+const ZETA_HI: f64 = 0.008;
+
+fn pressure_name(p: PressureKind) -> &'static str {
+    match p {
+        PressureKind::Paper => "paper",
+        _ => "interaction",
+    }
+}
+
+/// One configuration: a packing, a γ and a pressure form.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Config {
+    hex: HexBox,
+    gamma: f64,
+    pressure: PressureKind,
+}
+
+impl Config {
+    fn params(&self) -> ModelParams {
+        let mut p = ModelParams::paper(0.0).with_pressure(self.pressure);
+        p.energy.gamma = self.gamma;
+        p
+    }
+
+    fn name(&self) -> String {
+        format!(
+            "γ = {}, {} × {} ({} cells), {} form",
+            self.gamma,
+            self.hex.lx,
+            self.hex.ly,
+            self.hex.n_cells(),
+            pressure_name(self.pressure)
+        )
+    }
+}
+
+/// What a scale computes.
+struct Plan {
+    /// Configurations whose ζ_cr Arnoldi finds.
+    arnoldi: Vec<Config>,
+    /// Configurations whose ζ_cr perturbation growth finds.
+    growth: Vec<Config>,
+    arnoldi_opts: ArnoldiOptions,
+    growth_opts: GrowthOptions,
+}
+
+fn hex(cols: usize, rows: usize) -> HexBox {
+    HexBox::new(cols, rows, AREA_PER_CELL).expect("even rows")
+}
+
+fn plan(scale: Scale) -> Plan {
+    let forms = [PressureKind::Paper, PressureKind::Interaction];
+    let configs = |boxes: &[HexBox], gammas: &[f64]| -> Vec<Config> {
+        let mut v = Vec::new();
+        for &pressure in &forms {
+            for &hex in boxes {
+                for &gamma in gammas {
+                    v.push(Config {
+                        hex,
+                        gamma,
+                        pressure,
+                    });
+                }
+            }
+        }
+        v
+    };
+    let (small, mid, large) = (hex(6, 10), hex(12, 20), hex(24, 40));
+    match scale {
+        Scale::Quick => {
+            let mut arnoldi = configs(&[small], &GAMMAS);
+            arnoldi.extend(configs(&[mid], &[0.01]));
+            Plan {
+                arnoldi,
+                growth: configs(&[small], &[0.01]),
+                arnoldi_opts: ArnoldiOptions {
+                    krylov: 30,
+                    eps: 1e-5,
+                    seed: 1,
+                },
+                growth_opts: GrowthOptions {
+                    amplitude: 1e-4,
+                    intervals: 24,
+                    vectors: 4,
+                    seed: 2,
+                },
+            }
+        }
+        Scale::Paper => {
+            let mut growth = configs(&[small], &GAMMAS);
+            growth.extend(configs(&[mid], &[0.01]));
+            Plan {
+                arnoldi: configs(&[small, mid, large], &GAMMAS),
+                growth,
+                arnoldi_opts: ArnoldiOptions {
+                    krylov: 30,
+                    eps: 1e-5,
+                    seed: 1,
+                },
+                growth_opts: GrowthOptions {
+                    amplitude: 1e-4,
+                    intervals: 40,
+                    vectors: 6,
+                    seed: 2,
+                },
+            }
+        }
+    }
+}
+
+fn threshold_opts(tol: f64) -> ThresholdOptions {
+    ThresholdOptions {
+        step: StepParams::new(DT, 1),
+        steps: STEPS,
+        lo: 0.0,
+        hi: ZETA_HI,
+        tol,
+        narrow: 1e-4,
+    }
+}
+
+fn failed(config: &Config, e: StabilityError) -> SweepError {
+    SweepError::Reproduce {
+        why: format!("stability, {}: {e}", config.name()),
+    }
+}
+
+/// One measured threshold.
+struct Row {
+    config: Config,
+    method: &'static str,
+    /// `None` when σ did not cross zero in the bracket (with why).
+    result: Result<Threshold, String>,
+}
+
+impl Row {
+    fn zeta(&self) -> Option<(f64, f64)> {
+        self.result.as_ref().ok().map(|t| (t.zeta_cr, t.err))
+    }
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let plan = plan(p.scale);
+    let mut rests: BTreeMap<String, RestState> = BTreeMap::new();
+    let relax = Relaxation::default();
+    let key = |c: &Config| {
+        format!(
+            "{}x{} {} {}",
+            c.hex.cols,
+            c.hex.rows,
+            c.gamma,
+            pressure_name(c.pressure)
+        )
+    };
+    let mut rows: Vec<Row> = Vec::new();
+    let jobs: Vec<(Config, Method, f64)> = plan
+        .arnoldi
+        .iter()
+        .map(|c| (*c, Method::Arnoldi(plan.arnoldi_opts), TOL_ARNOLDI))
+        .chain(
+            plan.growth
+                .iter()
+                .map(|c| (*c, Method::Growth(plan.growth_opts), TOL_GROWTH)),
+        )
+        .collect();
+    for (k, (config, method, tol)) in jobs.iter().enumerate() {
+        p.reporter.stage(&format!(
+            "stability {}/{}: ζ_cr by {} for {}",
+            k + 1,
+            jobs.len(),
+            method.name(),
+            config.name()
+        ));
+        if !rests.contains_key(&key(config)) {
+            let rest =
+                rest_state(&config.hex, &config.params(), &relax).map_err(|e| failed(config, e))?;
+            rests.insert(key(config), rest);
+        }
+        let rest = &rests[&key(config)];
+        let result = match threshold(
+            &rest.tissue,
+            &config.params(),
+            method,
+            &threshold_opts(*tol),
+        ) {
+            Ok(t) => Ok(t),
+            Err(e @ StabilityError::NoCrossing { .. }) => Err(e.to_string()),
+            Err(e) => return Err(failed(config, e)),
+        };
+        rows.push(Row {
+            config: *config,
+            method: method.name(),
+            result,
+        });
+    }
+    write_tables(dir, &rows, &rests, &key)?;
+    p.reporter
+        .stage("stability: convergence in dt, margin, Krylov dimension and ε");
+    let convergence = convergence(dir, &rows, &plan)?;
+    p.reporter.stage("stability: pictures");
+    draw(dir, &rows)?;
+    if let Some(row) = rows
+        .iter()
+        .find(|r| r.method == "arnoldi" && r.config.gamma == 0.01 && r.config.hex == hex(6, 10))
+    {
+        if let Ok(t) = &row.result {
+            if let Some(sp) = &t.spectrum {
+                draw_mode(dir, &rests[&key(&row.config)].tissue, &sp.mode, t.zeta_cr)?;
+            }
+        }
+    }
+    let claims = claims(&rows);
+    let settings = settings(p.scale, &plan, &rests, &convergence);
+    Ok((claims, settings))
+}
+
+fn write_tables(
+    dir: &Path,
+    rows: &[Row],
+    rests: &BTreeMap<String, RestState>,
+    key: &dyn Fn(&Config) -> String,
+) -> Result<(), SweepError> {
+    let mut zc = String::from("gamma,lx,pressure,method,zeta_cr,zeta_cr_err\n");
+    let mut gr = String::from("gamma,lx,pressure,method,zeta,sigma,sigma_err\n");
+    let mut sp = String::from("gamma,lx,pressure,zeta,rank,sigma,omega,residual\n");
+    for r in rows {
+        let c = &r.config;
+        let (z, e) = r.zeta().unwrap_or((f64::NAN, f64::NAN));
+        zc += &format!(
+            "{},{},{},{},{z:e},{e:e}\n",
+            c.gamma,
+            c.hex.lx,
+            pressure_name(c.pressure),
+            r.method
+        );
+        if let Ok(t) = &r.result {
+            for ev in &t.evaluations {
+                gr += &format!(
+                    "{},{},{},{},{:e},{:e},{:e}\n",
+                    c.gamma,
+                    c.hex.lx,
+                    pressure_name(c.pressure),
+                    r.method,
+                    ev.zeta,
+                    ev.sigma,
+                    ev.sigma_err
+                );
+            }
+            if let Some(s) = &t.spectrum {
+                let last = t.evaluations.last().map_or(f64::NAN, |e| e.zeta);
+                for (rank, ritz) in s.ritz.iter().enumerate().take(10) {
+                    sp += &format!(
+                        "{},{},{},{last:e},{rank},{:e},{:e},{:e}\n",
+                        c.gamma,
+                        c.hex.lx,
+                        pressure_name(c.pressure),
+                        ritz.sigma,
+                        ritz.omega,
+                        ritz.residual
+                    );
+                }
+            }
+        }
+    }
+    write_text(&dir.join("zeta_cr.csv"), &zc)?;
+    write_text(&dir.join("growth_rates.csv"), &gr)?;
+    write_text(&dir.join("spectrum.csv"), &sp)?;
+    let mut rs = String::from(
+        "cols,rows,lx,ly,cells,anisotropy,gamma,pressure,relax_time,v_max,phi_rate,s_rms\n",
+    );
+    let mut seen = std::collections::BTreeSet::new();
+    for r in rows {
+        let k = key(&r.config);
+        if !seen.insert(k.clone()) {
+            continue;
+        }
+        let c = &r.config;
+        let s = &rests[&k];
+        rs += &format!(
+            "{},{},{},{},{},{:e},{},{},{},{:e},{:e},{:e}\n",
+            c.hex.cols,
+            c.hex.rows,
+            c.hex.lx,
+            c.hex.ly,
+            c.hex.n_cells(),
+            c.hex.anisotropy(),
+            c.gamma,
+            pressure_name(c.pressure),
+            s.time,
+            s.v_max,
+            s.phi_rate,
+            s.s_rms
+        );
+    }
+    write_text(&dir.join("rest_states.csv"), &rs)
+}
+
+/// One line of the convergence table: what changed, σ at the reference ζ, its error.
+struct Conv {
+    what: String,
+    sigma: f64,
+    err: f64,
+}
+
+/// σ at the Arnoldi ζ_cr of γ = 0.01, 6 × 10, paper form, as each numerical parameter changes;
+/// the shift of ζ_cr it implies is Δσ over the slope dσ/dζ.
+fn convergence(dir: &Path, rows: &[Row], plan: &Plan) -> Result<Vec<Conv>, SweepError> {
+    let Some((config, t)) = rows.iter().find_map(|r| {
+        (r.method == "arnoldi"
+            && r.config.gamma == 0.01
+            && r.config.hex == hex(6, 10)
+            && r.config.pressure == PressureKind::Paper)
+            .then_some(())
+            .and(r.result.as_ref().ok().map(|t| (r.config, t)))
+    }) else {
+        return Ok(Vec::new());
+    };
+    let zeta = t.zeta_cr;
+    let base = plan.arnoldi_opts;
+    let mut out = Vec::new();
+    let mut rest_at = BTreeMap::new();
+    let cases: Vec<(String, f64, usize, usize, ArnoldiOptions)> = vec![
+        (
+            format!(
+                "reference: dt {DT}, margin 16, k {}, ε {:e}",
+                base.krylov, base.eps
+            ),
+            DT,
+            16,
+            STEPS,
+            base,
+        ),
+        ("dt 0.2 (τ the same)".into(), 0.2, 16, STEPS * 5 / 2, base),
+        ("margin 12".into(), DT, 12, STEPS, base),
+        ("margin 20".into(), DT, 20, STEPS, base),
+        (
+            format!("Krylov dimension {}", 2 * base.krylov),
+            DT,
+            16,
+            STEPS,
+            ArnoldiOptions {
+                krylov: 2 * base.krylov,
+                ..base
+            },
+        ),
+        (
+            format!("ε {:e}", base.eps / 10.0),
+            DT,
+            16,
+            STEPS,
+            ArnoldiOptions {
+                eps: base.eps / 10.0,
+                ..base
+            },
+        ),
+        (
+            format!("ε {:e}", base.eps * 10.0),
+            DT,
+            16,
+            STEPS,
+            ArnoldiOptions {
+                eps: base.eps * 10.0,
+                ..base
+            },
+        ),
+    ];
+    for (what, dt, margin, steps, opts) in cases {
+        if !rest_at.contains_key(&margin) {
+            let relax = Relaxation {
+                margin,
+                ..Relaxation::default()
+            };
+            let rest = rest_state(&config.hex, &config.params(), &relax)
+                .map_err(|e| failed(&config, e))?;
+            rest_at.insert(margin, rest);
+        }
+        let rest = &rest_at[&margin];
+        let mut map = StepMap::new(
+            &rest.tissue,
+            &config.params().with_zeta(zeta),
+            StepParams::new(dt, 1),
+            steps,
+        )
+        .map_err(|e| failed(&config, e))?;
+        let s = stability::arnoldi(&mut map, &opts, None).map_err(|e| failed(&config, e))?;
+        out.push(Conv {
+            what,
+            sigma: s.sigma(),
+            err: s.ritz[0].residual,
+        });
+    }
+    let mut csv = String::from("case,zeta,sigma,sigma_err,zeta_shift\n");
+    let reference = out[0].sigma;
+    for c in &out {
+        csv += &format!(
+            "\"{}\",{zeta:e},{:e},{:e},{:e}\n",
+            c.what,
+            c.sigma,
+            c.err,
+            (c.sigma - reference) / t.slope
+        );
+    }
+    write_text(&dir.join("convergence.csv"), &csv)?;
+    Ok(out)
+}
+
+fn draw(dir: &Path, rows: &[Row]) -> Result<(), SweepError> {
+    // ζ_cr against γ, from zero, one series per (box, form, method).
+    let mut pg = Plot::new(
+        "ζ_cr of the hexagonal rest state against γ",
+        "γ",
+        "ζ_cr (bars: bracket and σ error)",
+    );
+    pg.zero_x = true;
+    pg.zero_y = true;
+    let mut series: BTreeMap<String, Vec<(f64, f64, f64)>> = BTreeMap::new();
+    for r in rows {
+        if let Some((z, e)) = r.zeta() {
+            series
+                .entry(format!(
+                    "L = {}, {}, {}",
+                    r.config.hex.lx,
+                    pressure_name(r.config.pressure),
+                    r.method
+                ))
+                .or_default()
+                .push((r.config.gamma, z, e));
+        }
+    }
+    let mut pl = Plot::new(
+        "ζ_cr of the hexagonal rest state against the box (γ = 0.01)",
+        "box side lx",
+        "ζ_cr",
+    );
+    pl.zero_y = true;
+    let mut by_l: BTreeMap<String, Vec<(f64, f64, f64)>> = BTreeMap::new();
+    for r in rows.iter().filter(|r| r.config.gamma == 0.01) {
+        if let Some((z, e)) = r.zeta() {
+            by_l.entry(format!(
+                "{}, {}",
+                pressure_name(r.config.pressure),
+                r.method
+            ))
+            .or_default()
+            .push((r.config.hex.lx as f64, z, e));
+        }
+    }
+    for (plot, map, path) in [
+        (&mut pg, &series, "zeta_cr_gamma.png"),
+        (&mut pl, &by_l, "zeta_cr_box.png"),
+    ] {
+        for (label, pts) in map.iter().filter(|(_, v)| v.len() > 1) {
+            let (x, y, e): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+                pts.iter().map(|p| p.0).collect(),
+                pts.iter().map(|p| p.1).collect(),
+                pts.iter().map(|p| p.2).collect(),
+            );
+            plot.series
+                .push(Series::new(label.clone()).with_points(&x, &y, &e));
+        }
+        if !plot.series.is_empty() {
+            drawn(plot.save_png(&dir.join(path)))?;
+        }
+    }
+    // σ(ζ) of γ = 0.01 on the smallest box, both methods.
+    let mut ps = Plot::new(
+        "Leading growth rate σ(ζ), γ = 0.01, 6 × 10 packing",
+        "ζ",
+        "σ (1/TU)",
+    );
+    ps.hlines.push((0.0, String::new()));
+    ps.legend = render::LegendAt::UpperLeft;
+    for r in rows
+        .iter()
+        .filter(|r| r.config.gamma == 0.01 && r.config.hex == hex(6, 10))
+    {
+        if let Ok(t) = &r.result {
+            let mut ev = t.evaluations.clone();
+            ev.sort_by(|a, b| a.zeta.total_cmp(&b.zeta));
+            let x: Vec<f64> = ev.iter().map(|e| e.zeta).collect();
+            let y: Vec<f64> = ev.iter().map(|e| e.sigma).collect();
+            let err: Vec<f64> = ev.iter().map(|e| e.sigma_err).collect();
+            ps.series.push(
+                Series::new(format!(
+                    "{}, {}",
+                    pressure_name(r.config.pressure),
+                    r.method
+                ))
+                .with_points(&x, &y, &err),
+            );
+        }
+    }
+    if !ps.series.is_empty() {
+        drawn(ps.save_png(&dir.join("growth_rates.png")))?;
+    }
+    Ok(())
+}
+
+/// The leading mode: each cell filled by the change of its area, its shape change drawn as an
+/// axis, and the displacement field `Σ_i φ_i δc_i` as arrows.
+fn draw_mode(dir: &Path, base: &Tissue<f64>, mode: &[f64], zeta: f64) -> Result<(), SweepError> {
+    let cells = base.cells();
+    let shape = cells.shape();
+    let lattice = cells.lattice();
+    let (nx, ny, n) = (shape.nx, shape.ny, shape.len());
+    let phi = cells.phi();
+    let mut patches = Patches {
+        nx,
+        ny,
+        origins: Vec::new(),
+        phi: vec![0.0; phi.len()],
+    };
+    let mut d_area = Vec::new();
+    let mut d_shape = Vec::new();
+    let mut centres = Vec::new();
+    let mut disp = [vec![0.0; lattice.len()], vec![0.0; lattice.len()]];
+    for i in 0..cells.n_cells() {
+        patches.origins.push(cells.map().origin[i]);
+        cells.unrolled_into(i, &mut patches.phi[i * n..(i + 1) * n]);
+        let p = &phi[i * n..(i + 1) * n];
+        let m = &mode[i * n..(i + 1) * n];
+        let xs = cells.map().cell_x(shape, i);
+        let ys = cells.map().cell_y(shape, i);
+        let c = base.centre(i);
+        let (mut a, mut da, mut dc) = (0.0, 0.0, [0.0; 2]);
+        let (mut ds, mut s0) = ([0.0; 2], [0.0; 2]);
+        for u in 0..nx {
+            for v in 0..ny {
+                let k = u * ny + v;
+                let rel = [
+                    lattice.delta_x(c[0], xs[u] as f64),
+                    lattice.delta_y(c[1], ys[v] as f64),
+                ];
+                a += p[k] * p[k];
+                da += 2.0 * p[k] * m[k];
+                dc[0] += 2.0 * p[k] * m[k] * rel[0];
+                dc[1] += 2.0 * p[k] * m[k] * rel[1];
+                let grad = |f: &[f64]| {
+                    [
+                        0.5 * (f[shape.xp[u] * ny + v] - f[shape.xm[u] * ny + v]),
+                        0.5 * (f[u * ny + (v + 1) % ny] - f[u * ny + (v + ny - 1) % ny]),
+                    ]
+                };
+                let (g0, gm) = (grad(p), grad(m));
+                let s = mechanics::equations::shape_tensor_density(g0);
+                s0[0] += s[0];
+                s0[1] += s[1];
+                // The derivative of ½(∂yφ² − ∂xφ²) and −∂xφ ∂yφ along the mode.
+                ds[0] += g0[1] * gm[1] - g0[0] * gm[0];
+                ds[1] -= g0[0] * gm[1] + g0[1] * gm[0];
+            }
+        }
+        d_area.push(da);
+        d_shape.push(ds);
+        centres.push([c[0], c[1]]);
+        let dcell = [dc[0] / a, dc[1] / a];
+        for u in 0..nx {
+            for v in 0..ny {
+                let node = lattice.index(xs[u] as usize, ys[v] as usize);
+                disp[0][node] += p[u * ny + v] * dcell[0];
+                disp[1][node] += p[u * ny + v] * dcell[1];
+            }
+        }
+    }
+    let mut pic = TissuePicture::new(lattice.lx, lattice.ly, 640);
+    pic.patches = patches;
+    pic.fill = Fill::Values {
+        values: d_area,
+        label: "δA (area change)".into(),
+        signed: true,
+    };
+    pic.axes = Some(CellAxes {
+        centres,
+        shapes: d_shape,
+    });
+    let [dx, dy] = disp;
+    pic.flow = Some(LatticeVectors {
+        a: dx,
+        b: dy,
+        every: 6,
+    });
+    pic.title = format!("Leading mode at ζ = {}: δA, δS axes, displacement", g(zeta));
+    let img = pic
+        .draw()
+        .map_err(|e| SweepError::Reproduce { why: e.to_string() })?;
+    drawn(img.save_png(&dir.join("mode.png")))
+}
+
+fn claims(rows: &[Row]) -> Vec<Claim> {
+    let mut claims = Vec::new();
+    // Methods agree.
+    let mut pairs = Vec::new();
+    for a in rows.iter().filter(|r| r.method == "arnoldi") {
+        if let Some(gr) = rows
+            .iter()
+            .find(|r| r.method == "growth" && r.config == a.config)
+        {
+            if let (Some((za, ea)), Some((zg, eg))) = (a.zeta(), gr.zeta()) {
+                pairs.push((za, ea, zg, eg));
+            }
+        }
+    }
+    let (v, why) = rule_agree(&pairs);
+    claims.push(Claim::new(
+        "Check: perturbation growth and Arnoldi give the same ζ_cr",
+        pairs
+            .iter()
+            .map(|p| format!("{} ± {} / {} ± {}", g(p.0), g(p.1), g(p.2), g(p.3)))
+            .collect::<Vec<_>>()
+            .join("; "),
+        v,
+        why,
+    ));
+    for pressure in [PressureKind::Paper, PressureKind::Interaction] {
+        let pn = pressure_name(pressure);
+        let arn: Vec<&Row> = rows
+            .iter()
+            .filter(|r| r.method == "arnoldi" && r.config.pressure == pressure)
+            .collect();
+        // The box with the most γ values.
+        let mut by_box: BTreeMap<usize, Vec<(f64, f64, f64)>> = BTreeMap::new();
+        for r in &arn {
+            if let Some((z, e)) = r.zeta() {
+                by_box
+                    .entry(r.config.hex.lx)
+                    .or_default()
+                    .push((r.config.gamma, z, e));
+            }
+        }
+        let missing = arn.iter().filter(|r| r.zeta().is_none()).count();
+        if let Some((lx, pts)) = by_box
+            .iter()
+            .max_by_key(|(lx, v)| (v.len(), std::cmp::Reverse(**lx)))
+        {
+            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
+            let e: Vec<f64> = pts.iter().map(|p| p.2).collect();
+            let list = pts
+                .iter()
+                .map(|p| format!("{}: {} ± {}", p.0, g(p.1), g(p.2)))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let (v, why) = rule_linear(&x, &y, &e);
+            claims.push(Claim::new(
+                format!("9.2a: ζ_cr is linear in γ (hexagonal rest state, L = {lx}, {pn} form)"),
+                format!("ζ_cr by Arnoldi at γ = {list}"),
+                v,
+                why,
+            ));
+            let (v, why) = rule_proportional(&x, &y, &e);
+            claims.push(Claim::new(
+                format!("9.2a: ζ_cr ∝ γ, a line through zero (L = {lx}, {pn} form)"),
+                "weighted line through the same points".to_string(),
+                v,
+                why,
+            ));
+        }
+        // Box sizes, at every γ measured on more than one box.
+        let mut by_gamma: BTreeMap<String, Vec<(f64, f64, f64)>> = BTreeMap::new();
+        for r in &arn {
+            if let Some((z, e)) = r.zeta() {
+                by_gamma
+                    .entry(r.config.gamma.to_string())
+                    .or_default()
+                    .push((r.config.hex.lx as f64, z, e));
+            }
+        }
+        for (gamma, pts) in by_gamma.iter().filter(|(_, v)| v.len() > 1) {
+            let list = pts
+                .iter()
+                .map(|p| format!("L = {}: {} ± {}", p.0, g(p.1), g(p.2)))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let (v, why) = rule_box(pts);
+            claims.push(Claim::new(
+                format!("9.2b: ζ_cr does not depend on the box (γ = {gamma}, {pn} form)"),
+                list.clone(),
+                v,
+                why,
+            ));
+            if gamma == "0.01" {
+                let (v, why) = rule_continuum(pts);
+                claims.push(Claim::new(
+                    format!("Continuum active nematics: ζ_cr → 0 as L → ∞ (γ = 0.01, {pn} form; the paper says the cell model has a finite threshold)"),
+                    list,
+                    v,
+                    why,
+                ));
+            }
+        }
+        if missing > 0 {
+            claims.push(Claim::new(
+                format!("ζ_cr found in the bracket [0, {ZETA_HI}] ({pn} form)"),
+                format!("{missing} configurations without a sign change"),
+                Verdict::Inconclusive,
+                "σ did not change sign in the bracket; see zeta_cr.csv (NaN rows)",
+            ));
+        }
+    }
+    claims
+}
+
+fn settings(
+    scale: Scale,
+    plan: &Plan,
+    rests: &BTreeMap<String, RestState>,
+    conv: &[Conv],
+) -> String {
+    let mut boxes: Vec<HexBox> = plan.arnoldi.iter().map(|c| c.hex).collect();
+    boxes.dedup();
+    let box_lines = boxes
+        .iter()
+        .map(|h| {
+            let [ax, ay] = h.spacings();
+            format!(
+                "{} × {} cells on {} × {} nodes (spacings {} along the rows, {} across; residual anisotropy {} %)",
+                h.cols,
+                h.rows,
+                h.lx,
+                h.ly,
+                g(ax),
+                g(ay),
+                g(100.0 * h.anisotropy())
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    let (tmin, tmax, vmax, rate, smin, smax) = rests.values().fold(
+        (f64::INFINITY, 0.0f64, 0.0f64, 0.0f64, f64::INFINITY, 0.0f64),
+        |a, r| {
+            (
+                a.0.min(r.time),
+                a.1.max(r.time),
+                a.2.max(r.v_max),
+                a.3.max(r.phi_rate),
+                a.4.min(r.s_rms),
+                a.5.max(r.s_rms),
+            )
+        },
+    );
+    let relax = Relaxation::default();
+    let conv_lines = if conv.is_empty() {
+        String::new()
+    } else {
+        let reference = conv[0].sigma;
+        format!(
+            "- Convergence (`convergence.csv`; σ at the Arnoldi ζ_cr of γ = 0.01, 6 × 10, paper form): {}.\n",
+            conv.iter()
+                .map(|c| format!("{}: σ = {} (Δσ = {})", c.what, g(c.sigma), g(c.sigma - reference)))
+                .collect::<Vec<_>>()
+                .join("; ")
+        )
+    };
+    format!(
+        "- Rest state: a hexagonal packing at the paper's density (one cell per {} nodes), discs of radius {}R relaxed at ζ = 0 with dt {} until no field changes by more than {:e} per TU (over {} steps) or {} TU: {box_lines}. Relaxed in {}–{} TU; at the end the largest field rate is {}/TU, the largest cell speed {} (a steady treadmilling of the interfaces: φ stays, v_i ≠ 0 balances the relaxation), and S_rms = {}–{}: the shape anisotropy the packing keeps from the square grid (`rest_states.csv`).\n\
+         - The map: {STEPS} Heun steps of dt {DT} (τ = {} TU), f64, margin 16, about the rest state at each ζ (the state relaxed at ζ = 0; its residual forcing at ζ > 0 is reported as the drift of the map). The two uniform translations are projected out (neutral). σ = ln|μ|/τ of the leading eigenvalue μ of the map's Jacobian.\n\
+         - Arnoldi: Krylov dimension {}, `J v ≈ (M(x₀ + εv) − M(x₀))/ε` with ε = {:e} for a unit v (the perturbation is then about 1e-7 per node: truncation error O(ε) against round-off O(1e-16/ε) per node, balanced near 1e-8 relative; checked against ε/10 and 10ε below), Hessenberg eigenproblem by faer; error = the leading Ritz residual. Each evaluation of a bisection starts from the last one's leading mode with a random third mixed in.\n\
+         - Perturbation growth: {} perturbations of norm {:e} about the same base, integrated over τ and renormalised (simultaneous power iteration with Rayleigh–Ritz on the {}×{} projected matrix), {} intervals ({} on a cold start); σ from the last rate plus the geometric tail of its approach, error twice that tail. Its convergence is slow because the leading modes form a dense band (spacing ~1e-4/TU), so it is run on fewer configurations.\n\
+         - ζ_cr: bisection on [0, {ZETA_HI}] (the bracket first narrowed, up to three times, to ± 1e-4 around the root of the straight line through its ends), to half-width {TOL_ARNOLDI:e} (Arnoldi) and {TOL_GROWTH:e} (growth); its error adds the σ error over dσ/dζ in quadrature.\n\
+         {conv_lines}\
+         - Scale `{}`. Files: `zeta_cr.csv`, `growth_rates.csv`, `spectrum.csv` (the leading Ritz values at the last evaluation), `rest_states.csv`, `convergence.csv`, `zeta_cr_gamma.png`, `zeta_cr_box.png`, `growth_rates.png`, `mode.png`.",
+        g(AREA_PER_CELL),
+        relax.init_radius,
+        relax.step.dt,
+        relax.phi_rate,
+        relax.check_every,
+        relax.max_time,
+        g(tmin),
+        g(tmax),
+        g(rate),
+        g(vmax),
+        g(smin),
+        g(smax),
+        STEPS as f64 * DT,
+        plan.arnoldi_opts.krylov,
+        plan.arnoldi_opts.eps,
+        plan.growth_opts.vectors,
+        plan.growth_opts.amplitude,
+        plan.growth_opts.vectors,
+        plan.growth_opts.vectors,
+        plan.growth_opts.intervals,
+        3 * plan.growth_opts.intervals,
+        scale.name(),
+    )
+}
