@@ -4,7 +4,7 @@
 use faer::Mat;
 
 use crate::growth::start_vector;
-use crate::map::{dot, norm, StepMap};
+use crate::map::{dot, norm, Operator};
 use crate::StabilityError;
 
 /// Options of [`arnoldi`].
@@ -61,7 +61,7 @@ impl Spectrum {
     }
 }
 
-/// Arnoldi on `J` (the map's Jacobian at its base, the uniform translations projected out
+/// Arnoldi on an [`Operator`] (in the study `J`, the map's Jacobian at its base, the uniform translations projected out
 /// before and after), from `start` (on the reference layout, e.g. the leading mode at a nearby
 /// activity, with a random part mixed in: [`crate::start_vector`]) or, without one, from a
 /// random vector from `opts.seed`.
@@ -69,12 +69,12 @@ impl Spectrum {
 /// # Errors
 /// [`StabilityError::Step`] when a step fails, [`StabilityError::Eigen`] when faer's
 /// eigensolver does not converge.
-pub fn arnoldi(
-    map: &mut StepMap,
+pub fn arnoldi<O: Operator + ?Sized>(
+    map: &mut O,
     opts: &ArnoldiOptions,
     start: Option<&[f64]>,
 ) -> Result<Spectrum, StabilityError> {
-    let n = map.len();
+    let n = map.dim();
     let k = opts.krylov.max(1);
     let first = start_vector(map, start, opts.seed);
     let mut basis: Vec<Vec<f64>> = vec![first];
@@ -82,7 +82,7 @@ pub fn arnoldi(
     let mut w = vec![0.0; n];
     let mut dim = k;
     for j in 0..k {
-        map.jvp(&basis[j], opts.eps, &mut w)?;
+        map.apply(&basis[j], opts.eps, &mut w)?;
         map.project(&mut w);
         // Modified Gram–Schmidt, twice (the second pass restores orthogonality lost to
         // cancellation).

@@ -8,7 +8,7 @@ use rand_chacha::ChaCha8Rng;
 
 use faer::Mat;
 
-use crate::map::{dot, norm, StepMap};
+use crate::map::{dot, norm, Operator};
 use crate::StabilityError;
 
 /// Options of [`growth_rate`].
@@ -53,22 +53,14 @@ pub struct Growth {
     pub direction: Vec<f64>,
 }
 
-/// A random unit vector with the uniform translations removed, reproducible from `seed`.
-pub fn random_direction(map: &StepMap, seed: u64) -> Vec<f64> {
+/// A random unit vector, reproducible from `seed`: each component uniform in ±½ times the
+/// operator's [`Operator::weight`], neutral directions removed.
+pub fn random_direction<O: Operator + ?Sized>(op: &O, seed: u64) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    // Only where a cell is: perturbing the far tail of a field would start with modes that
-    // the double well kills at once.
-    let mut v: Vec<f64> = map
-        .base()
-        .cells()
-        .phi()
-        .iter()
-        .map(|&p| {
-            let w = (4.0 * p * (1.0 - p)).max(0.0);
-            w * (rng.random::<f64>() - 0.5)
-        })
+    let mut v: Vec<f64> = (0..op.dim())
+        .map(|k| op.weight(k) * (rng.random::<f64>() - 0.5))
         .collect();
-    map.project(&mut v);
+    op.project(&mut v);
     let n = norm(&v);
     v.iter_mut().for_each(|x| *x /= n);
     v
@@ -78,7 +70,7 @@ pub fn random_direction(map: &StepMap, seed: u64) -> Vec<f64> {
 /// its norm mixed in, so that a mode that `start` lacks can still grow (a start that is one
 /// mode exactly would keep the iteration on it, even where another leads); without `start`, a
 /// random vector from `seed`. The uniform translations are removed.
-pub fn start_vector(map: &StepMap, start: Option<&[f64]>, seed: u64) -> Vec<f64> {
+pub fn start_vector<O: Operator + ?Sized>(map: &O, start: Option<&[f64]>, seed: u64) -> Vec<f64> {
     let random = random_direction(map, seed);
     match start {
         Some(s) if s.len() == random.len() => {
@@ -97,7 +89,8 @@ pub fn start_vector(map: &StepMap, start: Option<&[f64]>, seed: u64) -> Vec<f64>
     }
 }
 
-/// The leading growth rate of perturbations about `map`'s base by power iteration in time
+/// The leading growth rate of perturbations about the base of `map` (any [`Operator`]; a
+/// [`crate::StepMap`] in the study) by power iteration in time
 /// (simultaneous iteration): `opts.vectors` orthonormal perturbations of norm
 /// `opts.amplitude` are integrated over one application of the map, their differences with the
 /// base's image `M(x₀)` measured, the leading eigenvalue of the small matrix `Vᵀ J V` taken
@@ -115,12 +108,12 @@ pub fn start_vector(map: &StepMap, start: Option<&[f64]>, seed: u64) -> Vec<f64>
 /// # Errors
 /// [`StabilityError::Step`] when a step fails, [`StabilityError::Eigen`] when the small
 /// eigenproblem fails.
-pub fn growth_rate(
-    map: &mut StepMap,
+pub fn growth_rate<O: Operator + ?Sized>(
+    map: &mut O,
     opts: &GrowthOptions,
     start: Option<&[f64]>,
 ) -> Result<Growth, StabilityError> {
-    let n = map.len();
+    let n = map.dim();
     let p = opts.vectors.max(1);
     let mut block: Vec<Vec<f64>> = vec![start_vector(map, start, opts.seed)];
     for j in 1..p {
@@ -136,7 +129,7 @@ pub fn growth_rate(
     let mut lead = vec![0.0; p];
     for _ in 0..opts.intervals {
         for (v, w) in block.iter().zip(images.iter_mut()) {
-            map.jvp(v, opts.amplitude, w)?;
+            map.apply(v, opts.amplitude, w)?;
             map.project(w);
         }
         let b = Mat::<f64>::from_fn(p, p, |i, j| dot(&block[i], &images[j]));

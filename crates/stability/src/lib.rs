@@ -23,11 +23,13 @@ pub mod fit;
 mod growth;
 mod map;
 mod rest;
+#[cfg(test)]
+mod tests;
 mod threshold;
 
 pub use arnoldi::{arnoldi, ArnoldiOptions, Ritz, Spectrum};
 pub use growth::{growth_rate, random_direction, settle, start_vector, Growth, GrowthOptions};
-pub use map::{dot, norm, transfer, StepMap};
+pub use map::{dot, max_change, norm, transfer, Operator, StepMap};
 pub use rest::{rest_state, HexBox, Relaxation, RestState};
 pub use threshold::{
     bisect, threshold, Bisection, Evaluation, Method, Threshold, ThresholdOptions,

@@ -75,6 +75,51 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
+/// A linear operator for the eigensolvers ([`crate::arnoldi`], [`crate::growth_rate`]): the
+/// Jacobian of a [`StepMap`] applied by forward differences, or any matrix.
+pub trait Operator {
+    /// Dimension of the vectors it acts on.
+    fn dim(&self) -> usize;
+    /// The time one application spans: an eigenvalue μ is the growth rate `ln|μ|/τ`.
+    fn horizon(&self) -> f64;
+    /// `out = A v`; `eps` is the finite-difference step of an operator that needs one.
+    ///
+    /// # Errors
+    /// Whatever applying it can fail with (a time step).
+    fn apply(&mut self, v: &[f64], eps: f64, out: &mut [f64]) -> Result<(), StabilityError>;
+    /// Removes the neutral directions from `v` (none by default).
+    fn project(&self, _v: &mut [f64]) {}
+    /// The weight of component `k` in a random start (1 by default).
+    fn weight(&self, _k: usize) -> f64 {
+        1.0
+    }
+}
+
+impl Operator for StepMap {
+    fn dim(&self) -> usize {
+        self.len()
+    }
+
+    fn horizon(&self) -> f64 {
+        StepMap::horizon(self)
+    }
+
+    fn apply(&mut self, v: &[f64], eps: f64, out: &mut [f64]) -> Result<(), StabilityError> {
+        self.jvp(v, eps, out)
+    }
+
+    fn project(&self, v: &mut [f64]) {
+        StepMap::project(self, v);
+    }
+
+    /// `4φ(1 − φ)` of the base: random starts only where a cell's interface is (perturbing the
+    /// far tail of a field starts with modes that the double well kills at once).
+    fn weight(&self, k: usize) -> f64 {
+        let p = self.base.cells().phi()[k];
+        (4.0 * p * (1.0 - p)).max(0.0)
+    }
+}
+
 /// The map `M` of `steps` time steps about a base state, at one activity.
 #[derive(Debug)]
 pub struct StepMap {

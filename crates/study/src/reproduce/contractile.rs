@@ -30,6 +30,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 format!("model.zeta={}", ZETAS.join(",")),
             ],
             analyze: None,
+            seeds: None,
         },
     )?;
     p.reporter.stage("contractile: tables and plots");

@@ -113,6 +113,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 crop_side: Some(CROP),
                 ..AnalyzeOptions::default()
             }),
+            seeds: None,
         },
     )?;
     p.reporter.stage("defect-fields: averages and pictures");

@@ -58,6 +58,7 @@ pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResul
                 format!("model.zeta={}", ZETAS.join(",")),
             ],
             analyze: analyze.clone(),
+            seeds: None,
         },
     )?;
     let mut gsets = sets;
@@ -72,6 +73,7 @@ pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResul
                 format!("model.gamma={}", GAMMAS.join(",")),
             ],
             analyze,
+            seeds: None,
         },
     )?;
     Ok((zeta, gamma))

@@ -332,6 +332,8 @@ pub(crate) struct SweepJob {
     pub varies: Vec<String>,
     /// Analyse every run, with these options.
     pub analyze: Option<AnalyzeOptions>,
+    /// The seeds, when not the scale's.
+    pub seeds: Option<crate::Seeds>,
 }
 
 /// A finished sweep: its directory and summary.
@@ -352,7 +354,7 @@ pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, S
             .iter()
             .map(|v| v.parse::<Vary>())
             .collect::<Result<_, _>>()?,
-        seeds: Some(p.scale.seeds()),
+        seeds: Some(job.seeds.unwrap_or(p.scale.seeds())),
     };
     let points = spec.plan()?;
     std::fs::create_dir_all(&dir).map_err(|e| SweepError::write(&job.name, &dir, e))?;
@@ -416,7 +418,7 @@ fn write_verdict(
     wall_s: f64,
 ) -> Result<(), SweepError> {
     let mut s = format!(
-        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (docs/model.md §9) | measured (mean ± std over seeds) | verdict | reason |\n|---|---|---|---|\n",
+        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (docs/model.md §9) | measured (± as the settings above state) | verdict | reason |\n|---|---|---|---|\n",
         figure.title(),
         scale.name(),
         figure.name(),

@@ -199,6 +199,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     format!("model.zeta={ZETAS}"),
                 ],
                 analyze: None,
+                seeds: None,
             },
         )?;
         let recs = res.records(None)?;
@@ -220,6 +221,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     format!("model.zeta={ZETAS}"),
                 ],
                 analyze: None,
+                seeds: None,
             },
         )?;
         let name = Scale::Paper.integrator_name();

@@ -1,6 +1,6 @@
-//! Exploration: ζ_cr of a hexagonal packing by both methods, with timings.
+//! ζ_cr of one hexagonal packing by both methods, with each evaluation and the timings.
 //!
-//! `cargo run --release -p stability --example explore -- COLS ROWS GAMMA PRESSURE`
+//! `cargo run --release -p stability --example threshold -- COLS ROWS GAMMA PRESSURE`
 use mechanics::{ModelParams, PressureKind, StepParams};
 use stability::*;
 use std::time::Instant;
