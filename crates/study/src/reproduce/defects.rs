@@ -82,6 +82,39 @@ fn map_correlations<S: PartialEq>(maps: &[(S, [f64; BINS * BINS])]) -> Vec<f64> 
 /// the births. Below it (with two s.e.), births are not paired.
 const PAIRING_EFFECT: f64 = 0.1;
 
+/// The verdict on "±½ defects annihilate in pairs" from each run's paired fraction of deaths
+/// `f` and its null expectation `q`: holds when `f − q` exceeds 0 by two s.e.; does not hold when
+/// `f − q` lies below [`PAIRING_EFFECT`] within two s.e.; inconclusive otherwise, and with fewer
+/// than three runs.
+fn annihilate_in_pairs(f: &[f64], q: &[f64]) -> (Verdict, String) {
+    if f.len() < 3 {
+        return (
+            Verdict::Inconclusive,
+            format!(
+                "{} runs with deaths: too few to test (three needed)",
+                f.len()
+            ),
+        );
+    }
+    let excess: Vec<f64> = f.iter().zip(q).map(|(f, q)| f - q).collect();
+    let (e, se) = mean_se(&excess);
+    let what = format!(
+        "the paired fraction of deaths exceeds chance by {} ± {} (s.e.)",
+        g(e),
+        g(se)
+    );
+    if e + 2.0 * se < PAIRING_EFFECT {
+        (
+            Verdict::DoesNotHold,
+            format!("{what}: below {PAIRING_EFFECT} within two s.e."),
+        )
+    } else if e - 2.0 * se > 0.0 {
+        (Verdict::Holds, format!("{what}: more than two s.e."))
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
 /// The verdict on "±½ defects appear in pairs at random places" from each run's paired
 /// fraction of births `f` and its null expectation `q`, and the correlations `r` of the
 /// creation maps of pairs of runs. Pairs: the mean of `f − q` over runs against twice its
@@ -205,6 +238,8 @@ fn one_form(
     let (mut creations, mut unpaired) = (Vec::new(), 0.0f64);
     // Per active run: paired fraction of births, its null expectation, bin counts of creations.
     let (mut fractions, mut nulls, mut maps) = (Vec::new(), Vec::new(), Vec::new());
+    // The same for deaths: paired fraction of deaths (annihilations) and its null.
+    let (mut d_fractions, mut d_nulls, mut annihilations) = (Vec::new(), Vec::new(), 0usize);
     for r in &recs {
         let t = Table::read(&r.run.join("analysis/observables.csv"))?;
         let (time, np, nm, dens, net, un) = (
@@ -248,18 +283,26 @@ fn one_form(
             let ev = Table::read(&r.run.join("analysis/defect_events.csv"))?;
             let (kind, x, y) = (ev.strs("kind")?, ev.f64s("x")?, ev.f64s("y")?);
             let mut map = [0.0f64; BINS * BINS];
-            let mut made = 0.0;
+            let (mut made, mut ended) = (0.0, 0.0);
             for k in 0..kind.len() {
                 if kind[k] == "creation" {
                     creations.push((x[k], y[k]));
                     map[bin(x[k], y[k])] += 1.0;
                     made += 1.0;
+                } else if kind[k] == "annihilation" {
+                    ended += 1.0;
+                    annihilations += 1;
                 }
             }
             let run_unpaired: f64 = un.iter().filter(|x| x.is_finite()).sum();
             if let Some((f, q)) = pairing(made, run_unpaired, time.len(), BOX * BOX, RADIUS) {
                 fractions.push(f);
                 nulls.push(q);
+            }
+            // Deaths: half of the unpaired events are deaths, as for births.
+            if let Some((f, q)) = pairing(ended, run_unpaired, time.len(), BOX * BOX, RADIUS) {
+                d_fractions.push(f);
+                d_nulls.push(q);
             }
             maps.push((r.seed, map));
         }
@@ -325,6 +368,22 @@ fn one_form(
             v_pairs,
             why_pairs,
         ),
+        {
+            let (v, why) = annihilate_in_pairs(&d_fractions, &d_nulls);
+            Claim::new(
+                format!("9.5 ({pressure} pressure): ±1/2 defects annihilate in pairs"),
+                format!(
+                    "{annihilations} pair annihilations at ζ > 0, {unpaired} births or deaths without a partner; paired fraction of deaths {} ± {} (s.e. over {} runs) against {} ± {} for independent deaths at the same rate",
+                    g(mean_se(&d_fractions).0),
+                    g(mean_se(&d_fractions).1),
+                    d_fractions.len(),
+                    g(mean_se(&d_nulls).0),
+                    g(mean_se(&d_nulls).1),
+                ),
+                v,
+                why,
+            )
+        },
         Claim::new(
             format!("9.5 ({pressure} pressure): the defect density grows with ζ"),
             format!("ζ from 0: {td}; among ζ > 0: {ta}; at rest {} of the largest density is already there", g(at_rest / top)),
@@ -404,6 +463,27 @@ mod tests {
         // Too few runs.
         assert_eq!(
             pairs_at_random_places(&paired[..2], &q[..2], &random_r).0,
+            Verdict::Inconclusive
+        );
+    }
+
+    #[test]
+    fn the_annihilation_rule_gives_each_outcome() {
+        let q = [0.02, 0.03, 0.02, 0.025];
+        assert_eq!(
+            annihilate_in_pairs(&[0.7, 0.75, 0.68, 0.72], &q).0,
+            Verdict::Holds
+        );
+        assert_eq!(
+            annihilate_in_pairs(&[0.03, 0.05, 0.02, 0.04], &q).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            annihilate_in_pairs(&[0.0, 0.5, 0.05, 0.4], &q).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(
+            annihilate_in_pairs(&[0.7], &q[..1]).0,
             Verdict::Inconclusive
         );
     }

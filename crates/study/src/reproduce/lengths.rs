@@ -300,6 +300,41 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         drawn(pz.save_png(&dir.join(format!("fig3b_lengths_vs_zeta_{pressure}.png"))))?;
         drawn(pg.save_png(&dir.join(format!("fig3c_lengths_vs_gamma_{pressure}.png"))))?;
     }
+    // No net flow of the whole tissue: the mean cell velocity U(t) = ⟨v_i⟩ over the frames of
+    // the second half, against the cell speed.
+    let (_, from) = times(p.scale);
+    let mut flow_csv = String::from("pressure,zeta,seed,net_flow,cell_speed_rms,ratio,cells\n");
+    for pressure in PRESSURES {
+        let mut ratios = Vec::new();
+        let mut cells = 0usize;
+        for z in &active {
+            for r in recs
+                .iter()
+                .filter(|r| r.values[0] == pressure && r.values[1] == *z)
+            {
+                let (u, speed, n) = net_flow(&r.run, from)?;
+                cells = n;
+                flow_csv += &format!(
+                    "{pressure},{z},{},{u:e},{speed:e},{:e},{n}\n",
+                    r.seed,
+                    u / speed
+                );
+                ratios.push(u / speed);
+            }
+        }
+        let (v, why) = rule_net_flow(&ratios, cells);
+        claims.push(Claim::new(
+            format!("No net flow of the whole tissue ({pressure} pressure, γ = 0.01, ζ ≥ {ACTIVE}; the paper's periodic tissue has none)"),
+            format!(
+                "|⟨U⟩_t| / v_cell over {} runs: {}",
+                ratios.len(),
+                super::pm(mean_std(&ratios))
+            ),
+            v,
+            why,
+        ));
+    }
+    write_text(&dir.join("net_flow.csv"), &flow_csv)?;
     write_text(&dir.join("correlations.csv"), &corr_csv)?;
     write_text(&dir.join("lengths_vs_zeta.csv"), &csv_z)?;
     write_text(&dir.join("lengths_vs_gamma.csv"), &csv_g)?;
@@ -308,7 +343,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         "- Paper scene on L = 200 (240 cells, as the paper's Fig. 2a), both pressure forms. ζ sweep at γ = 0.01: ζ ∈ {{{}}} (lengths for ζ ≥ {ACTIVE}); γ sweep at ζ = {ZETA_OF_GAMMA_SWEEP}: γ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {}; a frame every 10 TU, analysed from t = {from} (the second half of the active phase).\n\
          - `monolayer analyze` on every run: v, ω and Q smoothed with a periodic {box_side}×{box_side} box (3R), their autocorrelations averaged over the frames; a length is the first minimum of the radially averaged correlation.\n\
-         - Files: `correlations.csv`, `lengths_vs_zeta.csv`, `lengths_vs_gamma.csv`, `fig3a_c_vorticity_*.png`, `c_velocity_*.png`, `c_q_*.png`, `fig3b_lengths_vs_zeta_*.png`, `fig3c_lengths_vs_gamma_*.png` (one per pressure form); the runs in `../sweeps/turbulence-*`.",
+         - Net flow: per run, `|⟨U⟩_t|`, the time mean over the analysed frames of the mean cell velocity `U = ⟨v_i⟩_i`, over the rms cell speed (`net_flow.csv`); the verdict compares the runs' mean ± 2 s.e. with `1/√N`.\n\
+         - Files: `net_flow.csv`, `correlations.csv`, `lengths_vs_zeta.csv`, `lengths_vs_gamma.csv`, `fig3a_c_vorticity_*.png`, `c_velocity_*.png`, `c_q_*.png`, `fig3b_lengths_vs_zeta_*.png`, `fig3c_lengths_vs_gamma_*.png` (one per pressure form); the runs in `../sweeps/turbulence-*`.",
         ZETAS.join(", "),
         GAMMAS.join(", "),
         p.scale.seeds(),
@@ -317,9 +353,102 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     Ok((claims, settings))
 }
 
+/// The net flow of a run: `|⟨U⟩_t|`, the time mean over the frames at `t ≥ from` of the mean
+/// cell velocity `U = ⟨v_i⟩_i`, the rms cell speed over the same frames, and the number of
+/// cells.
+fn net_flow(run: &Path, from: f64) -> Result<(f64, f64, usize), SweepError> {
+    let frames = run.join("frames");
+    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(&frames)
+        .map_err(|e| SweepError::write("the net flow", &frames, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "npz"))
+        .collect();
+    paths.sort();
+    let (mut sum, mut speed2, mut k, mut n) = ([0.0f64; 2], 0.0, 0usize, 0usize);
+    for path in &paths {
+        let a =
+            rundir::read_npz(path, &["time", "velocity"]).map_err(|source| SweepError::RunDir {
+                point: run.display().to_string(),
+                source,
+            })?;
+        if a[0].data.first().copied().unwrap_or(f64::NEG_INFINITY) < from {
+            continue;
+        }
+        let v = &a[1].data;
+        n = v.len() / 2;
+        if n == 0 {
+            continue;
+        }
+        let u = [
+            v.iter().step_by(2).sum::<f64>() / n as f64,
+            v.iter().skip(1).step_by(2).sum::<f64>() / n as f64,
+        ];
+        sum[0] += u[0];
+        sum[1] += u[1];
+        speed2 += v.iter().map(|x| x * x).sum::<f64>() / n as f64;
+        k += 1;
+    }
+    if k == 0 {
+        return Ok((f64::NAN, f64::NAN, n));
+    }
+    Ok((
+        (sum[0] / k as f64).hypot(sum[1] / k as f64),
+        (speed2 / k as f64).sqrt(),
+        n,
+    ))
+}
+
+/// No net flow: the ratios `|⟨U⟩_t| / v_cell` of the runs, against `1/√N`, the size of the mean of
+/// N independent cell velocities at one instant (a time mean of uncorrelated frames would be
+/// smaller still). Holds when mean + 2 s.e. of the ratios lies below `1/√N`; does not hold when
+/// mean − 2 s.e. lies above it; inconclusive otherwise.
+fn rule_net_flow(ratios: &[f64], cells: usize) -> (Verdict, String) {
+    let (m, se) = super::mean_se(ratios);
+    if ratios.len() < 2 || cells == 0 || !m.is_finite() {
+        return (
+            Verdict::Inconclusive,
+            "fewer than two runs with frames".into(),
+        );
+    }
+    let bound = 1.0 / (cells as f64).sqrt();
+    let what = format!(
+        "mean {} ± {} s.e. against 1/√N = {} (N = {cells})",
+        g(m),
+        g(se),
+        g(bound)
+    );
+    if m + 2.0 * se < bound {
+        (
+            Verdict::Holds,
+            format!("{what}: below the mean of N independent velocities"),
+        )
+    } else if m - 2.0 * se > bound {
+        (
+            Verdict::DoesNotHold,
+            format!("{what}: a net flow above what independent cells give"),
+        )
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_net_flow_rule_gives_each_outcome() {
+        assert_eq!(rule_net_flow(&[0.02, 0.03, 0.025], 240).0, Verdict::Holds);
+        assert_eq!(
+            rule_net_flow(&[0.3, 0.32, 0.31], 240).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            rule_net_flow(&[0.01, 0.12, 0.06], 240).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(rule_net_flow(&[0.01], 240).0, Verdict::Inconclusive);
+    }
 
     /// A change of more than two standard errors in the claimed direction holds, against it
     /// does not, and within them is inconclusive.
