@@ -20,6 +20,9 @@ pub struct Heatmap {
     pub values: Vec<f64>,
     /// Arrows of a vector field `(a_u, a_v)`, each `side²`, drawn every `arrow_every` nodes.
     pub arrows: Option<(Vec<f64>, Vec<f64>)>,
+    /// Director lines (headless segments) of a nematic field given as `(Q_xx, Q_xy)`: at
+    /// angle `½ atan2(Q_xy, Q_xx)`, length ∝ `|Q|`.
+    pub director: Option<(Vec<f64>, Vec<f64>)>,
     /// Nodes between arrows.
     pub arrow_every: usize,
     /// The names of the horizontal (`u`) and vertical (`v`) axes; empty draws none.
@@ -34,6 +37,7 @@ impl Heatmap {
             side,
             values,
             arrows: None,
+            director: None,
             arrow_every: (side / 12).max(1),
             axes: (String::new(), String::new()),
         }
@@ -51,6 +55,12 @@ impl Heatmap {
         self
     }
 
+    /// With director lines of the nematic field `(Q_xx, Q_xy)` over the colours.
+    pub fn with_director(mut self, qxx: Vec<f64>, qxy: Vec<f64>) -> Self {
+        self.director = Some((qxx, qxy));
+        self
+    }
+
     fn check(&self) -> Result<(), String> {
         let n = self.side * self.side;
         if self.side == 0 || self.values.len() != n {
@@ -61,7 +71,7 @@ impl Heatmap {
                 self.side
             ));
         }
-        if let Some((a, b)) = &self.arrows {
+        if let Some((a, b)) = self.arrows.as_ref().or(self.director.as_ref()) {
             if a.len() != n || b.len() != n {
                 return Err(format!(
                     "panel \"{}\": arrows of the wrong size",
@@ -200,6 +210,40 @@ fn draw_panel(p: &Heatmap, main: &Area<'_>, bar: &Area<'_>) -> Result<(), String
                     lines
                         .into_iter()
                         .map(|l| PathElement::new(l, BLACK.stroke_width(1))),
+                )
+                .map_err(e)?;
+        }
+    }
+    if let Some((qxx, qxy)) = &p.director {
+        let every = p.arrow_every.max(1);
+        let qmax = qxx
+            .iter()
+            .zip(qxy)
+            .map(|(a, b)| a.hypot(*b))
+            .filter(|m| m.is_finite())
+            .fold(0.0f64, f64::max);
+        if qmax > 0.0 {
+            let centre = s / 2;
+            let mut lines = Vec::new();
+            for iu in (centre % every..s).step_by(every) {
+                for iv in (centre % every..s).step_by(every) {
+                    let k = iu * s + iv;
+                    let m = qxx[k].hypot(qxy[k]);
+                    if !m.is_finite() || m < 1e-3 * qmax {
+                        continue;
+                    }
+                    let th = 0.5 * qxy[k].atan2(qxx[k]);
+                    let half_len = 0.45 * every as f64 * m / qmax;
+                    let (a, b) = (half_len * th.cos(), half_len * th.sin());
+                    let (x, y) = (iu as f64 - half, iv as f64 - half);
+                    lines.push(vec![(x - a, y - b), (x + a, y + b)]);
+                }
+            }
+            chart
+                .draw_series(
+                    lines
+                        .into_iter()
+                        .map(|l| PathElement::new(l, BLACK.stroke_width(2))),
                 )
                 .map_err(e)?;
         }

@@ -34,7 +34,7 @@ fn unit(column: &str) -> &'static str {
         "step" | "frame" => "time steps",
         "time" => "TU",
         "zeta" => "force/length (model units)",
-        "v_rms" | "cell_speed_rms" => "nodes/TU",
+        "v_rms" | "v_rms_smooth" | "cell_speed_rms" => "nodes/TU",
         "area_mean" | "area_min" | "area_max" => "nodes² (Σ φ²)",
         "x" | "y" | "r" | "length" => "nodes",
         "angle" => "radians",
@@ -73,7 +73,7 @@ pub fn write_run_json(dir: &Path, scene: &scene::Scene) -> Result<()> {
         .collect(),
         columns: [
             ("series.csv", table(SERIES_HEADER)),
-            ("analysis/observables.csv", table("frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate")),
+            ("analysis/observables.csv", table("frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth")),
             ("analysis/defects.csv", table("frame,time,x,y,charge,angle,track")),
             ("analysis/defect_events.csv", table("frame,time,kind,x,y")),
             ("analysis/correlations.csv", table("r,c_velocity,c_vorticity,c_q")),

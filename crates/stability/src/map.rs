@@ -148,7 +148,7 @@ impl StepMap {
         let cells = base.cells().clone();
         let base = Tissue::restore(
             cells,
-            params.clone(),
+            *params,
             0.0,
             0,
             base.centres().to_vec(),
@@ -247,7 +247,7 @@ impl StepMap {
         }
         Tissue::restore(
             cells,
-            t.params().clone(),
+            *t.params(),
             t.time(),
             t.iteration(),
             t.centres().to_vec(),

@@ -160,7 +160,7 @@ pub fn rest_state(
     let centres = hex.centres();
     let radius = relax.init_radius * params.energy.radius;
     let cells: Cells<f64> = init::discs(lattice, shape, &centres, radius, params.energy.lambda);
-    let mut tissue = Tissue::new(cells, params.clone().with_zeta(0.0));
+    let mut tissue = Tissue::new(cells, (*params).with_zeta(0.0));
     let mut ws = Workspace::new(tissue.cells());
     loop {
         let before = tissue.clone();

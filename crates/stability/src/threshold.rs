@@ -168,8 +168,7 @@ pub fn threshold(
     let mut spectrum = None;
     let b = bisect(
         |zeta| {
-            let mut map =
-                StepMap::new(base, &params.clone().with_zeta(zeta), opts.step, opts.steps)?;
+            let mut map = StepMap::new(base, &(*params).with_zeta(zeta), opts.step, opts.steps)?;
             let (sigma, err) = match method {
                 Method::Growth(g) => {
                     // A cold start runs three times as long: it begins far from the mode.

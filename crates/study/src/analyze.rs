@@ -570,7 +570,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let mut obs = String::new();
     row!(
         obs,
-        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate"
+        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth"
     );
     let mut defects_csv = String::new();
     // Axes and angle conventions are in the README: a comment line here would be taken for
@@ -648,7 +648,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         };
         row!(
             obs,
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -656,7 +656,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             net_charge(&found),
             found.len() as f64 / area,
             tracks.unpaired,
-            rate
+            rate,
+            rms(&[&svx, &svy])
         );
         prev_time = Some(time);
         info.frames += 1;

@@ -171,7 +171,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let panels = |f: &[Vec<f64>], name: &str, u: &str| {
             let axes = |h: Heatmap| h.with_axes(u, "v, nodes");
             vec![
-                axes(Heatmap::new("Q_xx (defect frame)", CROP, f[6].clone())),
+                axes(
+                    Heatmap::new("Q_xx, director lines (defect frame)", CROP, f[6].clone())
+                        .with_director(f[6].clone(), f[7].clone()),
+                ),
                 axes(Heatmap::new("σ_xx − mean", CROP, less_mean(&f[2]))),
                 axes(Heatmap::new("σ_xy", CROP, f[4].clone())),
                 axes(
@@ -267,6 +270,71 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             if np == 0.0 { Verdict::Inconclusive } else { v_head },
             why_head,
         ));
+        // The vortex pair of +1/2: per run, ω below the axis minus ω above it, at v = ∓1.5R.
+        let pair: Vec<f64> = runs
+            .iter()
+            .filter(|r| r.0 > 0.0)
+            .map(|r| {
+                vorticity_at(&r.2[0], &r.2[1], 0.0, -1.5 * R)
+                    - vorticity_at(&r.2[0], &r.2[1], 0.0, 1.5 * R)
+            })
+            .collect();
+        let (v_pair, why_pair) = sign_rule(
+            &pair,
+            &format!("counter-rotating vortices on the two sides of the axis in every one of {} runs, clear of 0 by two s.e.", pair.len()),
+            "the vortices turn the other way round, by more than two standard errors: flow towards the tail along the axis",
+            "runs have the pair turning as extensile self-propulsion makes it",
+        );
+        claims.push(Claim::new(
+            format!("9.6 ({pressure} pressure): a +1/2 defect carries a vortex pair, one on each side of its axis"),
+            format!(
+                "ω(0, −1.5R) − ω(0, +1.5R) per run: {}",
+                pair.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", ")
+            ),
+            if np == 0.0 { Verdict::Inconclusive } else { v_pair },
+            why_pair,
+        ));
+        // −1/2: no drift of the core (three-fold symmetry forbids one), and m = 3 run by run.
+        let (du, dv) = (per_run(false, 0), per_run(false, 1));
+        let (v_drift, why_drift) = no_drift(&du, &dv, vu.0.hypot(vv.0));
+        claims.push(Claim::new(
+            format!("9.6 ({pressure} pressure): a −1/2 defect does not self-propel (its three-fold symmetry forbids a drift)"),
+            format!(
+                "core (r ≤ R) velocity per run along an arm {}, across {}; +1/2 core speed {}",
+                du.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", "),
+                dv.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", "),
+                g(vu.0.hypot(vv.0))
+            ),
+            if nm == 0.0 { Verdict::Inconclusive } else { v_drift },
+            why_drift,
+        ));
+        let per_run_modes: Vec<[f64; 5]> = runs
+            .iter()
+            .filter(|r| r.1 > 0.0)
+            .map(|r| ring_modes(&r.3[0], &r.3[1], 1.5 * R))
+            .collect();
+        let three_each = per_run_modes
+            .iter()
+            .filter(|m| m[3] > m[1] && m[3] > m[2] && m[3] > m[4])
+            .count();
+        claims.push(Claim::new(
+            format!("9.6 ({pressure} pressure): the −1/2 flow is three-fold in every run"),
+            format!(
+                "m = 3 the largest of m = 1..4 in {three_each} of {} runs; m = 1 / m = 3 per run: {}",
+                per_run_modes.len(),
+                per_run_modes.iter().map(|m| g(m[1] / m[3])).collect::<Vec<_>>().join(", ")
+            ),
+            if per_run_modes.len() < 3 {
+                Verdict::Inconclusive
+            } else if three_each == per_run_modes.len() {
+                Verdict::Holds
+            } else if 2 * three_each < per_run_modes.len() {
+                Verdict::DoesNotHold
+            } else {
+                Verdict::Inconclusive
+            },
+            "holds when m = 3 leads in every run (at least three), does not hold when it leads in fewer than half, inconclusive between",
+        ));
     }
     write_text(&dir.join("defect_fields.csv"), &csv)?;
     let settings = format!(
@@ -313,11 +381,66 @@ fn propulsion(vu: &[f64], vv: &[f64]) -> (Verdict, String) {
     (v, why.to_string())
 }
 
+/// The vorticity `∂_u v_v − ∂_v v_u` of a crop at `(u, v)`, by central differences two nodes
+/// wide (bilinear values).
+fn vorticity_at(vu: &[f64], vv: &[f64], u: f64, v: f64) -> f64 {
+    (at(vv, u + 2.0, v) - at(vv, u - 2.0, v)) / 4.0
+        - (at(vu, u, v + 2.0) - at(vu, u, v - 2.0)) / 4.0
+}
+
+/// No drift of the −½ core: per-run core velocities `du` (along an arm) and `dv` (across), against
+/// the +½ core speed `plus`. Holds when both components are within two s.e. of 0 and the mean
+/// −½ core speed is under a quarter of `plus`; does not hold when a component is clear of 0 by
+/// two s.e. and the speed exceeds a quarter of `plus`; inconclusive otherwise.
+fn no_drift(du: &[f64], dv: &[f64], plus: f64) -> (Verdict, String) {
+    if du.len() < 2 {
+        return (
+            Verdict::Inconclusive,
+            format!("{} runs with −1/2 defects: too few for a spread", du.len()),
+        );
+    }
+    let (mu, su) = mean_se(du);
+    let (mv, sv) = mean_se(dv);
+    let speed = mu.hypot(mv);
+    let clear = mu.abs() > 2.0 * su || mv.abs() > 2.0 * sv;
+    let what = format!(
+        "mean core velocity ({} ± {}, {} ± {}) s.e., speed {} = {} of the +1/2 core speed",
+        g(mu),
+        g(su),
+        g(mv),
+        g(sv),
+        g(speed),
+        g(speed / plus)
+    );
+    if !clear && speed < 0.25 * plus {
+        (Verdict::Holds, format!("{what}: no drift within two s.e."))
+    } else if clear && speed > 0.25 * plus {
+        (
+            Verdict::DoesNotHold,
+            format!("{what}: a drift clear of 0, more than a quarter of the +1/2 speed"),
+        )
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
 /// The verdict on a sign claim measured once per run (`d` > 0 claimed): holds when every run
 /// (at least three) has the sign and the mean is above 0 by two standard errors; does not hold
 /// when the mean is below 0 by two standard errors; inconclusive otherwise (runs disagree, or
 /// too few).
 fn same_sign(d: &[f64]) -> (Verdict, String) {
+    sign_rule(
+        d,
+        &format!("more compressive at the head than at the tail in every one of {} runs (the sign Saw et al. (2017) measured in MDCK monolayers, which the paper cites); no continuum magnitude is checked", d.len()),
+        "the head is less compressed than the tail, by more than two standard errors over runs: the opposite of Saw et al. (2017)",
+        "runs have the head more compressed",
+    )
+}
+
+/// A sign claim measured once per run (`d` > 0 claimed): holds when every run (at least three)
+/// has the sign and the mean is above 0 by two standard errors (`holds` says why); does not
+/// hold when the mean is below 0 by two standard errors (`fails`); inconclusive otherwise.
+fn sign_rule(d: &[f64], holds: &str, fails: &str, counted: &str) -> (Verdict, String) {
     if d.len() < 3 {
         return (
             Verdict::Inconclusive,
@@ -330,11 +453,11 @@ fn same_sign(d: &[f64]) -> (Verdict, String) {
     let (m, se) = mean_se(d);
     let positive = d.iter().filter(|x| **x > 0.0).count();
     if positive == d.len() && m > 2.0 * se {
-        (Verdict::Holds, format!("more compressive at the head than at the tail in every one of {} runs (the sign Saw et al. (2017) measured in MDCK monolayers, which the paper cites); no continuum magnitude is checked", d.len()))
+        (Verdict::Holds, holds.to_string())
     } else if m < -2.0 * se {
-        (Verdict::DoesNotHold, "the head is less compressed than the tail, by more than two standard errors over runs: the opposite of Saw et al. (2017)".to_string())
+        (Verdict::DoesNotHold, fails.to_string())
     } else {
-        (Verdict::Inconclusive, format!("{positive} of {} runs have the head more compressed: the runs disagree, or the mean is within two standard errors of 0", d.len()))
+        (Verdict::Inconclusive, format!("{positive} of {} {counted}: the runs disagree, or the mean is within two standard errors of 0", d.len()))
     }
 }
 
@@ -366,6 +489,40 @@ mod tests {
 
     /// The per-run sign rule: all runs agree and clear of 0 holds; one run against is
     /// inconclusive (the pooled mean could still be positive); clearly negative does not hold.
+    #[test]
+    fn the_drift_rule_gives_each_outcome() {
+        use super::{no_drift, Verdict};
+        assert_eq!(
+            no_drift(&[1e-4, -1e-4, 0.0], &[0.0, 1e-4, -1e-4], 0.01).0,
+            Verdict::Holds
+        );
+        assert_eq!(
+            no_drift(&[0.005, 0.006, 0.0055], &[0.0, 1e-4, -1e-4], 0.01).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            no_drift(&[0.009, -0.001, 0.008], &[0.0, 1e-4, -1e-4], 0.01).0,
+            Verdict::Inconclusive
+        );
+    }
+
+    /// A vortex pair of the sense extensile propulsion drives has ω > 0 below the axis.
+    #[test]
+    fn vorticity_of_a_vortex_pair() {
+        use super::{vorticity_at, CROP};
+        // v_u = −cos(π v/40): flow towards −u on the axis, back along ±20.
+        let h = (CROP / 2) as f64;
+        let mut vu = vec![0.0; CROP * CROP];
+        for k in 0..CROP * CROP {
+            let v = (k % CROP) as f64 - h;
+            vu[k] = -(std::f64::consts::PI * v / 40.0).cos();
+        }
+        let vv = vec![0.0; CROP * CROP];
+        let below = vorticity_at(&vu, &vv, 0.0, -12.0);
+        let above = vorticity_at(&vu, &vv, 0.0, 12.0);
+        assert!(below > 0.0 && above < 0.0 && (below + above).abs() < 1e-12);
+    }
+
     #[test]
     fn the_sign_rule_gives_each_outcome() {
         use super::{same_sign, Verdict};

@@ -218,10 +218,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             method.name(),
             config.name()
         ));
-        if !rests.contains_key(&key(config)) {
-            let rest =
-                rest_state(&config.hex, &config.params(), &relax).map_err(|e| failed(config, e))?;
-            rests.insert(key(config), rest);
+        if let std::collections::btree_map::Entry::Vacant(slot) = rests.entry(key(config)) {
+            slot.insert(
+                rest_state(&config.hex, &config.params(), &relax).map_err(|e| failed(config, e))?,
+            );
         }
         let rest = &rests[&key(config)];
         let result = match threshold(
@@ -415,14 +415,15 @@ fn convergence(dir: &Path, rows: &[Row], plan: &Plan) -> Result<Vec<Conv>, Sweep
         ),
     ];
     for (what, dt, margin, steps, opts) in cases {
-        if !rest_at.contains_key(&margin) {
+        if let std::collections::btree_map::Entry::Vacant(slot) = rest_at.entry(margin) {
             let relax = Relaxation {
                 margin,
                 ..Relaxation::default()
             };
-            let rest = rest_state(&config.hex, &config.params(), &relax)
-                .map_err(|e| failed(&config, e))?;
-            rest_at.insert(margin, rest);
+            slot.insert(
+                rest_state(&config.hex, &config.params(), &relax)
+                    .map_err(|e| failed(&config, e))?,
+            );
         }
         let rest = &rest_at[&margin];
         let mut map = StepMap::new(
@@ -680,7 +681,7 @@ fn isolated_cell() -> Result<Claim, SweepError> {
     let params = ModelParams::paper(0.0);
     let run = |zeta: f64| -> Result<(f64, [f64; 2], Vec<f64>), SweepError> {
         let cells = phasefield::init::discs(lattice, shape.clone(), &[[20.3, 20.6]], 8.0, 2.5);
-        let mut t = Tissue::new(cells, params.clone().with_zeta(zeta));
+        let mut t = Tissue::new(cells, params.with_zeta(zeta));
         let mut ws = mechanics::Workspace::new(t.cells());
         for _ in 0..400 {
             t.step(&mut ws, &StepParams::new(DT, 1))
