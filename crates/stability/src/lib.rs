@@ -32,7 +32,7 @@ pub use growth::{growth_rate, random_direction, settle, start_vector, Growth, Gr
 pub use map::{dot, max_change, norm, transfer, Operator, StepMap};
 pub use rest::{rest_state, HexBox, Relaxation, RestState};
 pub use threshold::{
-    bisect, threshold, Bisection, Evaluation, Method, Threshold, ThresholdOptions,
+    bisect, threshold, Bisection, Evaluation, Method, Threshold, ThresholdOptions, NARROWING_ROUNDS,
 };
 
 /// Why a stability computation failed.
