@@ -120,7 +120,8 @@ enum Command {
     /// OUT/sweeps/), its data as CSV, its plots as PNG and OUT/FIGURE/verdict.md, a verdict
     /// on each claim of the paper that it tests.
     Reproduce {
-        /// threshold, lengths, defects, defect-fields, contractile, scaling, or all.
+        /// threshold, lengths, defects, defect-fields, contractile, scaling, stability,
+        /// run-length, or all.
         figure: String,
         /// The output directory (created if missing; a second call resumes).
         #[arg(long)]
