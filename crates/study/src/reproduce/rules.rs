@@ -159,7 +159,9 @@ pub(crate) fn rule_box(points: &[(f64, f64, f64)]) -> (Verdict, String) {
 /// The continuum prediction `ζ_cr → 0` as `L → ∞`: a weighted fit `ζ_cr = ζ_∞ + c/L²` (the
 /// slowest elastic mode of a box decays as `q² ∝ 1/L²`). Holds when `c > 2 se(c)` and
 /// `|ζ_∞| < 2 se(ζ_∞)`; does not hold when `ζ_∞ ≥ 3 se(ζ_∞)` (a finite limit); inconclusive
-/// otherwise, and with fewer than three sizes (two cannot tell a limit from a trend).
+/// otherwise, with fewer than three sizes (two cannot tell a limit from a trend), and when the
+/// form does not fit (`χ² > dof + 3√(2 dof)`: a limit read from a curve that misses the points
+/// means nothing; on 83, 166 and 333 nodes ζ_cr falls linearly in ln L instead).
 pub(crate) fn rule_continuum(points: &[(f64, f64, f64)]) -> (Verdict, String) {
     if points.len() < 3 {
         return (
@@ -185,7 +187,13 @@ pub(crate) fn rule_continuum(points: &[(f64, f64, f64)]) -> (Verdict, String) {
         g(f.chi2),
         f.dof
     );
-    if f.coef[0] >= 3.0 * f.se[0] {
+    let dof = f.dof.max(1) as f64;
+    if f.chi2 > dof + 3.0 * (2.0 * dof).sqrt() {
+        (
+            Verdict::Inconclusive,
+            format!("{what}: the form does not fit the points, so its limit is not a measurement"),
+        )
+    } else if f.coef[0] >= 3.0 * f.se[0] {
         (Verdict::DoesNotHold, format!("{what}: a finite limit"))
     } else if f.coef[1] > 2.0 * f.se[1] && f.coef[0].abs() < 2.0 * f.se[0] {
         (Verdict::Holds, what)
@@ -304,6 +312,12 @@ mod tests {
         assert_eq!(rule_continuum(&finite[..2]).0, Verdict::Inconclusive);
         let noisy: Vec<(f64, f64, f64)> = l.iter().map(|&l| (l, 4.0 / (l * l), 1e-3)).collect();
         assert_eq!(rule_continuum(&noisy).0, Verdict::Inconclusive);
+        // Linear in ln L (the measured shape): the 1/L² form misses it, so no verdict.
+        let log: Vec<(f64, f64, f64)> = l
+            .iter()
+            .map(|&l: &f64| (l, 1.66e-3 - 2.465e-4 * l.ln(), 1.5e-5))
+            .collect();
+        assert_eq!(rule_continuum(&log).0, Verdict::Inconclusive);
     }
 
     #[test]
