@@ -394,7 +394,7 @@ fn convergence(dir: &Path, rows: &[Row], plan: &Plan) -> Result<Vec<Conv>, Sweep
             },
         ),
         (
-            format!("ε {:e}", base.eps / 10.0),
+            format!("ε {}", g(base.eps / 10.0)),
             DT,
             16,
             STEPS,
@@ -404,7 +404,7 @@ fn convergence(dir: &Path, rows: &[Row], plan: &Plan) -> Result<Vec<Conv>, Sweep
             },
         ),
         (
-            format!("ε {:e}", base.eps * 10.0),
+            format!("ε {}", g(base.eps * 10.0)),
             DT,
             16,
             STEPS,
