@@ -159,23 +159,28 @@ impl StepMap {
         base.refresh(&mut ws);
         let residual_speed = crate::rest::v_max(&ws);
         let translations = translation_modes(base.cells());
-        let mut map = Self {
-            image: base.clone(),
-            image_vec: vec![0.0; base.cells().phi().len()],
+        let steps = steps.max(1);
+        let mut image = base.clone();
+        for _ in 0..steps {
+            image.step(&mut ws, &step)?;
+        }
+        let mut image_vec = vec![0.0; base.cells().phi().len()];
+        transfer(
+            image.cells(),
+            image.cells().phi(),
+            base.cells(),
+            &mut image_vec,
+        );
+        Ok(Self {
             base,
+            image,
+            image_vec,
             step,
-            steps: steps.max(1),
+            steps,
             ws,
             translations,
             residual_speed,
-        };
-        let mut image = map.base.clone();
-        map.advance(&mut image)?;
-        let mut v = vec![0.0; map.len()];
-        transfer(image.cells(), image.cells().phi(), map.base.cells(), &mut v);
-        map.image = image;
-        map.image_vec = v;
-        Ok(map)
+        })
     }
 
     /// Dimension of the state vector.
