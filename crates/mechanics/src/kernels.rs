@@ -193,6 +193,7 @@ pub(crate) fn evaluate<T: Real>(
     rhs_out: &mut [T],
     global: &mut LatticeSums<N_SUMS>,
     cell_state: &mut [CellState],
+    cell_force: Option<&[[f64; 2]]>,
     post: Post<'_, T>,
 ) {
     let shape = cells.shape();
@@ -304,7 +305,15 @@ pub(crate) fn evaluate<T: Real>(
             };
             run.sum_into([mask, p_all, qxx, qxy], value, &mut acc);
             let force = add_lanes(&acc).map(|f| 0.5 * f);
-            let v = velocity(force, xi);
+            // The terms' whole-cell forces (`crate::terms`), added before the velocity.
+            let v = match cell_force {
+                None => velocity(force, xi),
+                Some(f) => {
+                    let [gx, gy] = f[i];
+                    st.cell_force = Vector2::new(gx, gy);
+                    velocity([force[0] + gx, force[1] + gy], xi)
+                }
+            };
             let half_v = v.map(|c| 0.5 * c);
             st.force = Vector2::from(force);
             st.velocity = Vector2::from(v);

@@ -63,6 +63,7 @@ mod params;
 mod scatter;
 mod simulation;
 mod step;
+pub mod terms;
 mod tissue;
 mod workspace;
 
@@ -74,7 +75,7 @@ pub use nalgebra::Vector2;
 pub use observables::Observables;
 pub use params::{ModelParams, Precision, PressureKind, StepParams, ACTIVITY_DT};
 pub use simulation::{
-    Callback, CallbackError, Observation, RunInfo, Schedule, Simulation, SimulationError,
+    Callback, CallbackError, Fix, Observation, RunInfo, Schedule, Simulation, SimulationError,
     DEFAULT_SORT_EVERY,
 };
 pub use step::{CheckPoint, StateCheck, StepCheck, PHI_BOUND};

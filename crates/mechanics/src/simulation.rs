@@ -180,6 +180,32 @@ where
     }
 }
 
+/// A change to the state between steps (after LAMMPS' fixes and rapier's hooks): a protocol
+/// that changes parameters, a perturbation, an event that rewrites fields. Fixes run after
+/// the step and the activity switch, before the callbacks, in the order added; closures
+/// `FnMut(&mut Tissue<T>) -> Result<(), CallbackError>` are fixes.
+///
+/// A fix must keep the number of cells and the patch shape (the workspace is sized for
+/// them); one that changes fields should then call [`Tissue::recentre`], so that each patch
+/// follows its cell. A fix must be a deterministic function of the state (noise from
+/// [`crate::terms::NoiseKey`]), for runs to stay reproducible and resumable.
+pub trait Fix<T: Real> {
+    /// Changes the state.
+    ///
+    /// # Errors
+    /// Whatever stops the run.
+    fn apply(&mut self, tissue: &mut Tissue<T>) -> Result<(), CallbackError>;
+}
+
+impl<T: Real, F> Fix<T> for F
+where
+    F: FnMut(&mut Tissue<T>) -> Result<(), CallbackError>,
+{
+    fn apply(&mut self, tissue: &mut Tissue<T>) -> Result<(), CallbackError> {
+        self(tissue)
+    }
+}
+
 /// The state as a callback sees it: the tissue (read-only), the clock and derived quantities
 /// computed on demand and cached for this iteration.
 pub struct Observation<'a, T: Real> {
@@ -307,6 +333,7 @@ pub struct Simulation<T: Real = f64> {
     check: (Timer, Box<dyn StepCheck>),
     callbacks: Vec<Entry<T>>,
     writers: Vec<Entry<T>>,
+    fixes: Vec<(String, Timer, Box<dyn Fix<T>>)>,
     sort_scratch: Vec<T>,
     initialized: bool,
 }
@@ -333,6 +360,7 @@ impl<T: Real> Simulation<T> {
             ),
             callbacks: Vec::new(),
             writers: Vec::new(),
+            fixes: Vec::new(),
             sort_scratch: Vec::new(),
             initialized: false,
         }
@@ -424,6 +452,18 @@ impl<T: Real> Simulation<T> {
         });
     }
 
+    /// Adds a fix ([`Fix`]), run after every step at which `schedule` fires (never at the
+    /// starting state), before the callbacks.
+    pub fn add_fix(
+        &mut self,
+        name: impl Into<String>,
+        schedule: Schedule,
+        fix: impl Fix<T> + 'static,
+    ) {
+        self.fixes
+            .push((name.into(), Timer::new(schedule), Box::new(fix)));
+    }
+
     /// Adds an output writer, run when `schedule` fires, after the callbacks.
     pub fn add_output_writer(
         &mut self,
@@ -470,6 +510,7 @@ impl<T: Real> Simulation<T> {
                 Switch::Time(t) => self.tissue.time() >= t,
             };
             self.tissue.params.zeta = if on { zeta } else { 0.0 };
+            self.tissue.active = on;
         }
     }
 
@@ -488,6 +529,7 @@ impl<T: Real> Simulation<T> {
             .iter()
             .chain(&self.writers)
             .map(|e| &e.timer)
+            .chain(self.fixes.iter().map(|f| &f.1))
             .chain(std::iter::once(&self.check.0));
         for timer in timers {
             if let Schedule::TimeInterval(_) = timer.schedule {
@@ -577,6 +619,12 @@ impl<T: Real> Simulation<T> {
             self.initialized = true;
             self.fire(start, Hook::Initialize, stop)?;
             self.fire(start, Hook::Start, stop)?;
+            // A fix never fires at the starting state: this only sets a time schedule's next
+            // firing.
+            let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
+            for (_, timer, _) in &mut self.fixes {
+                timer.fires(iteration, time, true);
+            }
         }
         let mut none = ();
         while !*stop && !self.done(start) {
@@ -601,6 +649,17 @@ impl<T: Real> Simulation<T> {
                 }
             }
             self.apply_activity();
+            let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
+            for (name, timer, fix) in &mut self.fixes {
+                if timer.fires(iteration, time, false) {
+                    fix.apply(&mut self.tissue)
+                        .map_err(|source| SimulationError::Callback {
+                            name: name.clone(),
+                            iteration,
+                            source,
+                        })?;
+                }
+            }
             self.fire(start, Hook::Call, stop)?;
         }
         Ok(())

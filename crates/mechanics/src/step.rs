@@ -8,6 +8,7 @@ use crate::equations::{heun_corrector, heun_predictor};
 use crate::kernels::{evaluate, Post};
 use crate::params::StepParams;
 use crate::scatter::LatticeSums;
+use crate::terms::CellsView;
 use crate::tissue::Tissue;
 use crate::workspace::{CellState, Workspace, N_SUMS};
 use crate::StepError;
@@ -166,13 +167,15 @@ impl<T: Real> Tissue<T> {
             k1,
             sums,
             cell_state,
+            cell_force,
             ..
         } = ws;
         let post = match predict {
             Some(h) => Post::Predict { h, out: phi_old },
             None => Post::Nothing,
         };
-        self.evaluate_fields(self.step_needs_shapes(), k1, sums, cell_state, post);
+        let shapes = self.step_needs_shapes();
+        self.evaluate_fields(shapes, k1, sums, cell_state, cell_force, post);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -180,7 +183,31 @@ impl<T: Real> Tissue<T> {
         };
         check.check(at, cell_state)?;
         self.cells.swap_phi(phi_old);
+        if !self.terms.is_empty() {
+            self.with_terms_view(cell_state, |terms, view| {
+                terms.begin(view, view.iteration);
+                if let Some(h) = predict {
+                    terms.predict(h);
+                }
+            });
+        }
         Ok(())
+    }
+
+    /// Calls `f` with the terms and what they see of every slot.
+    fn with_terms_view(
+        &mut self,
+        cell_state: &[CellState],
+        f: impl FnOnce(&mut crate::terms::Terms, &CellsView<'_>),
+    ) {
+        let view = CellsView {
+            cells: cell_state,
+            ids: &self.cell_id,
+            centres: &self.centre,
+            active: self.active,
+            iteration: self.iteration,
+        };
+        f(&mut self.terms, &view);
     }
 
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
@@ -198,6 +225,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             com,
             next_centre,
+            cell_force,
             ..
         } = ws;
         self.evaluate_fields(
@@ -205,6 +233,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
+            cell_force,
             Post::Correct {
                 h,
                 k1,
@@ -214,11 +243,15 @@ impl<T: Real> Tissue<T> {
             },
         );
         self.cells.swap_phi(phi_old);
+        if !self.terms.is_empty() {
+            self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
+        }
     }
 
     /// The predictor `φ = φ_old + h k1` (forward Euler) from what [`Tissue::start_step`]
     /// left in `ws`.
     pub(crate) fn predict(&mut self, ws: &Workspace<T>, h: f64) {
+        self.terms.predict(h);
         let phi = self.cells.phi_mut();
         phi.par_iter_mut()
             .zip(ws.phi_old.par_iter().zip(ws.k1.par_iter()))
@@ -236,6 +269,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
+            cell_force,
             ..
         } = ws;
         self.evaluate_fields(
@@ -243,8 +277,12 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
+            cell_force,
             Post::Nothing,
         );
+        if !self.terms.is_empty() {
+            self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
+        }
         let updates = self
             .cells
             .phi_mut()
@@ -280,8 +318,24 @@ impl<T: Real> Tissue<T> {
         out: &mut [T],
         sums: &mut LatticeSums<N_SUMS>,
         cell_state: &mut [CellState],
+        cell_force: &mut [[f64; 2]],
         post: Post<'_, T>,
     ) {
+        // The terms' whole-cell forces of the current state, from the per-cell quantities the
+        // last evaluation left (see `CellContext::state`).
+        let cell_force = if self.terms.is_empty() {
+            None
+        } else {
+            let view = CellsView {
+                cells: cell_state,
+                ids: &self.cell_id,
+                centres: &self.centre,
+                active: self.active,
+                iteration: self.iteration,
+            };
+            self.terms.forces(&view, cell_force);
+            Some(&*cell_force)
+        };
         evaluate(
             &self.params,
             &self.cells,
@@ -290,6 +344,7 @@ impl<T: Real> Tissue<T> {
             out,
             sums,
             cell_state,
+            cell_force,
             post,
         );
     }
@@ -307,10 +362,11 @@ impl<T: Real> Tissue<T> {
             cell_state,
             observed_centre,
             com,
+            cell_force,
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
-        self.evaluate_fields(true, k2, sums, cell_state, Post::Nothing);
+        self.evaluate_fields(true, k2, sums, cell_state, cell_force, Post::Nothing);
     }
 }
 

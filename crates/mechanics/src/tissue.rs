@@ -5,6 +5,7 @@ use phasefield::{Cells, ComTable, Lattice, Real};
 use rayon::prelude::*;
 
 use crate::params::ModelParams;
+use crate::terms::Terms;
 
 /// Side, in nodes, of the blocks of the Morton order used by [`Tissue::sort_cells`]: about
 /// a cell radius, so that a block holds a cell or two.
@@ -29,6 +30,10 @@ pub struct Tissue<T: Real = f64> {
     /// is the sort key. Only the step writes it.
     pub(crate) centre: Vec<[f64; 2]>,
     pub(crate) cell_id: Vec<usize>,
+    /// The physics terms beyond the minimal model, with their per-cell state by identity.
+    pub(crate) terms: Terms,
+    /// Whether activity is on (the relaxation switch; see [`Tissue::set_active`]).
+    pub(crate) active: bool,
 }
 
 impl<T: Real> Tissue<T> {
@@ -36,6 +41,7 @@ impl<T: Real> Tissue<T> {
     /// With [`crate::Workspace::heap_bytes`], the memory a simulation needs.
     pub fn heap_bytes(&self) -> usize {
         self.cells.heap_bytes()
+            + self.terms.heap_bytes()
             + self.centre.capacity() * std::mem::size_of::<[f64; 2]>()
             + self.cell_id.capacity() * std::mem::size_of::<usize>()
     }
@@ -79,6 +85,8 @@ impl<T: Real> Tissue<T> {
             params,
             time,
             iteration,
+            terms: Terms::default(),
+            active: true,
         };
         let com = ComTable::new(t.cells.lattice());
         let mut centre = std::mem::take(&mut t.centre);
@@ -125,7 +133,53 @@ impl<T: Real> Tissue<T> {
             iteration,
             centre,
             cell_id,
+            terms: Terms::default(),
+            active: true,
         })
+    }
+
+    /// This tissue with the physics terms `terms` (`crate::terms`), their per-cell state
+    /// initialised from their seed unless it is there already.
+    pub fn with_terms(mut self, mut terms: Terms) -> Self {
+        terms.initialise(self.n_cells());
+        self.terms = terms;
+        self
+    }
+
+    /// The physics terms and their per-cell state.
+    pub fn terms(&self) -> &Terms {
+        &self.terms
+    }
+
+    /// The physics terms, to restore their state from a checkpoint
+    /// ([`Terms::set_variable`]) or change them between steps.
+    pub fn terms_mut(&mut self) -> &mut Terms {
+        &mut self.terms
+    }
+
+    /// Whether activity is on: the active terms (ζ is set apart, by [`Tissue::params_mut`]) act
+    /// only then. On by default; [`crate::Simulation::activity_from`] holds it off during the
+    /// relaxation.
+    pub fn active(&self) -> bool {
+        self.active
+    }
+
+    /// Switches activity on or off (see [`Tissue::active`]).
+    pub fn set_active(&mut self, on: bool) {
+        self.active = on;
+    }
+
+    /// The phase fields, slot by slot, to change between steps (a [`crate::Fix`]); call
+    /// [`Tissue::recentre`] after a change that moves a cell.
+    pub fn phi_mut(&mut self) -> &mut [T] {
+        self.cells.phi_mut()
+    }
+
+    /// Recomputes every centre of mass from the fields and moves each patch onto its cell's
+    /// centre, as a step does after its update.
+    pub fn recentre(&mut self) {
+        let com = ComTable::new(self.cells.lattice());
+        self.update_centres(&com);
     }
 
     /// The lattice.

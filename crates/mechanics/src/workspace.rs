@@ -59,9 +59,11 @@ pub struct CellState {
     pub area: f64,
     /// Deformation tensor `S_i` (docs/model.md §3).
     pub shape: TracelessTensor,
-    /// Interface force `F_i`.
+    /// Interface force `F_i` (pressure and active stress).
     pub force: Vector2<f64>,
-    /// Velocity `v_i = F_i / ξ`.
+    /// The whole-cell force of the physics terms, `Σ f_i` (`crate::terms`); zero without.
+    pub cell_force: Vector2<f64>,
+    /// Velocity `v_i = (F_i + Σ f_i) / ξ`.
     pub velocity: Vector2<f64>,
     /// Smallest `φ_i` on the patch.
     pub phi_min: f64,
@@ -88,6 +90,8 @@ pub struct Workspace<T: Real = f64> {
     /// The centres of mass of the state a fixed step ends in, computed in its corrector pass.
     pub(crate) next_centre: Vec<[f64; 2]>,
     pub(crate) com: ComTable,
+    /// The whole-cell forces of the terms for the next evaluation, by slot.
+    pub(crate) cell_force: Vec<[f64; 2]>,
 }
 
 impl<T: Real> Workspace<T> {
@@ -100,7 +104,9 @@ impl<T: Real> Workspace<T> {
             + self.sums.heap_bytes()
             + self.cell_state.capacity() * std::mem::size_of::<CellState>()
             + self.velocity_field.heap_bytes()
-            + (self.observed_centre.capacity() + self.next_centre.capacity())
+            + (self.observed_centre.capacity()
+                + self.next_centre.capacity()
+                + self.cell_force.capacity())
                 * std::mem::size_of::<[f64; 2]>()
             + self.com.heap_bytes()
             + crate::kernels::scratch_bytes()
@@ -121,6 +127,7 @@ impl<T: Real> Workspace<T> {
             observed_centre: vec![[0.0; 2]; cells.n_cells()],
             next_centre: vec![[0.0; 2]; cells.n_cells()],
             com: ComTable::new(lattice),
+            cell_force: vec![[0.0; 2]; cells.n_cells()],
         }
     }
 

@@ -1,0 +1,406 @@
+//! Physics terms beyond the paper's minimal model, and the place to put a new one
+//! (docs/model.md §11).
+//!
+//! A term plugs into the step in one of these ways:
+//! - a **whole-cell force** `f_i` added to the interface force before the velocity,
+//!   `ξ_i v_i = F_i + Σ_terms f_i` ([`CellTerm::force`]);
+//! - **per-cell state** `x_i` with its own dynamics `dx_i = r(x_i, cell) dt + b dW`
+//!   ([`CellTerm::rate`], [`CellTerm::noise`]), integrated by the same Heun predictor and
+//!   corrector as the fields (the stochastic Heun scheme, with one noise increment per step
+//!   used by both stages), and stored by cell identity so that re-sorting, checkpoints and
+//!   resumes carry it;
+//! - a **force density or free-energy derivative** inside the node loops: these are built in,
+//!   configured by plain parameters that the kernels read, since a loop that must vectorise
+//!   cannot call a trait object per node;
+//! - a **fix**: anything that changes the state between steps ([`crate::Fix`], run by
+//!   [`crate::Simulation::add_fix`]).
+//!
+//! A [`CellTerm`] may live in another crate (the workspace's `examples/custom-term` crate
+//! implements one). [`Polarity`] (self-propulsion with rotational diffusion and alignment) is
+//! the built-in one, written against the same trait.
+//!
+//! With no term configured the step does what it did before the terms existed, to the bit.
+//!
+//! Noise is counter-based ([`NoiseKey`]): a deviate is a function of (seed, cell identity,
+//! step, stage), never of the thread count, the slot order or what was drawn before.
+
+mod noise;
+mod polarity;
+
+use std::fmt;
+use std::sync::Arc;
+
+use nalgebra::Vector2;
+
+pub use noise::NoiseKey;
+pub use polarity::{Align, Polarity, Propulsion};
+
+use crate::workspace::CellState;
+
+/// What a term sees of one cell when it is asked for a force or a rate.
+#[derive(Debug, Clone, Copy)]
+#[non_exhaustive]
+pub struct CellContext<'a> {
+    /// The cell's identity (its index in the initial state).
+    pub id: usize,
+    /// Its centre of mass, as the step placed its patch.
+    pub centre: [f64; 2],
+    /// What the evaluation the term is called after computed for it. In
+    /// [`CellTerm::force`], which is called *before* an evaluation, this is the previous
+    /// evaluation's (at the start of a run, zero): a whole-cell force should depend on the
+    /// term's own state.
+    pub state: &'a CellState,
+    /// Whether activity is on (off during the relaxation of docs/model.md §6; see
+    /// [`crate::Simulation::activity_from`]). Active terms (propulsion, its noise and
+    /// alignment) do nothing while it is off.
+    pub active: bool,
+}
+
+/// A physics term with a whole-cell force and per-cell state (see the [module docs](self)).
+///
+/// Every method has a default that contributes nothing, so a term implements only what it
+/// adds. A term holds parameters only; its per-cell state is kept by the [`Terms`] it is
+/// added to. Implementations must be deterministic functions of their arguments (noise comes
+/// through [`CellTerm::noise`], drawn by the driver from counter-based keys).
+pub trait CellTerm: Send + Sync + fmt::Debug {
+    /// A short name, unique within a tissue: the prefix of its state in outputs and
+    /// checkpoints.
+    fn name(&self) -> &str;
+
+    /// The names of its per-cell state variables; empty (the default) for none.
+    fn state_names(&self) -> &[&'static str] {
+        &[]
+    }
+
+    /// The initial state of cell `id` into `out` (`state_names().len()` values); `keys(k)` is
+    /// a distinct [`NoiseKey`] for each `k`, to draw from.
+    fn initial_state(&self, id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {
+        let _ = (id, keys);
+        out.fill(0.0);
+    }
+
+    /// The whole-cell force on the cell with state `x`, added to its interface force before
+    /// the velocity `v_i = (F_i + Σ f_i)/ξ_i` is formed.
+    fn force(&self, cell: &CellContext<'_>, x: &[f64]) -> [f64; 2] {
+        let _ = (cell, x);
+        [0.0; 2]
+    }
+
+    /// The deterministic rate `dx/dt` of the state `x` into `out`, from the cell as the
+    /// evaluation at this state left it.
+    fn rate(&self, cell: &CellContext<'_>, x: &[f64], out: &mut [f64]) {
+        let _ = (cell, x);
+        out.fill(0.0);
+    }
+
+    /// The amplitude `b` of the additive noise `b dW` of each state variable into `out`
+    /// (`dW` a Wiener increment, `⟨dW²⟩ = dt`).
+    fn noise(&self, cell: &CellContext<'_>, out: &mut [f64]) {
+        let _ = cell;
+        out.fill(0.0);
+    }
+}
+
+/// One term and its per-cell state, by cell identity.
+#[derive(Debug, Clone)]
+struct Entry {
+    term: Arc<dyn CellTerm>,
+    /// State variables per cell.
+    len: usize,
+    /// The state `x`, `len` values per identity.
+    x: Vec<f64>,
+    /// The state at the start of the step.
+    old: Vec<f64>,
+    /// The rate at the start of the step.
+    rate1: Vec<f64>,
+    /// The noise of the step, `b N` (per √dt).
+    kick: Vec<f64>,
+    /// Scratch for a rate.
+    scratch: Vec<f64>,
+}
+
+/// The terms of a tissue with their per-cell state: built with [`Terms::new`] and
+/// [`Terms::with`], attached by [`crate::Tissue::with_terms`].
+#[derive(Debug, Clone, Default)]
+pub struct Terms {
+    entries: Vec<Entry>,
+    seed: u64,
+    /// Cells whose state is allocated (0 before the terms are attached to a tissue).
+    n: usize,
+}
+
+/// The `stage` of a key of an initial state: far from the terms' stages of a step.
+const INITIAL_STAGE: u64 = 1 << 62;
+
+impl Terms {
+    /// No terms, with the seed of their noise.
+    pub fn new(seed: u64) -> Self {
+        Self {
+            seed,
+            ..Self::default()
+        }
+    }
+
+    /// These terms and `term`.
+    ///
+    /// # Panics
+    /// If a term of the same name is already there.
+    pub fn with(mut self, term: impl CellTerm + 'static) -> Self {
+        self.add(Arc::new(term));
+        self
+    }
+
+    /// Adds a shared term.
+    ///
+    /// # Panics
+    /// If a term of the same name is already there.
+    pub fn add(&mut self, term: Arc<dyn CellTerm>) {
+        assert!(
+            self.get(term.name()).is_none(),
+            "a term named {:?} is already there",
+            term.name()
+        );
+        let len = term.state_names().len();
+        self.entries.push(Entry {
+            term,
+            len,
+            x: Vec::new(),
+            old: Vec::new(),
+            rate1: Vec::new(),
+            kick: Vec::new(),
+            scratch: vec![0.0; len],
+        });
+        if self.n > 0 {
+            let n = self.n;
+            self.n = 0;
+            self.initialise(n);
+        }
+    }
+
+    /// Whether there is no term.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// The seed of the terms' noise.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The terms, in the order added.
+    pub fn iter(&self) -> impl Iterator<Item = &dyn CellTerm> {
+        self.entries.iter().map(|e| &*e.term)
+    }
+
+    /// The term named `name`.
+    pub fn get(&self, name: &str) -> Option<&dyn CellTerm> {
+        self.iter().find(|t| t.name() == name)
+    }
+
+    /// The per-cell state of the term named `name`: `state_names().len()` values per cell,
+    /// by identity.
+    pub fn state(&self, name: &str) -> Option<&[f64]> {
+        self.entries
+            .iter()
+            .find(|e| e.term.name() == name)
+            .map(|e| &e.x[..])
+    }
+
+    /// Every state variable of every term as `(term/variable, values by identity)`, for
+    /// outputs and checkpoints.
+    pub fn variables(&self) -> Vec<(String, Vec<f64>)> {
+        let mut out = Vec::new();
+        for e in &self.entries {
+            for (k, v) in e.term.state_names().iter().enumerate() {
+                let values = (0..self.n).map(|id| e.x[id * e.len + k]).collect();
+                out.push((format!("{}/{v}", e.term.name()), values));
+            }
+        }
+        out
+    }
+
+    /// Sets the state variable `term/variable` ([`Terms::variables`]' names) from values by
+    /// identity, as a checkpoint kept them.
+    ///
+    /// # Errors
+    /// A message when no term has that variable or the count is not the number of cells.
+    pub fn set_variable(&mut self, name: &str, values: &[f64]) -> Result<(), String> {
+        let n = self.n;
+        let (term, var) = name
+            .split_once('/')
+            .ok_or_else(|| format!("{name:?} is not of the form term/variable"))?;
+        let e = self
+            .entries
+            .iter_mut()
+            .find(|e| e.term.name() == term)
+            .ok_or_else(|| format!("no term named {term:?}"))?;
+        let k = e
+            .term
+            .state_names()
+            .iter()
+            .position(|v| *v == var)
+            .ok_or_else(|| format!("the term {term:?} has no variable {var:?}"))?;
+        if values.len() != n {
+            return Err(format!("{} values of {name} for {n} cells", values.len()));
+        }
+        for (id, v) in values.iter().enumerate() {
+            e.x[id * e.len + k] = *v;
+        }
+        Ok(())
+    }
+
+    /// Allocates and initialises the state of `n` cells (what [`crate::Tissue::with_terms`]
+    /// does); a no-op when it is there already.
+    pub(crate) fn initialise(&mut self, n: usize) {
+        if self.n == n {
+            return;
+        }
+        self.n = n;
+        let seed = self.seed;
+        for (t, e) in self.entries.iter_mut().enumerate() {
+            let len = e.len;
+            e.x = vec![0.0; n * len];
+            e.old = vec![0.0; n * len];
+            e.rate1 = vec![0.0; n * len];
+            e.kick = vec![0.0; n * len];
+            for id in 0..n {
+                let key = |k: u64| NoiseKey {
+                    seed,
+                    cell: id as u64,
+                    step: 0,
+                    stage: INITIAL_STAGE + ((t as u64) << 16) + k,
+                };
+                e.term
+                    .initial_state(id, &key, &mut e.x[id * len..(id + 1) * len]);
+            }
+        }
+    }
+
+    /// Bytes of heap memory held by the state.
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.entries
+            .iter()
+            .map(|e| {
+                (e.x.capacity()
+                    + e.old.capacity()
+                    + e.rate1.capacity()
+                    + e.kick.capacity()
+                    + e.scratch.capacity())
+                    * 8
+            })
+            .sum()
+    }
+
+    /// The whole-cell forces of the current state into `out` (by slot).
+    pub(crate) fn forces(&self, view: &CellsView<'_>, out: &mut [[f64; 2]]) {
+        for (slot, f) in out.iter_mut().enumerate() {
+            let cell = view.context(slot);
+            let mut total = [0.0; 2];
+            for e in &self.entries {
+                let x = &e.x[cell.id * e.len..(cell.id + 1) * e.len];
+                let g = e.term.force(&cell, x);
+                total = [total[0] + g[0], total[1] + g[1]];
+            }
+            *f = total;
+        }
+    }
+
+    /// The start of a step from `iteration`: keeps the state, its rate and the step's noise
+    /// for [`Terms::predict`] and [`Terms::correct`].
+    pub(crate) fn begin(&mut self, view: &CellsView<'_>, iteration: u64) {
+        let seed = self.seed;
+        for (t, e) in self.entries.iter_mut().enumerate() {
+            let len = e.len;
+            if len == 0 {
+                continue;
+            }
+            e.old.copy_from_slice(&e.x);
+            for slot in 0..view.cells.len() {
+                let cell = view.context(slot);
+                let r = cell.id * len..(cell.id + 1) * len;
+                e.term.rate(&cell, &e.x[r.clone()], &mut e.rate1[r.clone()]);
+                e.term.noise(&cell, &mut e.scratch);
+                for (k, (kick, b)) in e.kick[r].iter_mut().zip(&e.scratch).enumerate() {
+                    *kick = if *b == 0.0 {
+                        0.0
+                    } else {
+                        let key = NoiseKey {
+                            seed,
+                            cell: cell.id as u64,
+                            step: iteration,
+                            stage: ((t as u64) << 16) + k as u64,
+                        };
+                        b * key.normal()
+                    };
+                }
+            }
+        }
+    }
+
+    /// The predictor `x = x_old + h r_1 + √h b N` from what [`Terms::start`] kept (again
+    /// after a rejected adaptive attempt, with the same noise).
+    pub(crate) fn predict(&mut self, h: f64) {
+        let sqrt_h = h.sqrt();
+        for e in &mut self.entries {
+            for (((x, o), r), k) in e.x.iter_mut().zip(&e.old).zip(&e.rate1).zip(&e.kick) {
+                *x = o + h * r + sqrt_h * k;
+            }
+        }
+    }
+
+    /// A corrector: `x = x_old + h/2 (r_1 + r(x)) + √h b N`, with `r(x)` from the evaluation
+    /// of the predicted state that `view` holds.
+    pub(crate) fn correct(&mut self, view: &CellsView<'_>, h: f64) {
+        let sqrt_h = h.sqrt();
+        for e in &mut self.entries {
+            let len = e.len;
+            if len == 0 {
+                continue;
+            }
+            for slot in 0..view.cells.len() {
+                let cell = view.context(slot);
+                let r = cell.id * len..(cell.id + 1) * len;
+                e.term.rate(&cell, &e.x[r.clone()], &mut e.scratch);
+                for (k, i) in r.enumerate() {
+                    e.x[i] = e.old[i] + 0.5 * h * (e.rate1[i] + e.scratch[k]) + sqrt_h * e.kick[i];
+                }
+            }
+        }
+    }
+
+    /// Back to the state at the start of the step (a failed adaptive step).
+    pub(crate) fn restore(&mut self) {
+        for e in &mut self.entries {
+            e.x.copy_from_slice(&e.old);
+        }
+    }
+}
+
+/// The per-cell data terms are called with, by slot.
+pub(crate) struct CellsView<'a> {
+    pub(crate) cells: &'a [CellState],
+    pub(crate) ids: &'a [usize],
+    pub(crate) centres: &'a [[f64; 2]],
+    pub(crate) active: bool,
+    /// The iteration of the state the step starts from.
+    pub(crate) iteration: u64,
+}
+
+impl CellsView<'_> {
+    fn context(&self, slot: usize) -> CellContext<'_> {
+        CellContext {
+            id: self.ids[slot],
+            centre: self.centres[slot],
+            state: &self.cells[slot],
+            active: self.active,
+        }
+    }
+}
+
+/// The signed angle from `a` to `b`, in (−π, π]: `atan2(a × b, a · b)`.
+pub fn signed_angle(a: Vector2<f64>, b: Vector2<f64>) -> f64 {
+    (a.x * b.y - a.y * b.x).atan2(a.dot(&b))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,269 @@
+//! Tests of the terms on isolated cells, where the model gives the answer: an isolated cell
+//! feels no interface force (docs/model.md §3), so it moves at `v = Σ f_i / ξ`.
+
+use nalgebra::Vector2;
+use phasefield::{init, Lattice, PatchShape};
+use rayon::prelude::*;
+
+use super::*;
+use crate::{ModelParams, StepParams, Tissue, Workspace};
+
+/// One paper cell (R = 8) on a 48² lattice with margin 14, relaxed at rest for 100 TU.
+fn relaxed_cell(terms: Terms) -> (Tissue, Workspace) {
+    let lattice = Lattice::new(48, 48);
+    let shape = PatchShape::new(lattice, 14).expect("margin 14 fits 48²");
+    let cells = init::discs(lattice, shape, &[[24.0, 24.0]], 8.0, 2.5);
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(terms);
+    let mut ws = Workspace::new(t.cells());
+    t.set_active(false);
+    for _ in 0..200 {
+        t.step(&mut ws, &StepParams::default()).expect("stable");
+    }
+    t.set_active(true);
+    (t, ws)
+}
+
+/// The displacement of a periodic centre from `a` to `b`, the shortest way round.
+fn displacement(a: [f64; 2], b: [f64; 2], l: f64) -> Vector2<f64> {
+    let d = |u: f64, v: f64| (v - u) - l * ((v - u) / l).round();
+    Vector2::new(d(a[0], b[0]), d(a[1], b[1]))
+}
+
+/// One paper cell (R = 8, interface width `lambda`) on 64² with margin 16, relaxed at rest
+/// for 100 TU, with a polarity `alpha` along x.
+fn polar_cell(lambda: f64, alpha: f64) -> (Tissue, Workspace) {
+    let lattice = Lattice::new(64, 64);
+    let shape = PatchShape::new(lattice, 16).unwrap();
+    let cells = init::discs(lattice, shape, &[[32.0, 32.0]], 8.0, lambda);
+    let mut p = ModelParams::paper(0.0);
+    p.energy.lambda = lambda;
+    let pol = Polarity::new(alpha).with_initial_angle(0.0);
+    let mut t = Tissue::new(cells, p).with_terms(Terms::new(1).with(pol));
+    let mut ws = Workspace::new(t.cells());
+    t.set_active(false);
+    for _ in 0..200 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    t.set_active(true);
+    (t, ws)
+}
+
+/// T1.1 of the extensions: an isolated polar cell moves along its polarity at α/ξ.
+///
+/// Its velocity `v_i = α p_i/ξ` is exact (the interface force of an isolated cell is zero),
+/// but its centre moves slower, by the dispersion of the central differences that advect
+/// the interface: measured 1.83 % slower at the paper's interface width λ = 2.5 and 0.60 %
+/// at λ = 5, over 100 TU after 50 TU of motion (1.82 % at dt 0.1 against 1.83 % at 0.5, so it
+/// is the space discretisation; 0.8 % at λ = 4). The error falls by 3.1 for a doubling of λ
+/// (second order would be 4; at λ = 5 the interface is no longer thin against R = 8).
+/// Asserted: below 1 % at λ = 5 (the spec's bound), below 2.5 % at λ = 2.5, and a fall by
+/// more than 2.5 for the doubling.
+#[test]
+fn an_isolated_polar_cell_moves_at_alpha_over_xi() {
+    let mut err = Vec::new();
+    for lambda in [2.5, 5.0] {
+        let (mut t, mut ws) = polar_cell(lambda, 0.04);
+        for _ in 0..100 {
+            t.step(&mut ws, &StepParams::default()).unwrap();
+        }
+        let start = t.centres()[0];
+        for _ in 0..200 {
+            t.step(&mut ws, &StepParams::default()).unwrap();
+        }
+        let v = displacement(start, t.centres()[0], 64.0) / 100.0;
+        assert!(v.y.abs() < 1e-9, "the cell moves along its polarity: {v:?}");
+        err.push(1.0 - v.x / 0.02);
+        // The velocity itself is α/ξ and the interface force zero.
+        let c = &ws.cell_states()[0];
+        assert!((c.velocity.x - 0.02).abs() < 1e-9 && c.force.norm() < 1e-9);
+        assert!((c.cell_force.x - 0.04).abs() < 1e-15);
+    }
+    let (coarse, fine) = (err[0], err[1]);
+    eprintln!("speed error: λ = 2.5 {coarse:e}, λ = 5 {fine:e}");
+    assert!(fine.abs() < 0.01, "λ = 5: {fine:e} off α/ξ");
+    assert!(coarse.abs() < 0.025, "λ = 2.5: {coarse:e} off α/ξ");
+    assert!(
+        coarse / fine > 2.5,
+        "not second order: {coarse:e} then {fine:e}"
+    );
+}
+
+/// A polarity that pushes with α = 0 and does not turn changes nothing: the step with it is
+/// the step without terms, to the bit (the term path adds an exact zero).
+#[test]
+fn a_term_that_adds_nothing_changes_nothing_to_the_bit() {
+    let run = |terms: Option<Terms>| {
+        let lattice = Lattice::new(48, 48);
+        let shape = PatchShape::new(lattice, 10).unwrap();
+        let centres = [[12.0, 12.0], [25.0, 14.0], [18.0, 30.0], [34.0, 34.0]];
+        let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
+        let mut t = Tissue::new(cells, ModelParams::paper(0.01));
+        if let Some(terms) = terms {
+            t = t.with_terms(terms);
+        }
+        let mut ws = Workspace::new(t.cells());
+        for _ in 0..30 {
+            t.step(&mut ws, &StepParams::default()).unwrap();
+        }
+        t.cells().phi().to_vec()
+    };
+    let plain = run(None);
+    let zero = run(Some(Terms::new(3).with(Polarity::new(0.0))));
+    assert!(plain
+        .iter()
+        .zip(&zero)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+}
+
+/// A user's term: a constant force on every cell (gravity on a tilted substrate).
+#[derive(Debug)]
+struct Tilt([f64; 2]);
+
+impl CellTerm for Tilt {
+    fn name(&self) -> &str {
+        "tilt"
+    }
+    fn force(&self, _: &CellContext<'_>, _: &[f64]) -> [f64; 2] {
+        self.0
+    }
+}
+
+/// Alignment to the velocity relaxes at the predicted rate. A cell pushed by a constant force
+/// `G x̂` besides its propulsion `α p` moves along `αp + G`; to first order in the angle δ of
+/// p from x̂, the velocity's angle is `αδ/(α+G)`, so `dδ/dt = −J |v| Δ(v, p) = −J (G/ξ) δ`.
+/// The measured decay rate of `ln δ` between δ = 0.1 and 0.02 is within 2 % of `J G/ξ`
+/// (measured 0.04 % off; the first-order expansion's error at δ = 0.1 is 0.5 %).
+#[test]
+fn alignment_to_the_velocity_relaxes_at_the_predicted_rate() {
+    let (alpha, g, j, xi) = (0.04, 0.02, 2.0, 2.0);
+    let pol = Polarity::new(alpha)
+        .with_alignment(Align::Velocity, j)
+        .with_initial_angle(0.1);
+    let (mut t, mut ws) = relaxed_cell(Terms::new(1).with(pol).with(Tilt([g, 0.0])));
+    let theta = |t: &Tissue| t.terms().state("polarity").unwrap()[0];
+    assert_eq!(theta(&t), 0.1, "the relaxation does not turn the polarity");
+    let mut samples = Vec::new();
+    while theta(&t) > 0.02 {
+        t.step(&mut ws, &StepParams::default()).expect("stable");
+        samples.push((t.time(), theta(&t).ln()));
+    }
+    // The least-squares slope of ln δ against t.
+    let n = samples.len() as f64;
+    let (mt, ml) = samples
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, l)| (a + t / n, b + l / n));
+    let (sxy, sxx) = samples.iter().fold((0.0, 0.0), |(a, b), (t, l)| {
+        (a + (t - mt) * (l - ml), b + (t - mt) * (t - mt))
+    });
+    let rate = -sxy / sxx;
+    let expected = j * g / xi;
+    eprintln!("alignment rate {rate} against {expected}");
+    assert!(
+        (rate / expected - 1.0).abs() < 0.02,
+        "rate {rate} against J G/ξ = {expected}"
+    );
+}
+
+/// T1.2 of the extensions: a polar cell with rotational diffusion is a persistent random
+/// walk, `⟨p(t)·p(0)⟩ = e^{−D_r t}` and `MSD(t) = 2 v₀² τ [t − τ(1 − e^{−t/τ})]` with
+/// `τ = 1/D_r`, `v₀ = α/ξ`. 64 seeds, each 2000 TU (20 τ), averaged over time origins every
+/// 10 TU; at every lag up to 2τ the measured MSD and correlation are within 10 % of the
+/// formulas. Measured: the MSD 3.3–3.8 % low at every lag (the centre moves 1.8 % slower
+/// than α/ξ, see the test above, and the MSD goes as v₀²), the correlation within 4 % (at
+/// 2τ, 0.141 against 0.135: `e^{−2}` from about 640 independent windows).
+#[test]
+fn rotational_diffusion_gives_a_persistent_random_walk() {
+    let (alpha, xi, d_r) = (0.04, 2.0, 0.01);
+    let (tau, v0) = (1.0 / d_r, alpha / xi);
+    let (seeds, dt, every, t_end) = (64u64, 0.5, 20usize, 2000.0);
+    let samples = (t_end / dt) as usize / every;
+    let runs: Vec<Vec<([f64; 2], f64)>> = (0..seeds)
+        .into_par_iter()
+        .map(|seed| {
+            let pol = Polarity::new(alpha).with_rotational_diffusion(d_r);
+            let (mut t, mut ws) = relaxed_cell(Terms::new(seed).with(pol));
+            // The centres unwrapped, so that a walk across the boundary is not folded.
+            let mut pos = [0.0; 2];
+            let mut last = t.centres()[0];
+            let mut out = vec![(pos, t.terms().state("polarity").unwrap()[0])];
+            for _ in 0..samples {
+                for _ in 0..every {
+                    t.step(&mut ws, &StepParams::new(dt, 1)).expect("stable");
+                }
+                let c = t.centres()[0];
+                let d = displacement(last, c, 48.0);
+                last = c;
+                pos = [pos[0] + d.x, pos[1] + d.y];
+                out.push((pos, t.terms().state("polarity").unwrap()[0]));
+            }
+            out
+        })
+        .collect();
+    for lag_tau in [0.25, 0.5, 1.0, 2.0] {
+        let lag = (lag_tau * tau / (dt * every as f64)).round() as usize;
+        let t = lag as f64 * dt * every as f64;
+        let (mut msd, mut corr, mut count) = (0.0, 0.0, 0.0);
+        for run in &runs {
+            for w in 0..run.len() - lag {
+                let ((a, ta), (b, tb)) = (run[w], run[w + lag]);
+                msd += (b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2);
+                corr += (tb - ta).cos();
+                count += 1.0;
+            }
+        }
+        let (msd, corr) = (msd / count, corr / count);
+        let msd_expected = 2.0 * v0 * v0 * tau * (t - tau * (1.0 - (-t / tau).exp()));
+        let corr_expected = (-t / tau).exp();
+        eprintln!("t {t}: MSD {msd} / {msd_expected}, corr {corr} / {corr_expected}");
+        assert!(
+            (msd / msd_expected - 1.0).abs() < 0.1,
+            "MSD at t = {t}: {msd} against {msd_expected}"
+        );
+        assert!(
+            (corr / corr_expected - 1.0).abs() < 0.1,
+            "⟨p(t)·p(0)⟩ at t = {t}: {corr} against {corr_expected}"
+        );
+    }
+}
+
+/// The noise is keyed by cell identity and step, so a run with terms is bit-identical for
+/// any thread count, and re-sorting the cells (which moves them between slots) does not
+/// change a cell's noise.
+#[test]
+fn terms_are_independent_of_threads_and_slots() {
+    let run = |threads: usize, sort: bool| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let lattice = Lattice::new(64, 64);
+            let shape = PatchShape::new(lattice, 10).unwrap();
+            let centres = [[40.0, 40.0], [12.0, 12.0], [40.0, 12.0], [12.0, 40.0]];
+            let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
+            let pol = Polarity::new(0.05)
+                .with_rotational_diffusion(0.05)
+                .with_alignment(Align::Force, 1.0);
+            let mut t =
+                Tissue::new(cells, ModelParams::paper(0.005)).with_terms(Terms::new(11).with(pol));
+            let mut ws = Workspace::new(t.cells());
+            let mut scratch = Vec::new();
+            for _ in 0..40 {
+                if sort {
+                    t.sort_cells(&mut scratch);
+                }
+                t.step(&mut ws, &StepParams::default()).unwrap();
+            }
+            let slots = t.slots();
+            let centres: Vec<[f64; 2]> = slots.iter().map(|&s| t.centres()[s]).collect();
+            (t.terms().state("polarity").unwrap().to_vec(), centres)
+        })
+    };
+    let reference = run(1, false);
+    assert_eq!(run(2, false), reference);
+    let sorted = run(1, true);
+    // Sorting changes the order of lattice sums (round-off), never which noise a cell gets.
+    for (a, b) in sorted.0.iter().zip(&reference.0) {
+        assert!((a - b).abs() < 1e-9, "{a} {b}");
+    }
+}
