@@ -6,4 +6,5 @@ mod common;
 mod docs;
 mod from_state;
 mod signals;
+mod terms;
 mod view;

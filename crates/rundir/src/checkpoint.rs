@@ -19,6 +19,7 @@
 //! | `cell_id` | `(N,)` int64 | identity of each slot |
 //! | `scene` | `(bytes,)` uint8 | the resolved scene (TOML) |
 //! | `controller` | `(5,)` | adaptive runs only: [`mechanics::Controller::to_array`] |
+//! | `TERM.VARIABLE` | `(N,)` | each physics term's per-cell state, by identity (e.g. `polarity.theta`; [`mechanics::terms::Terms::variables`]) |
 //!
 //! Each is written under a temporary name, flushed to disk (`fsync`) and renamed, so a kill
 //! at any moment leaves the previous checkpoint intact; the newest [`KEEP`] are kept.
@@ -121,10 +122,18 @@ pub fn write_checkpoint<T: Real>(
             ),
         ])
     };
-    let mut arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
+    let mut arrays: Vec<(String, Vec<u8>)> = arrays()
+        .map_err(|e| RunDirError::io("encode", &path, e))?
+        .into_iter()
+        .map(|(name, a)| (name.to_string(), a))
+        .collect();
+    for (name, values) in term_arrays(tissue) {
+        let a = npy(&[n], values).map_err(|e| RunDirError::io("encode", &path, e))?;
+        arrays.push((name, a));
+    }
     if let Some(c) = controller {
         let a = npy(&[5], c.to_array()).map_err(|e| RunDirError::io("encode", &path, e))?;
-        arrays.push(("controller", a));
+        arrays.push(("controller".into(), a));
     }
     // Stored, not deflated: the state is mostly noise in its low bits.
     write_zip(&path, arrays, zip::CompressionMethod::Stored, true)?;
@@ -262,6 +271,61 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
         Cells::from_storage(l, shape, phi, pairs(7), pairs(8)).map_err(|r| bad("phi", r))?;
     let centre: Vec<[f64; 2]> = a[9].data.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
     let ids: Vec<usize> = a[10].data.iter().map(|&v| v as usize).collect();
-    Tissue::restore(cells, scene.model_params(zeta), time, step, centre, ids)
-        .map_err(|r| bad("cell_id", r))
+    let tissue = Tissue::restore(cells, scene.model_params(zeta), time, step, centre, ids)
+        .map_err(|r| bad("cell_id", r))?
+        .with_terms(scene.terms());
+    read_terms(path, tissue, true)
+}
+
+/// The name of the array that holds a term's state variable (`polarity/theta` →
+/// `polarity.theta`), in checkpoints and frames.
+pub(crate) fn term_array_name(variable: &str) -> String {
+    variable.replace('/', ".")
+}
+
+/// Every term state variable of `tissue` as (array name, values by identity).
+pub(crate) fn term_arrays<T: Real>(tissue: &Tissue<T>) -> Vec<(String, Vec<f64>)> {
+    tissue
+        .terms()
+        .variables()
+        .into_iter()
+        .map(|(name, values)| (term_array_name(&name), values))
+        .collect()
+}
+
+/// Sets the state of `tissue`'s terms from the arrays of `path` (a checkpoint or a frame,
+/// cells in identity order). A missing array is an error when `required`, and otherwise
+/// leaves the state as the terms initialised it (a frame of a run without the term).
+///
+/// # Errors
+/// A damaged or missing array, naming the file and the array.
+pub(crate) fn read_terms<T: Real>(
+    path: &Path,
+    mut tissue: Tissue<T>,
+    required: bool,
+) -> Result<Tissue<T>> {
+    for (name, _) in tissue.terms().variables() {
+        let array = term_array_name(&name);
+        let values = match read_npz(path, &[&array]) {
+            Ok(mut a) => a.remove(0).data,
+            Err(RunDirError::MissingArray { .. }) if !required => continue,
+            Err(e) => return Err(e),
+        };
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(RunDirError::BadArray {
+                path: path.to_path_buf(),
+                name: array,
+                reason: "holds non-finite values".into(),
+            });
+        }
+        tissue
+            .terms_mut()
+            .set_variable(&name, &values)
+            .map_err(|reason| RunDirError::BadArray {
+                path: path.to_path_buf(),
+                name: array.clone(),
+                reason,
+            })?;
+    }
+    Ok(tissue)
 }

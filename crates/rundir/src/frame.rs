@@ -123,7 +123,35 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
             ),
         ])
     };
-    let arrays = arrays().map_err(|e| RunDirError::io("encode", &path, e))?;
+    let mut arrays: Vec<(String, Vec<u8>)> = arrays()
+        .map_err(|e| RunDirError::io("encode", &path, e))?
+        .into_iter()
+        .map(|(name, a)| (name.to_string(), a))
+        .collect();
+    let terms = crate::checkpoint::term_arrays(tissue);
+    let mut extra = Vec::new();
+    if !tissue.terms().is_empty() {
+        extra.push((
+            "cell_force".to_string(),
+            npy(
+                &[n64, 2],
+                cs.iter().flat_map(|c| [c.cell_force.x, c.cell_force.y]),
+            ),
+        ));
+    }
+    if let Some((_, theta)) = terms.iter().find(|(name, _)| name == "polarity.theta") {
+        extra.push((
+            "polarity".to_string(),
+            npy(&[n64, 2], theta.iter().flat_map(|t| [t.cos(), t.sin()])),
+        ));
+    }
+    for (name, values) in terms {
+        extra.push((name, npy(&[n64], values)));
+    }
+    for (name, a) in extra {
+        let a = a.map_err(|e| RunDirError::io("encode", &path, e))?;
+        arrays.push((name, a));
+    }
     write_npz(&path, arrays)?;
     Ok(path)
 }

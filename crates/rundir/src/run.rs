@@ -413,6 +413,8 @@ impl RunDir {
                 let tissue = scene
                     .tissue_from_state::<T>(state)
                     .map_err(|e| initial_state(Box::new(e)))?;
+                let tissue = crate::state::saved_terms(scene, tissue)
+                    .map_err(|e| initial_state(Box::new(e)))?;
                 let mut sim = scene.simulation_from(tissue);
                 let w = add_writers(&mut sim, &self.dir, &schedules)?;
                 (sim, w)

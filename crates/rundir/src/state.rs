@@ -37,8 +37,29 @@ pub fn read_state(path: &Path) -> Result<Cells<f64>> {
 pub fn initial_tissue<T: Real>(scene: &Scene) -> std::result::Result<Tissue<T>, StateError> {
     match initial_state(scene)? {
         None => Ok(scene.tissue::<T>()?),
-        Some(state) => Ok(scene.tissue_from_state::<T>(&state)?),
+        Some(state) => saved_terms(scene, scene.tissue_from_state::<T>(&state)?),
     }
+}
+
+/// `tissue` (built from the saved state `scene` starts from) with the state of its physics
+/// terms read from that file, cell by cell, where it has them (a frame or checkpoint of a run
+/// with the same terms); terms the file lacks keep the state their seed gave them.
+///
+/// # Errors
+/// A damaged term array in the file.
+pub fn saved_terms<T: Real>(
+    scene: &Scene,
+    tissue: Tissue<T>,
+) -> std::result::Result<Tissue<T>, StateError> {
+    let Some(from) = scene.init_from() else {
+        return Ok(tissue);
+    };
+    crate::checkpoint::read_terms(Path::new(from), tissue, false).map_err(|error| {
+        StateError::Read {
+            from: from.to_string(),
+            error,
+        }
+    })
 }
 
 /// The saved state `scene` starts from (`init = "frame"`; `None` for the other layouts),

@@ -2,6 +2,7 @@
 //! completely, with `deny_unknown_fields` on every table and `--set section.key=value`
 //! overrides (ripgrep's low-level arguments: close to the file, checked only for syntax).
 
+use mechanics::terms::{Align, Polarity, Propulsion, Terms};
 use mechanics::{ModelParams, Precision, PressureKind, StepParams};
 use phasefield::PatchShape;
 use serde::{Deserialize, Serialize};
@@ -201,6 +202,84 @@ impl Default for Run {
     }
 }
 
+/// `[polarity]`: self-propulsion along a polarity with rotational diffusion and alignment
+/// (docs/model.md §11.1, `mechanics::terms::Polarity`); absent: no self-propulsion.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolaritySpec {
+    /// The propulsion force α per cell (the reference code's examples: 0.04); a cell alone
+    /// moves at α/ξ.
+    pub alpha: f64,
+    /// The rotational diffusion constant D_r per time unit (default 0): the polarity's
+    /// persistence time is 1/D_r. The reference code's `D-pol` is `√(2 D_r)`.
+    #[serde(default)]
+    pub rotational_diffusion: f64,
+    /// What the polarity turns towards (default `"none"`).
+    #[serde(default)]
+    pub align: AlignKind,
+    /// The alignment rate J per unit of the target's magnitude (default 0; the reference
+    /// code's `J-pol`, 0.1 in its examples).
+    #[serde(default)]
+    pub align_rate: f64,
+    /// How the propulsion is spread (default `"cell"`).
+    #[serde(default)]
+    pub propulsion: PropulsionKind,
+    /// Every cell's initial angle in radians (0 along +x); absent: uniform on the circle,
+    /// from `[run] seed`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
+}
+
+/// `[polarity] align`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AlignKind {
+    /// No alignment: a persistent random walk.
+    #[default]
+    None,
+    /// To the cell's own velocity (flocking).
+    Velocity,
+    /// To the interface force, away from the cells it presses against.
+    Force,
+    /// To the cell's long axis, the end nearer the polarity.
+    Shape,
+}
+
+/// `[polarity] propulsion`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PropulsionKind {
+    /// A whole-cell force α p.
+    #[default]
+    Cell,
+    /// A force density α φ² p, summing to α A p (α per unit area).
+    Density,
+}
+
+impl PolaritySpec {
+    /// The term these keys describe.
+    pub fn term(&self) -> Polarity {
+        let align = match self.align {
+            AlignKind::None => Align::None,
+            AlignKind::Velocity => Align::Velocity,
+            AlignKind::Force => Align::Force,
+            AlignKind::Shape => Align::Shape,
+        };
+        let propulsion = match self.propulsion {
+            PropulsionKind::Cell => Propulsion::Cell,
+            PropulsionKind::Density => Propulsion::Density,
+        };
+        let p = Polarity::new(self.alpha)
+            .with_rotational_diffusion(self.rotational_diffusion)
+            .with_alignment(align, self.align_rate)
+            .with_propulsion(propulsion);
+        match self.angle {
+            Some(theta) => p.with_initial_angle(theta),
+            None => p,
+        }
+    }
+}
+
 /// A whole scene file, as written: parsed, not yet validated (validate it into a
 /// [`crate::Scene`] with [`SceneFile::validate`]).
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -219,6 +298,9 @@ pub struct SceneFile {
     /// `[run]`.
     #[serde(default)]
     pub run: Run,
+    /// `[polarity]`, when the cells are self-propelled.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polarity: Option<PolaritySpec>,
 }
 
 impl SceneFile {
@@ -260,6 +342,15 @@ impl SceneFile {
             .with_energy(energy)
             .with_xi(m.xi)
             .with_pressure(m.pressure)
+    }
+
+    /// The physics terms beyond the minimal model, with the run's seed for their noise.
+    pub fn terms(&self) -> Terms {
+        let mut terms = Terms::new(self.run.seed);
+        if let Some(p) = &self.polarity {
+            terms = terms.with(p.term());
+        }
+        terms
     }
 
     /// The integrator parameters.

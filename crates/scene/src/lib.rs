@@ -295,10 +295,15 @@ impl Scene {
             f.init_radius(),
             f.model.lambda,
         );
-        Ok(Tissue::new(
-            cells.into_precision::<T>(),
-            self.initial_params(),
-        ))
+        Ok(
+            Tissue::new(cells.into_precision::<T>(), self.initial_params())
+                .with_terms(self.file.terms()),
+        )
+    }
+
+    /// The physics terms beyond the minimal model (`[polarity]`), with the run's seed.
+    pub fn terms(&self) -> mechanics::terms::Terms {
+        self.file.terms()
     }
 
     /// The initial tissue from a saved state `state` (the fields of a frame or a checkpoint,
@@ -315,10 +320,10 @@ impl Scene {
         let ids = (0..state.n_cells()).collect();
         let placed = Tissue::from_state(state.clone(), self.initial_params(), 0.0, 0, ids);
         let cells = state.resampled(self.patch_shape(), placed.centres());
-        Ok(Tissue::new(
-            cells.into_precision::<T>(),
-            self.initial_params(),
-        ))
+        Ok(
+            Tissue::new(cells.into_precision::<T>(), self.initial_params())
+                .with_terms(self.file.terms()),
+        )
     }
 
     /// Checks that a saved state fits the scene: the same lattice and the same number of

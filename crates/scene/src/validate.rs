@@ -3,7 +3,7 @@
 
 use phasefield::{init, Lattice, PatchShape};
 
-use crate::file::{InitKind, SceneFile};
+use crate::file::{AlignKind, InitKind, SceneFile};
 use crate::Scene;
 
 /// A problem with a scene, naming the key and the fix.
@@ -283,6 +283,53 @@ impl SceneFile {
                 "the activity must be a finite number",
                 "use a value between -0.01 and 0.01",
             ));
+        }
+        if let Some(p) = &self.polarity {
+            if !p.alpha.is_finite() {
+                return Err(invalid(
+                    "polarity",
+                    "alpha",
+                    p.alpha,
+                    "the propulsion force must be a finite number",
+                    "use a force of order 0.01-0.1 (the reference code's examples use 0.04)",
+                ));
+            }
+            if !(p.rotational_diffusion.is_finite() && p.rotational_diffusion >= 0.0) {
+                return Err(invalid(
+                    "polarity",
+                    "rotational_diffusion",
+                    p.rotational_diffusion,
+                    "the rotational diffusion constant must be zero or positive",
+                    "use D_r = 1/(persistence time), e.g. 4.5e-4 (the reference code's D-pol = 0.03 is D_r = D-pol^2/2)",
+                ));
+            }
+            if !(p.align_rate.is_finite() && p.align_rate >= 0.0) {
+                return Err(invalid(
+                    "polarity",
+                    "align_rate",
+                    p.align_rate,
+                    "the alignment rate must be zero or positive",
+                    "use a rate of order 0.1 (the reference code's J-pol), or 0 for none",
+                ));
+            }
+            if p.align_rate > 0.0 && p.align == AlignKind::None {
+                return Err(invalid(
+                    "polarity",
+                    "align_rate",
+                    p.align_rate,
+                    "an alignment rate with align = \"none\" aligns to nothing",
+                    "set align = \"velocity\", \"force\" or \"shape\", or remove align_rate",
+                ));
+            }
+            if let Some(a) = p.angle.filter(|a| !a.is_finite()) {
+                return Err(invalid(
+                    "polarity",
+                    "angle",
+                    a,
+                    "the initial angle must be a finite number",
+                    "give it in radians (0 is along +x), or remove it for random angles",
+                ));
+            }
         }
         let it = &self.integrator;
         if !(it.dt.is_finite() && it.dt > 0.0) {
