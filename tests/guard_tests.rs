@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 28] = [
+const KEYS: [&str; 34] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -147,8 +147,14 @@ const KEYS: [&str; 28] = [
     "run.seed",
     "run.output_every",
     "run.series_every",
+    "polarity.alpha",
+    "polarity.rotational_diffusion",
+    "polarity.align",
+    "polarity.align_rate",
+    "polarity.propulsion",
+    "polarity.angle",
 ];
-const VALUES: [&str; 32] = [
+const VALUES: [&str; 36] = [
     "0",
     "-1",
     "1",
@@ -181,6 +187,10 @@ const VALUES: [&str; 32] = [
     "\"f32\"",
     "\"f64\"",
     "{ a = 1 }",
+    "\"velocity\"",
+    "\"force\"",
+    "\"shape\"",
+    "\"density\"",
 ];
 
 /// Stands for the path of a real frame of the base scene (`frame_path`) among [`VALUES`].
