@@ -9,4 +9,22 @@ pub use phasefield;
 pub use render;
 pub use rundir;
 pub use scene;
+pub use stability;
 pub use study;
+
+/// Everything a whole run needs, from a scene or by hand, in one `use monolayer::prelude::*;`:
+/// the lattice, patches and initial states (`phasefield`), the model, its parameters, the
+/// driver with its callbacks and fixes (`mechanics`), the physics terms and the trait a new
+/// one implements (`mechanics::terms`), scenes (`scene`) and run directories (`rundir`).
+pub mod prelude {
+    pub use mechanics::prelude::*;
+    pub use mechanics::terms::{
+        Align, CellContext, CellTerm, NoiseKey, Polarity, Propulsion, Terms,
+    };
+    pub use mechanics::{
+        AdaptiveParams, CellState, Controller, Fix, StateCheck, StepCheck, StepError, SumField,
+    };
+    pub use phasefield::{init, Cells, EnergyParams, Lattice, PatchShape, Real};
+    pub use rundir::RunDir;
+    pub use scene::Scene;
+}

@@ -85,9 +85,9 @@ pub use workspace::{CellState, SumField, Workspace};
 /// The types most programs need: `use mechanics::prelude::*;`.
 pub mod prelude {
     pub use crate::{
-        Callback, CallbackError, ModelParams, Observables, Observation, Precision, PressureKind,
-        Schedule, Simulation, StepParams, Tissue, TissueFields, TracelessTensor, Vector2,
-        Workspace,
+        Callback, CallbackError, Fix, ModelParams, Observables, Observation, Precision,
+        PressureKind, Schedule, Simulation, StepParams, Tissue, TissueFields, TracelessTensor,
+        Vector2, Workspace,
     };
 }
 
