@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 34] = [
+const KEYS: [&str; 35] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -153,6 +153,7 @@ const KEYS: [&str; 34] = [
     "polarity.align_rate",
     "polarity.propulsion",
     "polarity.angle",
+    "adhesion.omega",
 ];
 const VALUES: [&str; 36] = [
     "0",

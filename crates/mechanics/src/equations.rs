@@ -148,6 +148,38 @@ pub fn rhs(velocity: [f64; 2], grad: [f64; 2], dfdphi: f64) -> f64 {
     -velocity[0] * grad[0] - velocity[1] * grad[1] - dfdphi
 }
 
+/// The adhesion coefficient `c = 2ωλ` of the cell–cell adhesion energy
+/// `F_adh = ωλ Σ_{i≠j} Σ_x ∇φ_i·∇φ_j` (docs/model.md §11.2).
+#[inline(always)]
+pub fn adhesion_coefficient(omega: f64, lambda: f64) -> f64 {
+    2.0 * omega * lambda
+}
+
+/// The adhesion part of `δF/δφ_i` at a node: `−c (∇²s1 − ∇²φ_i) = −c Σ_{j≠i} ∇²φ_j`, with
+/// `c` = [`adhesion_coefficient`], `lap_s1` the lattice Laplacian of `s1 = Σ φ_j` and
+/// `lap_self` the Laplacian of `φ_i` on its patch.
+#[inline(always)]
+pub fn adhesion_derivative(c: f64, lap_s1: f64, lap_self: f64) -> f64 {
+    -c * (lap_s1 - lap_self)
+}
+
+/// Cell i's single-cell part of the adhesion pressure, `+c φ_i ∇²φ_i`, which the scatter adds
+/// to `U`; with [`adhesion_pressure`] the adhesion adds the φ-weighted sum of its derivative,
+/// `Σ_i φ_i δF_adh/δφ_i = −c (s1 ∇²s1 − Σ_i φ_i ∇²φ_i)`, to the pressure in both forms (the
+/// paper form's unweighted sum would be `−c (N − 1) ∇²s1`, which does not vanish away from
+/// the contacts; docs/model.md §11.2).
+#[inline(always)]
+pub fn adhesion_pressure_cell_part(c: f64, phi: f64, laplacian: f64) -> f64 {
+    c * phi * laplacian
+}
+
+/// The cross part of the adhesion pressure, `−c s1 ∇²s1` (see
+/// [`adhesion_pressure_cell_part`]).
+#[inline(always)]
+pub fn adhesion_pressure(c: f64, s1: f64, lap_s1: f64) -> f64 {
+    -c * s1 * lap_s1
+}
+
 /// The Heun predictor (a forward-Euler step): `φ* = φⁿ + Δt R(φⁿ)` (docs/model.md §4).
 #[inline(always)]
 pub fn heun_predictor(phi_old: f64, dt: f64, r_old: f64) -> f64 {

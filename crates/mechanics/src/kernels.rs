@@ -23,6 +23,7 @@ use phasefield::{Cells, ComTable, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
 use crate::equations::{
+    adhesion_coefficient, adhesion_derivative, adhesion_pressure, adhesion_pressure_cell_part,
     force_density, heun_corrector, heun_predictor, nematic_density, pressure, pressure_cell_part,
     pressure_self_coefficient, pressure_self_part_with, rhs, shape_tensor_density, velocity,
 };
@@ -32,6 +33,7 @@ use crate::scatter::{scatter, LatticeSums};
 use crate::workspace::{CellState, SumField, N_SUMS};
 
 // Where each lattice sum is stored.
+const I_S1: usize = SumField::S1.index();
 const I_S2: usize = SumField::S2.index();
 const I_QXX: usize = SumField::Qxx.index();
 const I_QXY: usize = SumField::Qxy.index();
@@ -194,6 +196,7 @@ pub(crate) fn evaluate<T: Real>(
     global: &mut LatticeSums<N_SUMS>,
     cell_state: &mut [CellState],
     cell_force: Option<&[[f64; 2]]>,
+    lap_s1: &mut [f64],
     post: Post<'_, T>,
 ) {
     let shape = cells.shape();
@@ -216,6 +219,7 @@ pub(crate) fn evaluate<T: Real>(
     // 2. Lattice sums.
     let coef = energy.coefficients();
     let kind = params.pressure;
+    let c_adh = adhesion_coefficient(params.omega, energy.lambda);
     {
         let cs: &[CellState] = cell_state;
         scatter::<N_SUMS, T, _, _>(
@@ -231,8 +235,10 @@ pub(crate) fn evaluate<T: Real>(
                     let [q_xx, q_xy] = nematic_density(p, sh);
                     [p, p * p, u, q_xx, q_xy]
                 };
-                match kind {
-                    PressureKind::Paper => run.add_to(
+                // Adhesion adds its single-cell part `c φ ∇²φ` to `U` (a branch outside the
+                // node loops: without adhesion the loops are what they were).
+                match (kind, c_adh != 0.0) {
+                    (PressureKind::Paper, false) => run.add_to(
                         [],
                         move |s, []| {
                             let p = s.c;
@@ -247,7 +253,7 @@ pub(crate) fn evaluate<T: Real>(
                         },
                         sums,
                     ),
-                    PressureKind::Interaction => run.add_to(
+                    (PressureKind::Interaction, false) => run.add_to(
                         [],
                         move |s, []| {
                             let p = s.c;
@@ -255,6 +261,16 @@ pub(crate) fn evaluate<T: Real>(
                                 p,
                                 pressure_cell_part(PressureKind::Interaction, &coef, p, 0.0, 0.0),
                             )
+                        },
+                        sums,
+                    ),
+                    (kind, true) => run.add_to(
+                        [],
+                        move |s, []| {
+                            let (p, lap) = (s.c, s.laplacian());
+                            let u = pressure_cell_part(kind, &coef, p, lap, area_factor)
+                                + adhesion_pressure_cell_part(c_adh, p, lap);
+                            node(p, u)
                         },
                         sums,
                     ),
@@ -269,6 +285,11 @@ pub(crate) fn evaluate<T: Real>(
                 }
             },
         );
+    }
+
+    // Adhesion: the lattice Laplacian of s1, and its cross term in the pressure.
+    if c_adh != 0.0 {
+        add_adhesion_pressure(c_adh, global, lap_s1);
     }
 
     // 3. Forces, velocities and the right-hand side.
@@ -353,6 +374,10 @@ pub(crate) fn evaluate<T: Real>(
             }
         }
     };
+    assert!(
+        c_adh == 0.0 || matches!(post, Post::Nothing),
+        "adhesion adds to the right-hand side after the force pass, so the Heun update cannot be fused into it"
+    );
     let cells_iter = rhs_out
         .par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
@@ -404,4 +429,68 @@ pub(crate) fn evaluate<T: Real>(
                 });
         }
     }
+    if c_adh != 0.0 {
+        rhs_out
+            .par_chunks_mut(plen)
+            .zip(phi.par_chunks(plen))
+            .enumerate()
+            .for_each(|(i, (out, cell))| {
+                add_adhesion_rhs(c_adh, cells, i, cell, lap_s1, out);
+            });
+    }
+}
+
+/// The lattice Laplacian of `s1` into `lap_s1` (index `x * ly + y`), and the adhesion's cross
+/// term `−c s1 ∇²s1` ([`adhesion_pressure`]) added to the pressure, once the scatter has
+/// completed the sums.
+fn add_adhesion_pressure(c: f64, sums: &mut LatticeSums<N_SUMS>, lap_s1: &mut [f64]) {
+    let lattice = sums.lattice();
+    let (lx, ly) = (lattice.lx, lattice.ly);
+    assert_eq!(
+        lap_s1.len(),
+        lx * ly,
+        "the Laplacian buffer holds the lattice"
+    );
+    lap_s1.par_chunks_mut(ly).enumerate().for_each(|(x, out)| {
+        let (xm, xp) = ((x + lx - 1) % lx, (x + 1) % lx);
+        let (c0, cm, cp) = (
+            sums.column(I_S1, x),
+            sums.column(I_S1, xm),
+            sums.column(I_S1, xp),
+        );
+        for y in 0..ly {
+            let (ym, yp) = (
+                if y == 0 { ly - 1 } else { y - 1 },
+                if y + 1 == ly { 0 } else { y + 1 },
+            );
+            out[y] = cm[y] + cp[y] + c0[ym] + c0[yp] - 4.0 * c0[y];
+        }
+    });
+    for x in 0..lx {
+        let (s1, p) = sums.column_pair_mut(I_S1, I_P, x);
+        for ((p, &s1), &lap) in p.iter_mut().zip(s1).zip(&lap_s1[x * ly..(x + 1) * ly]) {
+            *p += adhesion_pressure(c, s1, lap);
+        }
+    }
+}
+
+/// Adds the adhesion's part of `−δF/δφ_i`, `c (∇²s1 − ∇²φ_i)` ([`adhesion_derivative`]), to
+/// cell `i`'s right-hand side `out`, node by node (a sweep of its own, run only with
+/// adhesion).
+fn add_adhesion_rhs<T: Real>(
+    c: f64,
+    cells: &Cells<T>,
+    i: usize,
+    cell: &[T],
+    lap_s1: &[f64],
+    out: &mut [T],
+) {
+    let shape = cells.shape();
+    let ly = cells.lattice().ly;
+    let (xs, ys) = (cells.map().cell_x(shape, i), cells.map().cell_y(shape, i));
+    phasefield::for_each_stencil_at(cell, shape, |k, a, b, s| {
+        let node = xs[a] as usize * ly + ys[b] as usize;
+        let r = out[k].to_f64() - adhesion_derivative(c, lap_s1[node], s.laplacian());
+        out[k] = T::from_f64(r);
+    });
 }

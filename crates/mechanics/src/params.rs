@@ -31,6 +31,10 @@ pub struct ModelParams {
     pub zeta: f64,
     /// Pressure definition.
     pub pressure: PressureKind,
+    /// Cell–cell adhesion ω (docs/model.md §11.2; default 0, none): the energy
+    /// `ωλ Σ_{i≠j} ∫∇φ_i·∇φ_j`, which lowers the energy of a shared interface.
+    #[serde(default)]
+    pub omega: f64,
 }
 
 impl Default for ModelParams {
@@ -44,6 +48,12 @@ impl ModelParams {
     /// These parameters with the free energy `energy`.
     pub fn with_energy(mut self, energy: EnergyParams) -> Self {
         self.energy = energy;
+        self
+    }
+
+    /// These parameters with cell–cell adhesion `omega`.
+    pub fn with_adhesion(mut self, omega: f64) -> Self {
+        self.omega = omega;
         self
     }
 
@@ -72,6 +82,7 @@ impl ModelParams {
             xi: 2.0,
             zeta,
             pressure: PressureKind::Paper,
+            omega: 0.0,
         }
     }
 

@@ -156,6 +156,29 @@ impl<const K: usize> LatticeSums<K> {
         &self.data[start..start + self.lattice.ly]
     }
 
+    /// Lattice column `x` of field `read`, and of field `write` to change (`read < write`).
+    ///
+    /// # Panics
+    /// If `read >= write`, `write >= K` or `x >= lx`.
+    pub(crate) fn column_pair_mut(
+        &mut self,
+        read: usize,
+        write: usize,
+        x: usize,
+    ) -> (&[f64], &mut [f64]) {
+        assert!(read < write && write < K && x < self.lattice.lx);
+        let (base, stride) = self.locate(x);
+        let ly = self.lattice.ly;
+        let (a, b) = self.data.split_at_mut(base + write * stride);
+        let r = base + read * stride;
+        (&a[r..r + ly], &mut b[..ly])
+    }
+
+    /// The lattice.
+    pub(crate) fn lattice(&self) -> Lattice {
+        self.lattice
+    }
+
     /// Lattice column `x` of every field.
     #[inline(always)]
     pub fn columns(&self, x: usize) -> [&[f64]; K] {

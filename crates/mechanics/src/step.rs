@@ -126,9 +126,12 @@ impl<T: Real> Tissue<T> {
         let dt = step_params.dt;
         // The predictor and the last corrector pass are fused into the evaluations before
         // them (`Post`): two sweeps over every field and two parallel loops fewer per step.
+        // Adhesion adds to the right-hand side in a sweep of its own, after the force pass, so
+        // its steps are the separate sweeps (tested to be the fused step to the bit).
+        let fused = self.fuses();
         self.start_step(ws, dt, Some(dt), check)?;
         for pass in 0..step_params.npc {
-            if pass + 1 < step_params.npc {
+            if pass + 1 < step_params.npc || !fused {
                 self.correct::<false>(ws, dt);
             } else {
                 self.correct_last(ws, dt);
@@ -136,7 +139,7 @@ impl<T: Real> Tissue<T> {
         }
         self.iteration += 1;
         self.time += dt;
-        if step_params.npc > 0 {
+        if step_params.npc > 0 && fused {
             // The last corrector pass measured the new centres (`Post::Correct`).
             self.move_patches_to(&ws.next_centre);
         } else {
@@ -168,14 +171,16 @@ impl<T: Real> Tissue<T> {
             sums,
             cell_state,
             cell_force,
+            lap_s1,
             ..
         } = ws;
+        let fused = self.fuses();
         let post = match predict {
-            Some(h) => Post::Predict { h, out: phi_old },
-            None => Post::Nothing,
+            Some(h) if fused => Post::Predict { h, out: phi_old },
+            _ => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
-        self.evaluate_fields(shapes, k1, sums, cell_state, cell_force, post);
+        self.evaluate_fields(shapes, k1, sums, cell_state, cell_force, lap_s1, post);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -184,14 +189,22 @@ impl<T: Real> Tissue<T> {
         check.check(at, cell_state)?;
         self.cells.swap_phi(phi_old);
         if !self.terms.is_empty() {
-            self.with_terms_view(cell_state, |terms, view| {
-                terms.begin(view, view.iteration);
-                if let Some(h) = predict {
-                    terms.predict(h);
-                }
-            });
+            self.with_terms_view(cell_state, |terms, view| terms.begin(view, view.iteration));
+        }
+        if let Some(h) = predict {
+            if fused {
+                self.terms.predict(h);
+            } else {
+                self.predict(ws, h);
+            }
         }
         Ok(())
+    }
+
+    /// Whether the Heun update is fused into the force pass: not with adhesion, which adds to
+    /// the right-hand side after it.
+    fn fuses(&self) -> bool {
+        self.params.omega == 0.0
     }
 
     /// Calls `f` with the terms and what they see of every slot.
@@ -226,6 +239,7 @@ impl<T: Real> Tissue<T> {
             com,
             next_centre,
             cell_force,
+            lap_s1,
             ..
         } = ws;
         self.evaluate_fields(
@@ -234,6 +248,7 @@ impl<T: Real> Tissue<T> {
             sums,
             cell_state,
             cell_force,
+            lap_s1,
             Post::Correct {
                 h,
                 k1,
@@ -270,6 +285,7 @@ impl<T: Real> Tissue<T> {
             sums,
             cell_state,
             cell_force,
+            lap_s1,
             ..
         } = ws;
         self.evaluate_fields(
@@ -278,6 +294,7 @@ impl<T: Real> Tissue<T> {
             sums,
             cell_state,
             cell_force,
+            lap_s1,
             Post::Nothing,
         );
         if !self.terms.is_empty() {
@@ -319,8 +336,19 @@ impl<T: Real> Tissue<T> {
         sums: &mut LatticeSums<N_SUMS>,
         cell_state: &mut [CellState],
         cell_force: &mut [[f64; 2]],
+        lap_s1: &mut Vec<f64>,
         post: Post<'_, T>,
     ) {
+        // The lattice buffer of adhesion, made on its first use (the one allocation of a run
+        // with adhesion).
+        let n = if self.params.omega != 0.0 {
+            self.lattice().len()
+        } else {
+            0
+        };
+        if lap_s1.len() != n {
+            lap_s1.resize(n, 0.0);
+        }
         // The terms' whole-cell forces of the current state, from the per-cell quantities the
         // last evaluation left (see `CellContext::state`).
         let cell_force = if self.terms.is_empty() {
@@ -345,6 +373,7 @@ impl<T: Real> Tissue<T> {
             sums,
             cell_state,
             cell_force,
+            lap_s1,
             post,
         );
     }
@@ -363,10 +392,19 @@ impl<T: Real> Tissue<T> {
             observed_centre,
             com,
             cell_force,
+            lap_s1,
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
-        self.evaluate_fields(true, k2, sums, cell_state, cell_force, Post::Nothing);
+        self.evaluate_fields(
+            true,
+            k2,
+            sums,
+            cell_state,
+            cell_force,
+            lap_s1,
+            Post::Nothing,
+        );
     }
 }
 

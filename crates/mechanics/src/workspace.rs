@@ -92,6 +92,8 @@ pub struct Workspace<T: Real = f64> {
     pub(crate) com: ComTable,
     /// The whole-cell forces of the terms for the next evaluation, by slot.
     pub(crate) cell_force: Vec<[f64; 2]>,
+    /// The lattice Laplacian of `s1`, with adhesion only (empty otherwise).
+    pub(crate) lap_s1: Vec<f64>,
 }
 
 impl<T: Real> Workspace<T> {
@@ -108,6 +110,7 @@ impl<T: Real> Workspace<T> {
                 + self.next_centre.capacity()
                 + self.cell_force.capacity())
                 * std::mem::size_of::<[f64; 2]>()
+            + self.lap_s1.capacity() * std::mem::size_of::<f64>()
             + self.com.heap_bytes()
             + crate::kernels::scratch_bytes()
     }
@@ -128,6 +131,7 @@ impl<T: Real> Workspace<T> {
             next_centre: vec![[0.0; 2]; cells.n_cells()],
             com: ComTable::new(lattice),
             cell_force: vec![[0.0; 2]; cells.n_cells()],
+            lap_s1: Vec::new(),
         }
     }
 

@@ -230,6 +230,15 @@ pub struct PolaritySpec {
     pub angle: Option<f64>,
 }
 
+/// `[adhesion]`: cell–cell adhesion (docs/model.md §11.2); absent: none.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AdhesionSpec {
+    /// The adhesion strength ω (the reference code's cluster example: 0.01): the energy
+    /// `ωλ Σ_{i≠j} ∫∇φ_i·∇φ_j` of shared interfaces.
+    pub omega: f64,
+}
+
 /// `[polarity] align`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -301,6 +310,9 @@ pub struct SceneFile {
     /// `[polarity]`, when the cells are self-propelled.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarity: Option<PolaritySpec>,
+    /// `[adhesion]`, when the cells adhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub adhesion: Option<AdhesionSpec>,
 }
 
 impl SceneFile {
@@ -342,6 +354,7 @@ impl SceneFile {
             .with_energy(energy)
             .with_xi(m.xi)
             .with_pressure(m.pressure)
+            .with_adhesion(self.adhesion.as_ref().map_or(0.0, |a| a.omega))
     }
 
     /// The physics terms beyond the minimal model, with the run's seed for their noise.

@@ -284,6 +284,17 @@ impl SceneFile {
                 "use a value between -0.01 and 0.01",
             ));
         }
+        if let Some(a) = &self.adhesion {
+            if !(a.omega.is_finite() && a.omega >= 0.0) {
+                return Err(invalid(
+                    "adhesion",
+                    "omega",
+                    a.omega,
+                    "the adhesion strength must be zero or positive",
+                    "use a value of order 0.01 (the reference code's cluster example), or remove [adhesion]",
+                ));
+            }
+        }
         if let Some(p) = &self.polarity {
             if !p.alpha.is_finite() {
                 return Err(invalid(

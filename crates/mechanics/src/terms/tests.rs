@@ -267,3 +267,150 @@ fn terms_are_independent_of_threads_and_slots() {
         assert!((a - b).abs() < 1e-9, "{a} {b}");
     }
 }
+
+/// The discrete adhesion energy `F_adh = ωλ Σ_{i≠j} Σ_x ∇⁺φ_i·∇⁺φ_j` (forward differences, on
+/// the periodic lattice) of full-domain fields `phi` (cell after cell).
+fn adhesion_energy(omega: f64, lambda: f64, phi: &[f64], lx: usize, ly: usize) -> f64 {
+    let n = phi.len() / (lx * ly);
+    let grad = |i: usize, x: usize, y: usize| {
+        let f = |x: usize, y: usize| phi[i * lx * ly + x * ly + y];
+        [f((x + 1) % lx, y) - f(x, y), f(x, (y + 1) % ly) - f(x, y)]
+    };
+    let mut e = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            if i == j {
+                continue;
+            }
+            for x in 0..lx {
+                for y in 0..ly {
+                    let (a, b) = (grad(i, x, y), grad(j, x, y));
+                    e += a[0] * b[0] + a[1] * b[1];
+                }
+            }
+        }
+    }
+    omega * lambda * e
+}
+
+/// T2.1 of the extensions: the adhesion's part of `δF/δφ_i` in the step is the derivative of
+/// the discrete energy [`adhesion_energy`] (whose adjoint gradient is the five-point
+/// Laplacian), by central finite differences on three random 20 × 20 fields stored on the
+/// full domain. The energy is quadratic, so the difference quotient is exact but for
+/// round-off: agreement to 1e-10 of the largest derivative. The step's part is read as the
+/// change of the right-hand side when ω is switched on, at a friction so large (1e200) that
+/// advection is nil. The pressure gains `Σ_i φ_i δF_adh/δφ_i`, to round-off.
+#[test]
+fn adhesion_is_the_derivative_of_its_discrete_energy() {
+    let (lx, ly) = (20, 20);
+    let lattice = Lattice::new(lx, ly);
+    let shape = PatchShape::new(lattice, 0).unwrap();
+    let mut cells =
+        phasefield::Cells::zeros(lattice, shape, &[[5.0, 5.0], [12.0, 9.0], [8.0, 15.0]]);
+    let mut state = 12345u64;
+    for v in cells.phi_mut() {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        *v = (state >> 11) as f64 / (1u64 << 53) as f64;
+    }
+    let (omega, lambda) = (0.01, 2.5);
+    let evaluate = |omega: f64| {
+        let params = ModelParams::paper(0.0).with_xi(1e200).with_adhesion(omega);
+        let t = Tissue::new(cells.clone(), params);
+        let mut ws = Workspace::new(t.cells());
+        t.refresh(&mut ws);
+        (ws.k2.clone(), ws.sum_field(crate::SumField::P))
+    };
+    let ((r0, p0), (r1, p1)) = (evaluate(0.0), evaluate(omega));
+    let phi = cells.phi().to_vec();
+    let n = 3;
+    let mut worst: f64 = 0.0;
+    let mut largest: f64 = 0.0;
+    for i in 0..n {
+        for node in [0, 37, 150, 211, 399] {
+            let k = i * lx * ly + node;
+            let h = 1e-3;
+            let (mut up, mut down) = (phi.clone(), phi.clone());
+            up[k] += h;
+            down[k] -= h;
+            let fd = (adhesion_energy(omega, lambda, &up, lx, ly)
+                - adhesion_energy(omega, lambda, &down, lx, ly))
+                / (2.0 * h);
+            let step = -(r1[k] - r0[k]);
+            worst = worst.max((fd - step).abs());
+            largest = largest.max(fd.abs());
+        }
+    }
+    assert!(largest > 1e-3, "the test fields have adhesion: {largest}");
+    assert!(worst < 1e-10 * largest, "{worst:e} off, of {largest:e}");
+    // P gains Σ_i φ_i δF_adh/δφ_i.
+    for node in 0..lx * ly {
+        let expected: f64 = (0..n)
+            .map(|i| phi[i * lx * ly + node] * -(r1[i * lx * ly + node] - r0[i * lx * ly + node]))
+            .sum();
+        let got = p1[node] - p0[node];
+        assert!(
+            (got - expected).abs() < 1e-12,
+            "P at {node}: {got} against {expected}"
+        );
+    }
+}
+
+/// T2.2 of the extensions: a doublet (R = 8, centres 15 apart, γ = 0.02, μ = 5, λ = 3,
+/// κ = 0.1, ξ = 1, no activity) relaxed for 400 TU: its contact, the overlap `Σ φ₁φ₂` and
+/// the length of the contact line (the extent across the line of the nodes where both
+/// fields exceed 0.25), grows with ω ∈ {0, 0.005, 0.01, 0.02}; an isolated cell with
+/// adhesion feels no force.
+#[test]
+fn a_doublet_adheres_more_with_omega() {
+    let measure = |omega: f64| {
+        let lattice = Lattice::new(64, 48);
+        let shape = PatchShape::new(lattice, 16).unwrap();
+        let cells = init::discs(lattice, shape, &[[24.5, 24.0], [39.5, 24.0]], 8.0, 3.0);
+        let mut energy = phasefield::EnergyParams::paper();
+        (energy.gamma, energy.mu, energy.lambda, energy.kappa) = (0.02, 5.0, 3.0, 0.1);
+        let params = ModelParams::paper(0.0)
+            .with_energy(energy)
+            .with_xi(1.0)
+            .with_adhesion(omega);
+        let mut t = Tissue::new(cells, params);
+        let mut ws = Workspace::new(t.cells());
+        for _ in 0..2000 {
+            t.step(&mut ws, &StepParams::new(0.2, 1)).expect("stable");
+        }
+        let c = t.cells();
+        let (mut overlap, mut rows) = (0.0, std::collections::BTreeSet::new());
+        for x in 0..64 {
+            for y in 0..48 {
+                let (a, b) = (c.value_at(0, x, y), c.value_at(1, x, y));
+                overlap += a * b;
+                if a > 0.25 && b > 0.25 {
+                    rows.insert(y);
+                }
+            }
+        }
+        (overlap, rows.len())
+    };
+    let results: Vec<(f64, usize)> = [0.0, 0.005, 0.01, 0.02]
+        .iter()
+        .map(|&w| measure(w))
+        .collect();
+    eprintln!("doublet (overlap, contact length) against omega: {results:?}");
+    for w in results.windows(2) {
+        assert!(w[1].0 > w[0].0, "the overlap does not grow: {results:?}");
+        assert!(w[1].1 >= w[0].1, "the contact shrinks: {results:?}");
+    }
+    assert!(
+        results[3].1 > results[0].1,
+        "no longer contact: {results:?}"
+    );
+    // A cell alone: no adhesion force.
+    let lattice = Lattice::new(48, 48);
+    let shape = PatchShape::new(lattice, 14).unwrap();
+    let cells = init::discs(lattice, shape, &[[24.0, 24.0]], 8.0, 2.5);
+    let t = Tissue::new(cells, ModelParams::paper(0.0).with_adhesion(0.02));
+    let mut ws = Workspace::new(t.cells());
+    t.refresh(&mut ws);
+    assert!(ws.cell(0).force.norm() < 1e-12, "{:?}", ws.cell(0).force);
+}
