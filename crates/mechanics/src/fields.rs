@@ -61,7 +61,10 @@ impl<T: Real> Tissue<T> {
     pub fn fields(&self, ws: &mut Workspace<T>) -> TissueFields {
         self.refresh(ws);
         self.scatter_velocity(ws);
-        let zeta = self.params.zeta;
+        // With populations of their own ζ the sums hold `Σ ζ_j φ_j S_j`, the active stress's
+        // tensor, and `Q` is scattered again unweighted.
+        let mixed = self.populations.mixed_zeta(&self.params, self.active);
+        let zeta = if mixed { 1.0 } else { self.params.zeta };
         let [vx, vy] = ws.velocity_field();
         let mut f = TissueFields {
             vx,
@@ -75,6 +78,26 @@ impl<T: Real> Tissue<T> {
         f.sigma_xx = (0..n).map(|k| -f.pressure[k] - zeta * f.qxx[k]).collect();
         f.sigma_yy = (0..n).map(|k| -f.pressure[k] + zeta * f.qxx[k]).collect();
         f.sigma_xy = (0..n).map(|k| -zeta * f.qxy[k]).collect();
+        if mixed {
+            let Workspace {
+                cell_state,
+                velocity_field,
+                ..
+            } = ws;
+            let cs: &[_] = cell_state;
+            scatter::<2, T, _, _>(
+                &self.cells,
+                self.cells.phi(),
+                velocity_field,
+                |i, run, sums| {
+                    let [sxx, sxy] = cs[i].shape.components();
+                    run.add_to([], |s, []| [s.c * sxx, s.c * sxy], sums);
+                },
+                |_| {},
+            );
+            f.qxx = velocity_field.field(0);
+            f.qxy = velocity_field.field(1);
+        }
         f
     }
 }

@@ -30,6 +30,7 @@ use crate::equations::{
 use crate::geometry::TracelessTensor;
 use crate::params::{ModelParams, PressureKind};
 use crate::scatter::{scatter, LatticeSums};
+use crate::terms::{CellConstants, Populations};
 use crate::workspace::{CellState, SumField, N_SUMS};
 
 // Where each lattice sum is stored.
@@ -197,12 +198,18 @@ pub(crate) fn evaluate<T: Real>(
     cell_state: &mut [CellState],
     cell_force: Option<&[[f64; 2]]>,
     lap_s1: &mut [f64],
+    cells_of: (&Populations, &[usize], bool),
     post: Post<'_, T>,
 ) {
+    let (pops, ids, active) = cells_of;
     let shape = cells.shape();
     let plen = shape.len();
     let energy = params.energy;
-    let zeta = params.zeta;
+    // With populations of their own ζ the scatter weights each S_i by ζ_i and the force takes
+    // the weighted sum as it is; otherwise the sum is Q and the force multiplies it by ζ.
+    let mixed = pops.mixed_zeta(params, active);
+    let zeta = if mixed { 1.0 } else { params.zeta };
+    let constants = |i: usize| pops.constants(ids[i], params, active, mixed);
 
     // 1. Per cell: area, deformation tensor, range.
     cell_state
@@ -229,8 +236,10 @@ pub(crate) fn evaluate<T: Real>(
             |i, run, [s1, s2, u, qxx, qxy, _]| {
                 let sums = [s1, s2, u, qxx, qxy];
                 let c = &cs[i];
+                let k = constants(i);
+                let coef = k.coef;
                 let area_factor = coef.area_factor(c.area);
-                let sh = c.shape.components();
+                let sh = c.shape.components().map(|v| k.zeta_weight * v);
                 let node = move |p: f64, u: f64| {
                     let [q_xx, q_xy] = nematic_density(p, sh);
                     [p, p * p, u, q_xx, q_xy]
@@ -295,10 +304,10 @@ pub(crate) fn evaluate<T: Real>(
     // 3. Forces, velocities and the right-hand side.
     let g: &LatticeSums<N_SUMS> = global;
     let map = cells.map();
-    let xi = params.xi;
-    let c_self = pressure_self_coefficient(kind, &coef);
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
+        let CellConstants { coef, xi, .. } = constants(i);
+        let c_self = pressure_self_coefficient(kind, &coef);
         PADDED.with_borrow_mut(|padded| {
             padded.fill(cell, shape);
             padded.gather(xs, g.cell_runs(i), |x| {

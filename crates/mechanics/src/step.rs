@@ -218,6 +218,7 @@ impl<T: Real> Tissue<T> {
             ids: &self.cell_id,
             centres: &self.centre,
             active: self.active,
+            populations: &self.populations,
             iteration: self.iteration,
         };
         f(&mut self.terms, &view);
@@ -325,7 +326,7 @@ impl<T: Real> Tissue<T> {
     /// Whether a step computes the deformation tensors and `Q`: only the active force uses
     /// them (see [`evaluate`]).
     fn step_needs_shapes(&self) -> bool {
-        self.params.zeta != 0.0
+        self.populations.any_activity(&self.params, self.active)
     }
 
     /// [`evaluate`] of the current fields, into `out` and the workspace parts given.
@@ -359,6 +360,7 @@ impl<T: Real> Tissue<T> {
                 ids: &self.cell_id,
                 centres: &self.centre,
                 active: self.active,
+                populations: &self.populations,
                 iteration: self.iteration,
             };
             self.terms.forces(&view, cell_force);
@@ -374,6 +376,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            (&self.populations, &self.cell_id, self.active),
             post,
         );
     }

@@ -5,7 +5,7 @@ use phasefield::{Cells, ComTable, Lattice, Real};
 use rayon::prelude::*;
 
 use crate::params::ModelParams;
-use crate::terms::Terms;
+use crate::terms::{Populations, Terms};
 
 /// Side, in nodes, of the blocks of the Morton order used by [`Tissue::sort_cells`]: about
 /// a cell radius, so that a block holds a cell or two.
@@ -34,6 +34,8 @@ pub struct Tissue<T: Real = f64> {
     pub(crate) terms: Terms,
     /// Whether activity is on (the relaxation switch; see [`Tissue::set_active`]).
     pub(crate) active: bool,
+    /// Per-cell parameters (empty: every cell has `params`').
+    pub(crate) populations: Populations,
 }
 
 impl<T: Real> Tissue<T> {
@@ -87,6 +89,7 @@ impl<T: Real> Tissue<T> {
             iteration,
             terms: Terms::default(),
             active: true,
+            populations: Populations::default(),
         };
         let com = ComTable::new(t.cells.lattice());
         let mut centre = std::mem::take(&mut t.centre);
@@ -135,6 +138,7 @@ impl<T: Real> Tissue<T> {
             cell_id,
             terms: Terms::default(),
             active: true,
+            populations: Populations::default(),
         })
     }
 
@@ -144,6 +148,26 @@ impl<T: Real> Tissue<T> {
         terms.initialise(self.n_cells());
         self.terms = terms;
         self
+    }
+
+    /// This tissue with cells in populations of their own parameters (`crate::terms`).
+    ///
+    /// # Panics
+    /// If the populations do not assign every cell.
+    pub fn with_populations(mut self, populations: Populations) -> Self {
+        assert!(
+            populations.is_empty() || populations.of_cell().len() == self.n_cells(),
+            "{} cells assigned to populations, {} in the tissue",
+            populations.of_cell().len(),
+            self.n_cells()
+        );
+        self.populations = populations;
+        self
+    }
+
+    /// The populations (empty when every cell has the tissue's parameters).
+    pub fn populations(&self) -> &Populations {
+        &self.populations
     }
 
     /// The physics terms and their per-cell state.

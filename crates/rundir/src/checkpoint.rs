@@ -273,7 +273,8 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
     let ids: Vec<usize> = a[10].data.iter().map(|&v| v as usize).collect();
     let tissue = Tissue::restore(cells, scene.model_params(zeta), time, step, centre, ids)
         .map_err(|r| bad("cell_id", r))?
-        .with_terms(scene.terms());
+        .with_terms(scene.terms())
+        .with_populations(scene.populations());
     read_terms(path, tissue, true)
 }
 
@@ -293,13 +294,13 @@ pub(crate) fn term_arrays<T: Real>(tissue: &Tissue<T>) -> Vec<(String, Vec<f64>)
         .collect()
 }
 
-/// Sets the state of `tissue`'s terms from the arrays of `path` (a checkpoint or a frame,
+/// `tissue` with the state of its terms from the arrays of `path` (a checkpoint or a frame,
 /// cells in identity order). A missing array is an error when `required`, and otherwise
 /// leaves the state as the terms initialised it (a frame of a run without the term).
 ///
 /// # Errors
 /// A damaged or missing array, naming the file and the array.
-pub(crate) fn read_terms<T: Real>(
+pub fn read_terms<T: Real>(
     path: &Path,
     mut tissue: Tissue<T>,
     required: bool,

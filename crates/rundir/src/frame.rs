@@ -148,6 +148,13 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
     for (name, values) in terms {
         extra.push((name, npy(&[n64], values)));
     }
+    let pops = tissue.populations();
+    if !pops.is_empty() {
+        extra.push((
+            "population".to_string(),
+            npy(&[n64], pops.of_cell().iter().map(|&k| i64::from(k))),
+        ));
+    }
     for (name, a) in extra {
         let a = a.map_err(|e| RunDirError::io("encode", &path, e))?;
         arrays.push((name, a));

@@ -2,7 +2,7 @@
 //! completely, with `deny_unknown_fields` on every table and `--set section.key=value`
 //! overrides (ripgrep's low-level arguments: close to the file, checked only for syntax).
 
-use mechanics::terms::{Align, Polarity, Propulsion, Terms};
+use mechanics::terms::{Align, Polarity, Population, Populations, Propulsion, Terms};
 use mechanics::{ModelParams, Precision, PressureKind, StepParams};
 use phasefield::PatchShape;
 use serde::{Deserialize, Serialize};
@@ -239,6 +239,57 @@ pub struct AdhesionSpec {
     pub omega: f64,
 }
 
+/// `[[population]]`: a population of cells with parameters of their own (docs/model.md
+/// §11.3); absent: every cell has `[model]`'s. The counts must add up to `[cells] count`;
+/// cells are dealt to populations by a shuffle drawn from `[run] seed`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PopulationSpec {
+    /// A name for outputs (default `"A"`, `"B"`, … by position).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Number of cells.
+    pub count: usize,
+    /// Interface stiffness γ (default `[model] gamma`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gamma: Option<f64>,
+    /// Area constraint μ (default `[model] mu`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mu: Option<f64>,
+    /// Target radius R (default `[cells] radius`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Friction ξ (default `[model] xi`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub xi: Option<f64>,
+    /// Activity ζ (default `[model] zeta`), switched on after the relaxation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zeta: Option<f64>,
+    /// Propulsion α (default `[polarity] alpha`; needs `[polarity]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha: Option<f64>,
+    /// Rotational diffusion D_r (default `[polarity] rotational_diffusion`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotational_diffusion: Option<f64>,
+    /// Alignment rate J (default `[polarity] align_rate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub align_rate: Option<f64>,
+}
+
+impl PopulationSpec {
+    /// The population's name: its own, or a letter by its position `k`.
+    pub fn name(&self, k: usize) -> String {
+        self.name.clone().unwrap_or_else(|| {
+            let letter = (b'A' + (k % 26) as u8) as char;
+            if k < 26 {
+                letter.to_string()
+            } else {
+                format!("{letter}{}", k / 26)
+            }
+        })
+    }
+}
+
 /// `[polarity] align`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -313,6 +364,9 @@ pub struct SceneFile {
     /// `[adhesion]`, when the cells adhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adhesion: Option<AdhesionSpec>,
+    /// `[[population]]`, when cells differ.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub population: Vec<PopulationSpec>,
 }
 
 impl SceneFile {
@@ -361,9 +415,45 @@ impl SceneFile {
     pub fn terms(&self) -> Terms {
         let mut terms = Terms::new(self.run.seed);
         if let Some(p) = &self.polarity {
-            terms = terms.with(p.term());
+            let mut term = p.term();
+            for (k, pop) in self.population.iter().enumerate() {
+                if pop.alpha.is_some()
+                    || pop.rotational_diffusion.is_some()
+                    || pop.align_rate.is_some()
+                {
+                    term = term.with_population(
+                        k,
+                        pop.alpha,
+                        pop.rotational_diffusion,
+                        pop.align_rate,
+                    );
+                }
+            }
+            terms = terms.with(term);
         }
         terms
+    }
+
+    /// The populations of `[[population]]` (empty without), cells dealt by `[run] seed`.
+    pub fn populations(&self) -> Populations {
+        if self.population.is_empty() {
+            return Populations::default();
+        }
+        let kinds = self
+            .population
+            .iter()
+            .map(|p| {
+                let mut k = Population::new();
+                k.gamma = p.gamma;
+                k.mu = p.mu;
+                k.radius = p.radius;
+                k.xi = p.xi;
+                k.zeta = p.zeta;
+                k
+            })
+            .collect();
+        let counts: Vec<usize> = self.population.iter().map(|p| p.count).collect();
+        Populations::new(kinds, &counts, self.run.seed)
     }
 
     /// The integrator parameters.

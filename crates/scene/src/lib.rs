@@ -297,8 +297,14 @@ impl Scene {
         );
         Ok(
             Tissue::new(cells.into_precision::<T>(), self.initial_params())
-                .with_terms(self.file.terms()),
+                .with_terms(self.file.terms())
+                .with_populations(self.file.populations()),
         )
+    }
+
+    /// The populations of `[[population]]` (empty without), cells dealt by `[run] seed`.
+    pub fn populations(&self) -> mechanics::terms::Populations {
+        self.file.populations()
     }
 
     /// The physics terms beyond the minimal model (`[polarity]`), with the run's seed.
@@ -322,7 +328,8 @@ impl Scene {
         let cells = state.resampled(self.patch_shape(), placed.centres());
         Ok(
             Tissue::new(cells.into_precision::<T>(), self.initial_params())
-                .with_terms(self.file.terms()),
+                .with_terms(self.file.terms())
+                .with_populations(self.file.populations()),
         )
     }
 

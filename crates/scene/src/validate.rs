@@ -284,6 +284,107 @@ impl SceneFile {
                 "use a value between -0.01 and 0.01",
             ));
         }
+        if !self.population.is_empty() {
+            let total: usize = self.population.iter().map(|p| p.count).sum();
+            if total != self.cells.count {
+                return Err(invalid(
+                    "population",
+                    "count",
+                    total,
+                    format!(
+                        "the populations' counts add up to {total}, but [cells] count = {}",
+                        self.cells.count
+                    ),
+                    format!(
+                        "make the counts add up to {}, or set [cells] count = {total}",
+                        self.cells.count
+                    ),
+                ));
+            }
+            for (k, p) in self.population.iter().enumerate() {
+                let which = format!("population {k} ({})", p.name(k));
+                let checks: [(&'static str, Option<f64>, bool, &str); 8] = [
+                    (
+                        "gamma",
+                        p.gamma,
+                        p.gamma.is_none_or(|v| v.is_finite() && v >= 0.0),
+                        "zero or positive (paper: 0.01)",
+                    ),
+                    (
+                        "mu",
+                        p.mu,
+                        p.mu.is_none_or(|v| v.is_finite() && v >= 0.0),
+                        "zero or positive (paper: 3)",
+                    ),
+                    (
+                        "radius",
+                        p.radius,
+                        p.radius.is_none_or(|v| v.is_finite() && v >= 1.0),
+                        "at least one node (paper: 8)",
+                    ),
+                    (
+                        "xi",
+                        p.xi,
+                        p.xi.is_none_or(|v| v.is_finite() && v > 0.0),
+                        "positive (paper: 2)",
+                    ),
+                    (
+                        "zeta",
+                        p.zeta,
+                        p.zeta.is_none_or(f64::is_finite),
+                        "a finite number, e.g. between -0.01 and 0.01",
+                    ),
+                    (
+                        "alpha",
+                        p.alpha,
+                        p.alpha.is_none_or(f64::is_finite),
+                        "a finite number, e.g. 0.04",
+                    ),
+                    (
+                        "rotational_diffusion",
+                        p.rotational_diffusion,
+                        p.rotational_diffusion
+                            .is_none_or(|v| v.is_finite() && v >= 0.0),
+                        "zero or positive",
+                    ),
+                    (
+                        "align_rate",
+                        p.align_rate,
+                        p.align_rate.is_none_or(|v| v.is_finite() && v >= 0.0),
+                        "zero or positive",
+                    ),
+                ];
+                for (key, value, ok, want) in checks {
+                    if !ok {
+                        return Err(invalid(
+                            "population",
+                            key,
+                            value.unwrap_or(f64::NAN),
+                            format!("in {which}, {key} must be {want}"),
+                            format!(
+                                "give {key} = a value {want}, or remove it to take the scene's"
+                            ),
+                        ));
+                    }
+                }
+                if self.polarity.is_none() {
+                    let polar = [
+                        ("alpha", p.alpha),
+                        ("rotational_diffusion", p.rotational_diffusion),
+                        ("align_rate", p.align_rate),
+                    ];
+                    if let Some((key, Some(v))) = polar.into_iter().find(|(_, v)| v.is_some()) {
+                        return Err(invalid(
+                            "population",
+                            key,
+                            v,
+                            format!("{which} sets a polarity parameter, but the scene has no [polarity]"),
+                            "add a [polarity] table (alpha = 0 for cells that do not propel themselves), or remove the key",
+                        ));
+                    }
+                }
+            }
+        }
         if let Some(a) = &self.adhesion {
             if !(a.omega.is_finite() && a.omega >= 0.0) {
                 return Err(invalid(
@@ -572,6 +673,19 @@ impl SceneFile {
 
     /// The stability estimate of the active phase.
     pub(crate) fn stability_estimate(&self) -> f64 {
-        self.model_params(self.model.zeta).max_stable_dt()
+        let base = self.model_params(self.model.zeta);
+        // The smallest over the populations, each with its own constants.
+        self.population
+            .iter()
+            .map(|p| {
+                let mut m = base;
+                m.energy.gamma = p.gamma.unwrap_or(m.energy.gamma);
+                m.energy.mu = p.mu.unwrap_or(m.energy.mu);
+                m.energy.radius = p.radius.unwrap_or(m.energy.radius);
+                m.xi = p.xi.unwrap_or(m.xi);
+                m.zeta = p.zeta.unwrap_or(m.zeta);
+                m.max_stable_dt()
+            })
+            .fold(base.max_stable_dt(), f64::min)
     }
 }

@@ -404,13 +404,19 @@ pub(crate) fn load_frame(
         origins.push([o[0] as usize, o[1] as usize]);
     }
     let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &phi.data);
-    let tissue = Tissue::from_state(
+    let mut tissue = Tissue::from_state(
         cells,
         scene.model_params(zeta),
         time,
         step,
         (0..n).collect(),
-    );
+    )
+    .with_populations(scene.populations())
+    .with_terms(scene.terms());
+    // The terms act as they did in the run: from the end of the relaxation, with the state
+    // the frame holds.
+    tissue.set_active(time >= scene.file().run.relax_time * (1.0 - 1e-12));
+    let tissue = rundir::read_terms(path, tissue, false).map_err(|e| input(path, e.to_string()))?;
     // The per-cell arrays must describe the cells of `phi`, in its order: each stored centre
     // must be the centre of mass of its field (to a tenth of a node: f32 storage rounds it by
     // about 1e-5), or pictures and ParaView files would put one cell's values on another.

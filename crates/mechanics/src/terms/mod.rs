@@ -26,6 +26,7 @@
 
 mod noise;
 mod polarity;
+mod populations;
 
 use std::fmt;
 use std::sync::Arc;
@@ -34,6 +35,8 @@ use nalgebra::Vector2;
 
 pub use noise::NoiseKey;
 pub use polarity::{Align, Polarity, Propulsion};
+pub(crate) use populations::CellConstants;
+pub use populations::{Population, Populations};
 
 use crate::workspace::CellState;
 
@@ -50,6 +53,8 @@ pub struct CellContext<'a> {
     /// evaluation's (at the start of a run, zero): a whole-cell force should depend on the
     /// term's own state.
     pub state: &'a CellState,
+    /// The cell's population (0 without populations).
+    pub population: usize,
     /// Whether activity is on (off during the relaxation of docs/model.md §6; see
     /// [`crate::Simulation::activity_from`]). Active terms (propulsion, its noise and
     /// alignment) do nothing while it is off.
@@ -382,6 +387,7 @@ pub(crate) struct CellsView<'a> {
     pub(crate) ids: &'a [usize],
     pub(crate) centres: &'a [[f64; 2]],
     pub(crate) active: bool,
+    pub(crate) populations: &'a Populations,
     /// The iteration of the state the step starts from.
     pub(crate) iteration: u64,
 }
@@ -392,6 +398,7 @@ impl CellsView<'_> {
             id: self.ids[slot],
             centre: self.centres[slot],
             state: &self.cells[slot],
+            population: self.populations.population(self.ids[slot]),
             active: self.active,
         }
     }

@@ -43,7 +43,7 @@ pub enum Propulsion {
 }
 
 /// Self-propulsion along a polarity with rotational diffusion and alignment.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct Polarity {
     /// The propulsion force `α` (per cell, or per unit area with [`Propulsion::Density`]).
@@ -58,6 +58,8 @@ pub struct Polarity {
     pub align_rate: f64,
     /// Every cell's initial angle; `None`: uniform on the circle, drawn from the seed.
     pub initial_angle: Option<f64>,
+    /// Per population (`crate::terms::Populations`), its own `[α, D_r, J]` where given.
+    pub by_population: Vec<[Option<f64>; 3]>,
 }
 
 impl Polarity {
@@ -70,7 +72,34 @@ impl Polarity {
             align: Align::None,
             align_rate: 0.0,
             initial_angle: None,
+            by_population: Vec::new(),
         }
+    }
+
+    /// With population `k`'s own propulsion, rotational diffusion and alignment rate, where
+    /// given.
+    pub fn with_population(
+        mut self,
+        k: usize,
+        alpha: Option<f64>,
+        rotational_diffusion: Option<f64>,
+        align_rate: Option<f64>,
+    ) -> Self {
+        if self.by_population.len() <= k {
+            self.by_population.resize(k + 1, [None; 3]);
+        }
+        self.by_population[k] = [alpha, rotational_diffusion, align_rate];
+        self
+    }
+
+    /// `[α, D_r, J]` of a cell of population `k`.
+    pub fn values(&self, k: usize) -> [f64; 3] {
+        let own = self.by_population.get(k).copied().unwrap_or([None; 3]);
+        [
+            own[0].unwrap_or(self.alpha),
+            own[1].unwrap_or(self.rotational_diffusion),
+            own[2].unwrap_or(self.align_rate),
+        ]
     }
 
     /// With rotational diffusion `d_r`.
@@ -139,9 +168,10 @@ impl CellTerm for Polarity {
         if !cell.active {
             return [0.0; 2];
         }
+        let [alpha, ..] = self.values(cell.population);
         let magnitude = match self.propulsion {
-            Propulsion::Cell => self.alpha,
-            Propulsion::Density => self.alpha * cell.state.area,
+            Propulsion::Cell => alpha,
+            Propulsion::Density => alpha * cell.state.area,
         };
         let p = direction(x[0]);
         [magnitude * p.x, magnitude * p.y]
@@ -149,20 +179,21 @@ impl CellTerm for Polarity {
 
     fn rate(&self, cell: &CellContext<'_>, x: &[f64], out: &mut [f64]) {
         out[0] = 0.0;
-        if !cell.active || self.align == Align::None || self.align_rate == 0.0 {
+        let [.., rate] = self.values(cell.population);
+        if !cell.active || self.align == Align::None || rate == 0.0 {
             return;
         }
         let p = direction(x[0]);
         let f = self.target(cell, p);
         let norm = f.norm();
         if norm > 0.0 {
-            out[0] = -self.align_rate * norm * signed_angle(f, p);
+            out[0] = -rate * norm * signed_angle(f, p);
         }
     }
 
     fn noise(&self, cell: &CellContext<'_>, out: &mut [f64]) {
         out[0] = if cell.active {
-            (2.0 * self.rotational_diffusion).sqrt()
+            (2.0 * self.values(cell.population)[1]).sqrt()
         } else {
             0.0
         };

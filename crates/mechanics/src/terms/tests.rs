@@ -414,3 +414,53 @@ fn a_doublet_adheres_more_with_omega() {
     t.refresh(&mut ws);
     assert!(ws.cell(0).force.norm() < 1e-12, "{:?}", ws.cell(0).force);
 }
+
+/// T6.1 of the extensions: populations whose parameters are the tissue's (one overriding
+/// every parameter with the tissue's own value, one overriding nothing) step exactly as the
+/// tissue without populations, to the bit, at ζ ≠ 0.
+#[test]
+fn uniform_populations_are_the_scalar_model_to_the_bit() {
+    let run = |pops: Option<Populations>| {
+        let lattice = Lattice::new(48, 48);
+        let shape = PatchShape::new(lattice, 10).unwrap();
+        let centres = [[12.0, 12.0], [25.0, 14.0], [18.0, 30.0], [34.0, 34.0]];
+        let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
+        let mut t = Tissue::new(cells, ModelParams::paper(0.01));
+        if let Some(p) = pops {
+            t = t.with_populations(p);
+        }
+        let mut ws = Workspace::new(t.cells());
+        for _ in 0..30 {
+            t.step(&mut ws, &StepParams::default()).unwrap();
+        }
+        let f = t.fields(&mut ws);
+        (t.cells().phi().to_vec(), f.qxx, f.sigma_xx)
+    };
+    let p = ModelParams::paper(0.01);
+    let same = Population::new()
+        .with_gamma(p.energy.gamma)
+        .with_mu(p.energy.mu)
+        .with_radius(p.energy.radius)
+        .with_xi(p.xi)
+        .with_zeta(p.zeta);
+    let pops = Populations::new(vec![same, Population::new()], &[2, 2], 5);
+    let (a, b) = (run(None), run(Some(pops)));
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&a.0), bits(&b.0), "fields");
+    assert_eq!(bits(&a.1), bits(&b.1), "Q");
+    assert_eq!(bits(&a.2), bits(&b.2), "stress");
+}
+
+/// Populations are dealt by a shuffle from the seed: the counts are kept, and both
+/// populations are spread over the identities.
+#[test]
+fn populations_are_dealt_with_their_counts() {
+    let pops = Populations::new(vec![Population::new(); 3], &[10, 20, 30], 4);
+    let of = pops.of_cell();
+    for (k, want) in [10, 20, 30].into_iter().enumerate() {
+        assert_eq!(of.iter().filter(|&&p| p as usize == k).count(), want);
+    }
+    // Not in blocks: the first ten identities are not all population 0.
+    assert!(of[..10].iter().any(|&p| p != 0));
+    assert_eq!(Populations::new(vec![Population::new(); 3], &[10, 20, 30], 4), pops);
+}

@@ -1,0 +1,205 @@
+//! Per-cell parameters: cells in populations, each with its own γ, μ, R, ξ and ζ
+//! (docs/model.md §11.3).
+//!
+//! With per-cell values the equations keep their form with the cell's own constants:
+//! `δF/δφ_i` with `γ_i, μ_i, R_i`; `v_i = F_i/ξ_i`; the active stress `−Σ_j ζ_j φ_j S_j`.
+//! The pressure of the paper form, `P = Σ_i δF/δφ_i`, then holds the weighted sums
+//! `Σ γ_j φ_j`, `Σ (μ_j/a_j) φ_j` … of the extensions' table; here they need no field of their
+//! own, since every per-cell term of `P` is summed cell by cell into `U` already
+//! ([`crate::equations::pressure_cell_part`] with the cell's coefficients). κ and λ stay global.
+//!
+//! A population without an override of a parameter takes the tissue's ([`crate::ModelParams`]),
+//! so that populations that override nothing step exactly as the tissue without them, to the
+//! bit. A population's ζ acts while the activity is on ([`crate::Tissue::active`]).
+
+use phasefield::{EnergyCoefficients, EnergyParams};
+
+use super::NoiseKey;
+use crate::ModelParams;
+
+/// The parameters one population overrides; `None` takes the tissue's.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
+pub struct Population {
+    /// Interface stiffness γ.
+    pub gamma: Option<f64>,
+    /// Area constraint μ.
+    pub mu: Option<f64>,
+    /// Target radius R.
+    pub radius: Option<f64>,
+    /// Friction ξ.
+    pub xi: Option<f64>,
+    /// Activity ζ.
+    pub zeta: Option<f64>,
+}
+
+impl Population {
+    /// A population that overrides nothing.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// With its own γ.
+    pub fn with_gamma(mut self, v: f64) -> Self {
+        self.gamma = Some(v);
+        self
+    }
+    /// With its own μ.
+    pub fn with_mu(mut self, v: f64) -> Self {
+        self.mu = Some(v);
+        self
+    }
+    /// With its own R.
+    pub fn with_radius(mut self, v: f64) -> Self {
+        self.radius = Some(v);
+        self
+    }
+    /// With its own ξ.
+    pub fn with_xi(mut self, v: f64) -> Self {
+        self.xi = Some(v);
+        self
+    }
+    /// With its own ζ.
+    pub fn with_zeta(mut self, v: f64) -> Self {
+        self.zeta = Some(v);
+        self
+    }
+}
+
+/// The populations of a tissue and the population of every cell (by identity).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Populations {
+    kinds: Vec<Population>,
+    of_cell: Vec<u16>,
+}
+
+/// A cell's constants in one evaluation.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CellConstants {
+    pub(crate) coef: EnergyCoefficients,
+    pub(crate) xi: f64,
+    /// The weight of the cell's `S_i` in the active stress's sum: 1 when every cell has the
+    /// tissue's ζ (which then multiplies the sum), ζ_i otherwise.
+    pub(crate) zeta_weight: f64,
+}
+
+impl Populations {
+    /// Populations of `counts[k]` cells each with the parameters `kinds[k]`, the cells
+    /// (identities `0..Σ counts`) dealt to them by a shuffle drawn from `seed`, so that the
+    /// populations are mixed whatever the initial layout.
+    ///
+    /// # Panics
+    /// If the lengths differ or there are more than 65536 populations.
+    pub fn new(kinds: Vec<Population>, counts: &[usize], seed: u64) -> Self {
+        assert_eq!(kinds.len(), counts.len(), "a count per population");
+        assert!(kinds.len() <= 1 << 16, "at most 65536 populations");
+        let mut of_cell: Vec<u16> = counts
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &c)| std::iter::repeat_n(k as u16, c))
+            .collect();
+        // Fisher–Yates from counter-based uniforms.
+        for i in (1..of_cell.len()).rev() {
+            let u = NoiseKey {
+                seed,
+                cell: i as u64,
+                step: 0,
+                stage: 1 << 61,
+            }
+            .uniform();
+            let j = ((u * (i + 1) as f64) as usize).min(i);
+            of_cell.swap(i, j);
+        }
+        Self { kinds, of_cell }
+    }
+
+    /// Populations with the given population of every cell, by identity.
+    ///
+    /// # Panics
+    /// If a cell names a population that is not there.
+    pub fn from_assignment(kinds: Vec<Population>, of_cell: Vec<u16>) -> Self {
+        assert!(of_cell.iter().all(|&k| (k as usize) < kinds.len()));
+        Self { kinds, of_cell }
+    }
+
+    /// Whether there are none (every cell has the tissue's parameters).
+    pub fn is_empty(&self) -> bool {
+        self.kinds.is_empty()
+    }
+
+    /// The populations.
+    pub fn kinds(&self) -> &[Population] {
+        &self.kinds
+    }
+
+    /// The population of every cell, by identity.
+    pub fn of_cell(&self) -> &[u16] {
+        &self.of_cell
+    }
+
+    /// The population of cell `id` (0 without populations).
+    pub fn population(&self, id: usize) -> usize {
+        self.of_cell.get(id).map_or(0, |&k| k as usize)
+    }
+
+    /// Whether some population's ζ differs from the tissue's in an evaluation with `params`:
+    /// the active stress is then `−Σ ζ_j φ_j S_j`, summed with each cell's weight (otherwise
+    /// `−ζ Σ φ_j S_j`, as without populations, to the bit).
+    pub(crate) fn mixed_zeta(&self, params: &ModelParams, active: bool) -> bool {
+        (0..self.kinds.len()).any(|k| self.zeta(k, params, active) != params.zeta)
+    }
+
+    /// The energy parameters of population `k` from the tissue's.
+    pub fn energy(&self, k: usize, base: &EnergyParams) -> EnergyParams {
+        let mut e = *base;
+        if let Some(p) = self.kinds.get(k) {
+            e.gamma = p.gamma.unwrap_or(e.gamma);
+            e.mu = p.mu.unwrap_or(e.mu);
+            e.radius = p.radius.unwrap_or(e.radius);
+        }
+        e
+    }
+
+    /// The ζ of population `k`, with the activity on or off.
+    pub fn zeta(&self, k: usize, params: &ModelParams, active: bool) -> f64 {
+        match self.kinds.get(k).and_then(|p| p.zeta) {
+            Some(z) if active => z,
+            Some(_) => 0.0,
+            None => params.zeta,
+        }
+    }
+
+    /// The constants of cell `id` in an evaluation with `params`.
+    #[inline]
+    pub(crate) fn constants(
+        &self,
+        id: usize,
+        params: &ModelParams,
+        active: bool,
+        mixed: bool,
+    ) -> CellConstants {
+        if self.kinds.is_empty() {
+            return CellConstants {
+                coef: params.energy.coefficients(),
+                xi: params.xi,
+                zeta_weight: 1.0,
+            };
+        }
+        let k = self.population(id);
+        let xi = self.kinds[k].xi.unwrap_or(params.xi);
+        CellConstants {
+            coef: self.energy(k, &params.energy).coefficients(),
+            xi,
+            zeta_weight: if mixed {
+                self.zeta(k, params, active)
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// Whether some cell has a non-zero ζ in an evaluation with `params`.
+    pub(crate) fn any_activity(&self, params: &ModelParams, active: bool) -> bool {
+        params.zeta != 0.0
+            || (active && self.kinds.iter().any(|k| k.zeta.is_some_and(|z| z != 0.0)))
+    }
+}
