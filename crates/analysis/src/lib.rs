@@ -41,6 +41,7 @@ pub mod correlation;
 pub mod crop;
 pub mod defects;
 pub mod fields;
+pub mod mixing;
 pub mod smooth;
 pub mod tracking;
 

@@ -26,6 +26,10 @@ struct RunJson {
     axes: &'static str,
     units: BTreeMap<&'static str, &'static str>,
     columns: BTreeMap<&'static str, BTreeMap<&'static str, &'static str>>,
+    /// The per-cell arrays a frame has beyond the minimal model's, with their meaning.
+    frame_arrays: BTreeMap<String, String>,
+    /// The populations by index (the frame's `population` array), with their counts.
+    populations: Vec<(String, usize)>,
 }
 
 /// The unit of a column of `series.csv` or of the analysis tables.
@@ -42,6 +46,39 @@ fn unit(column: &str) -> &'static str {
         "creation_rate" => "pair creations per node per TU",
         _ => "dimensionless",
     }
+}
+
+/// The frame arrays of the scene's physics terms and populations, with their meaning.
+fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
+    let mut m = BTreeMap::new();
+    let terms = scene.terms();
+    if !terms.is_empty() {
+        m.insert(
+            "cell_force".into(),
+            "(N, 2): the physics terms' whole-cell force on each cell (force units), beside the interface force 'force'".into(),
+        );
+    }
+    for (name, _) in terms.variables() {
+        let array = crate::checkpoint::term_array_name(&name);
+        let meaning = match array.as_str() {
+            "polarity.theta" => "(N,): each cell's polarity angle, radians counterclockwise from +x".to_string(),
+            _ => format!("(N,): the per-cell state variable {name} of a physics term"),
+        };
+        m.insert(array, meaning);
+    }
+    if terms.get("polarity").is_some() {
+        m.insert(
+            "polarity".into(),
+            "(N, 2): each cell's polarity (cos theta, sin theta)".into(),
+        );
+    }
+    if !scene.populations().is_empty() {
+        m.insert(
+            "population".into(),
+            "(N,) int64: each cell's population, an index into 'populations'".into(),
+        );
+    }
+    m
 }
 
 /// Writes `dir/run.json` for a run of `scene`.
@@ -73,7 +110,7 @@ pub fn write_run_json(dir: &Path, scene: &scene::Scene) -> Result<()> {
         .collect(),
         columns: [
             ("series.csv", table(SERIES_HEADER)),
-            ("analysis/observables.csv", table("frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth")),
+            ("analysis/observables.csv", table("frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order")),
             ("analysis/defects.csv", table("frame,time,x,y,charge,angle,track")),
             ("analysis/defect_events.csv", table("frame,time,kind,x,y")),
             ("analysis/correlations.csv", table("r,c_velocity,c_vorticity,c_q")),
@@ -81,6 +118,14 @@ pub fn write_run_json(dir: &Path, scene: &scene::Scene) -> Result<()> {
         ]
         .into_iter()
         .collect(),
+        frame_arrays: frame_arrays(scene),
+        populations: scene
+            .file()
+            .population
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (p.name(k), p.count))
+            .collect(),
     };
     let path = dir.join("run.json");
     let text = serde_json::to_string_pretty(&json).expect("run.json always serialises");

@@ -576,7 +576,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let mut obs = String::new();
     row!(
         obs,
-        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth"
+        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order"
     );
     let mut defects_csv = String::new();
     // Axes and angle conventions are in the README: a comment line here would be taken for
@@ -602,12 +602,14 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
     for path in &selected {
+        let frame = load_frame(path, &scene, &shape, lattice)?;
+        let (demix, polar) = mixing_and_order(&frame, &shape);
         let LoadedFrame {
             tissue,
             shapes,
             step,
             ..
-        } = load_frame(path, &scene, &shape, lattice)?;
+        } = frame;
         let ws = ws.get_or_insert_with(|| Workspace::new(tissue.cells()));
         let f = tissue.fields(ws);
         let smooth = |v: &[f64]| box_smooth(lattice, v, box_side).expect("checked above");
@@ -654,7 +656,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         };
         row!(
             obs,
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -663,7 +665,9 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             found.len() as f64 / area,
             tracks.unpaired,
             rate,
-            rms(&[&svx, &svy])
+            rms(&[&svx, &svy]),
+            demix,
+            polar
         );
         prev_time = Some(time);
         info.frames += 1;
@@ -695,6 +699,33 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     write_file(&out.join("lengths.csv"), l.as_bytes())?;
     write_averages(&out.join("defect_averages.npz"), &avg)?;
     Ok(info)
+}
+
+/// The demixing parameter of the frame's populations over the cells that touch
+/// (`analysis::mixing`; NaN without populations), and the polar order `|⟨p_i⟩|` of the
+/// cells' polarities (NaN without `[polarity]`).
+fn mixing_and_order(frame: &LoadedFrame, shape: &PatchShape) -> (f64, f64) {
+    let tissue = &frame.tissue;
+    let pops = tissue.populations();
+    let demix = if pops.is_empty() {
+        f64::NAN
+    } else {
+        let (_, owner) = crate::view::phi_sum_and_owner(frame, shape.nx, shape.ny);
+        let pairs = analysis::mixing::contacts(tissue.lattice(), &owner);
+        let label: Vec<usize> = (0..tissue.n_cells()).map(|id| pops.population(id)).collect();
+        analysis::mixing::demixing(&pairs, &label)
+    };
+    let polar = tissue
+        .terms()
+        .state("polarity")
+        .map_or(f64::NAN, |theta| {
+            let n = theta.len().max(1) as f64;
+            let (c, s) = theta
+                .iter()
+                .fold((0.0, 0.0), |(c, s), t| (c + t.cos(), s + t.sin()));
+            (c / n).hypot(s / n)
+        });
+    (demix, polar)
 }
 
 fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {

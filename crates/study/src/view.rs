@@ -493,7 +493,7 @@ pub fn render_run(
 
 /// `Σ_i φ_i` at every node, and the cell with the largest `φ_i` where that exceeds ½ (−1
 /// elsewhere).
-fn phi_sum_and_owner(frame: &LoadedFrame, nx: usize, ny: usize) -> (Vec<f32>, Vec<i32>) {
+pub(crate) fn phi_sum_and_owner(frame: &LoadedFrame, nx: usize, ny: usize) -> (Vec<f32>, Vec<i32>) {
     let l = frame.tissue.lattice();
     let mut sum = vec![0.0f64; l.len()];
     let mut best = vec![0.5f64; l.len()];
