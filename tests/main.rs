@@ -8,3 +8,4 @@ mod phasefield_tests;
 mod regression;
 mod simulation_tests;
 mod strategies;
+mod terms_tests;

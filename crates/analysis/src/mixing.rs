@@ -50,7 +50,10 @@ pub fn demixing(pairs: &[[usize; 2]], label: &[usize]) -> f64 {
     for &l in label {
         counts[l] += 1;
     }
-    let expected = counts.iter().map(|&c| (c * c.saturating_sub(1)) as f64).sum::<f64>()
+    let expected = counts
+        .iter()
+        .map(|&c| (c * c.saturating_sub(1)) as f64)
+        .sum::<f64>()
         / (n * (n - 1)) as f64;
     like / pairs.len() as f64 - expected
 }
@@ -154,7 +157,10 @@ mod tests {
         }
         let m = draws.iter().sum::<f64>() / 200.0;
         let sd = (draws.iter().map(|d| (d - m).powi(2)).sum::<f64>() / 199.0).sqrt();
-        assert!(m.abs() < 4.0 * sd / 200f64.sqrt(), "random labels: {m} ± {sd}");
+        assert!(
+            m.abs() < 4.0 * sd / 200f64.sqrt(),
+            "random labels: {m} ± {sd}"
+        );
     }
 
     /// The trend rule gives each verdict on series built for it: five runs growing at 1e-4

@@ -61,7 +61,9 @@ fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
     for (name, _) in terms.variables() {
         let array = crate::checkpoint::term_array_name(&name);
         let meaning = match array.as_str() {
-            "polarity.theta" => "(N,): each cell's polarity angle, radians counterclockwise from +x".to_string(),
+            "polarity.theta" => {
+                "(N,): each cell's polarity angle, radians counterclockwise from +x".to_string()
+            }
             _ => format!("(N,): the per-cell state variable {name} of a physics term"),
         };
         m.insert(array, meaning);

@@ -712,19 +712,18 @@ fn mixing_and_order(frame: &LoadedFrame, shape: &PatchShape) -> (f64, f64) {
     } else {
         let (_, owner) = crate::view::phi_sum_and_owner(frame, shape.nx, shape.ny);
         let pairs = analysis::mixing::contacts(tissue.lattice(), &owner);
-        let label: Vec<usize> = (0..tissue.n_cells()).map(|id| pops.population(id)).collect();
+        let label: Vec<usize> = (0..tissue.n_cells())
+            .map(|id| pops.population(id))
+            .collect();
         analysis::mixing::demixing(&pairs, &label)
     };
-    let polar = tissue
-        .terms()
-        .state("polarity")
-        .map_or(f64::NAN, |theta| {
-            let n = theta.len().max(1) as f64;
-            let (c, s) = theta
-                .iter()
-                .fold((0.0, 0.0), |(c, s), t| (c + t.cos(), s + t.sin()));
-            (c / n).hypot(s / n)
-        });
+    let polar = tissue.terms().state("polarity").map_or(f64::NAN, |theta| {
+        let n = theta.len().max(1) as f64;
+        let (c, s) = theta
+            .iter()
+            .fold((0.0, 0.0), |(c, s), t| (c + t.cos(), s + t.sin()));
+        (c / n).hypot(s / n)
+    });
     (demix, polar)
 }
 

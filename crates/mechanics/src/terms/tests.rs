@@ -462,5 +462,8 @@ fn populations_are_dealt_with_their_counts() {
     }
     // Not in blocks: the first ten identities are not all population 0.
     assert!(of[..10].iter().any(|&p| p != 0));
-    assert_eq!(Populations::new(vec![Population::new(); 3], &[10, 20, 30], 4), pops);
+    assert_eq!(
+        Populations::new(vec![Population::new(); 3], &[10, 20, 30], 4),
+        pops
+    );
 }
