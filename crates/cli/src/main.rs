@@ -149,7 +149,7 @@ enum Command {
         /// `all`, or steps such as `0,500,1000` (the numbers in frames/frame_STEP.npz).
         #[arg(long, default_value = "all")]
         frames: String,
-        /// What fills the cells: none, velocity, pressure, area, deformation or id.
+        /// What fills the cells: none, velocity, pressure, area, deformation, id or population.
         #[arg(long, default_value = "none")]
         colour: String,
         /// The director of the smoothed Q, as short segments.
@@ -165,6 +165,9 @@ enum Command {
         /// Each cell's principal deformation axis (with --colour none: the paper's Fig. 1b).
         #[arg(long)]
         axes: bool,
+        /// Each cell's polarity as an arrow (scenes with [polarity]).
+        #[arg(long)]
+        polarity: bool,
         /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
         #[arg(long)]
         size: Option<u32>,
@@ -489,6 +492,7 @@ fn real_main() -> Result<ExitCode> {
             defects,
             flow,
             axes,
+            polarity,
             size,
             range,
             movie,
@@ -515,6 +519,7 @@ fn real_main() -> Result<ExitCode> {
                 defects,
                 flow,
                 axes,
+                polarity,
                 size,
                 range,
                 movie,

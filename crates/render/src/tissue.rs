@@ -80,6 +80,16 @@ pub struct CellAxes {
     pub shapes: Vec<[f64; 2]>,
 }
 
+/// Each cell's polarity `p_i` (docs/model.md §11.1): an arrow from its centre, a cell radius
+/// long.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellArrows {
+    /// The centres `[x, y]`.
+    pub centres: Vec<[f64; 2]>,
+    /// The unit vectors `[p_x, p_y]`.
+    pub directions: Vec<[f64; 2]>,
+}
+
 /// A picture of a tissue state; [`TissuePicture::draw`] makes it.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -104,6 +114,8 @@ pub struct TissuePicture {
     pub defects: Vec<Defect>,
     /// Principal deformation axes, one per cell.
     pub axes: Option<CellAxes>,
+    /// Polarities, one arrow per cell.
+    pub polarity: Option<CellArrows>,
     /// The size of marks (defects, the longest axis), in lattice units; about a cell radius.
     pub mark: f64,
     /// The title over the picture.
@@ -123,6 +135,7 @@ pub const PLUS: [u8; 3] = [230, 85, 13];
 /// Colour of −½ marks.
 pub const MINUS: [u8; 3] = [0, 90, 200];
 const AXIS: [u8; 3] = [200, 20, 20];
+const POLARITY: [u8; 3] = [10, 110, 40];
 
 const TITLE_PX: u32 = 36;
 const BAR_PX: u32 = 110;
@@ -141,6 +154,7 @@ impl TissuePicture {
             flow: None,
             defects: Vec::new(),
             axes: None,
+            polarity: None,
             mark: 8.0,
             title: String::new(),
             size,
@@ -460,6 +474,30 @@ impl TissuePicture {
                         c.disc(px, py, 1.2 * line_w, AXIS);
                     });
                 }
+            }
+        }
+        if let Some(CellArrows {
+            centres,
+            directions,
+        }) = &self.polarity
+        {
+            let len = 0.9 * self.mark;
+            for (ctr, p) in centres.iter().zip(directions) {
+                if !(ctr.iter().chain(p).all(|v| v.is_finite())) {
+                    continue;
+                }
+                let (a, b) = (p[0] * len, p[1] * len);
+                self.periodic(c, ctr[0], ctr[1], len, |c, (px, py), s| {
+                    let tip = (px + a * s, py - b * s);
+                    c.line((px, py), tip, 1.5 * line_w, POLARITY);
+                    let (hx, hy) = (-0.35 * a * s, 0.35 * b * s);
+                    for ang in [0.45f64, -0.45] {
+                        let (cs, sn) = (ang.cos(), ang.sin());
+                        let end = (tip.0 + cs * hx - sn * hy, tip.1 + sn * hx + cs * hy);
+                        c.line(tip, end, 1.5 * line_w, POLARITY);
+                    }
+                    c.disc(px, py, 1.2 * line_w, POLARITY);
+                });
             }
         }
         let r = (0.22 * self.mark * s).max(3.0);

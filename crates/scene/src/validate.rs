@@ -395,6 +395,22 @@ impl SceneFile {
                     "use a value of order 0.01 (the reference code's cluster example), or remove [adhesion]",
                 ));
             }
+            // Two overlapping cells have the gradient energy λ(γ ± ω)|∇(φ1 ± φ2)|²/2: at ω ≥ γ
+            // their difference costs nothing and a contact breaks into stripes of the lattice.
+            let gamma = self
+                .population
+                .iter()
+                .filter_map(|p| p.gamma)
+                .fold(self.model.gamma, f64::min);
+            if a.omega >= gamma {
+                return Err(invalid(
+                    "adhesion",
+                    "omega",
+                    a.omega,
+                    format!("adhesion at or above the interface stiffness (gamma = {gamma}) makes the interface between two cells cost nothing, and contacts break into stripes at the lattice scale"),
+                    format!("use omega below gamma, e.g. {}", gamma * 0.75),
+                ));
+            }
         }
         if let Some(p) = &self.polarity {
             if !p.alpha.is_finite() {

@@ -18,7 +18,9 @@ use std::str::FromStr;
 use analysis::defects::detect;
 use analysis::smooth::box_smooth;
 use mechanics::{TissueFields, Workspace};
-use render::{CellAxes, Fill, LatticeVectors, Movie, Patches, RenderError, TissuePicture};
+use render::{
+    CellArrows, CellAxes, Fill, LatticeVectors, Movie, Patches, RenderError, TissuePicture,
+};
 use rundir::vtk::{write_pvd, write_vti, write_vtp, VtkArray, VtkValues};
 use rundir::RunDirError;
 use scene::Scene;
@@ -98,6 +100,8 @@ pub enum Colour {
     Deformation,
     /// Each cell its own colour.
     Id,
+    /// Each cell by its population (`[[population]]`).
+    Population,
 }
 
 impl FromStr for Colour {
@@ -110,11 +114,10 @@ impl FromStr for Colour {
             "area" => Self::Area,
             "deformation" => Self::Deformation,
             "id" => Self::Id,
-            _ => {
-                return Err(format!(
-                    "--colour {s}: use none, velocity, pressure, area, deformation or id"
-                ))
-            }
+            "population" => Self::Population,
+            _ => return Err(format!(
+                "--colour {s}: use none, velocity, pressure, area, deformation, id or population"
+            )),
         })
     }
 }
@@ -134,6 +137,8 @@ pub struct RenderOptions {
     pub flow: bool,
     /// Each cell's principal deformation axis (with `Colour::None`: the paper's Fig. 1b).
     pub axes: bool,
+    /// Each cell's polarity, an arrow (scenes with `[polarity]`).
+    pub polarity: bool,
     /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
     pub size: Option<u32>,
     /// The colour bar's range (default: each frame's own).
@@ -155,6 +160,7 @@ impl Default for RenderOptions {
             defects: false,
             flow: false,
             axes: false,
+            polarity: false,
             size: None,
             range: None,
             movie: None,
@@ -329,6 +335,12 @@ fn picture(
             "|v|",
         )),
         Colour::Area => Some((frame.areas.clone(), "area Σφ²")),
+        Colour::Population => Some((
+            (0..frame.tissue.n_cells())
+                .map(|id| frame.tissue.populations().population(id) as f64)
+                .collect(),
+            "population",
+        )),
         Colour::Deformation => Some((
             frame.shapes.iter().map(|s| s[0].hypot(s[1])).collect(),
             "|S|",
@@ -396,6 +408,14 @@ fn picture(
             centres: frame.centres.clone(),
             shapes: frame.shapes.clone(),
         });
+    }
+    if opts.polarity {
+        if let Some(theta) = frame.tissue.terms().state("polarity") {
+            p.polarity = Some(CellArrows {
+                centres: frame.centres.clone(),
+                directions: theta.iter().map(|t| [t.cos(), t.sin()]).collect(),
+            });
+        }
     }
     p.title = format!(
         "t = {}   ζ = {}   step {}",
@@ -588,6 +608,20 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
         ),
         VtkArray::new("area", 1, VtkValues::F64(frame.areas.clone())),
     ];
+    let mut arrays = arrays;
+    let tissue = &frame.tissue;
+    if !tissue.populations().is_empty() {
+        let pops = (0..n).map(|id| tissue.populations().population(id) as i32);
+        arrays.push(VtkArray::new(
+            "population",
+            1,
+            VtkValues::I32(pops.collect()),
+        ));
+    }
+    if let Some(theta) = tissue.terms().state("polarity") {
+        let p = theta.iter().flat_map(|t| [t.cos(), t.sin(), 0.0]).collect();
+        arrays.push(VtkArray::new("polarity", 3, VtkValues::F64(p)));
+    }
     (points, arrays)
 }
 
@@ -596,7 +630,7 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
 /// | file | what |
 /// |---|---|
 /// | `fields_STEP.vti` | ImageData `lx × ly × 1`, spacing 1; point arrays (float32 unless said): `phi_sum` `Σ_i φ_i`; `cell_id` (int32) the cell with the largest `φ_i` at the node, −1 where none exceeds ½; `velocity` `(v_x, v_y, 0)`; `Q` `(Q_xx, Q_xy)`; `director` `|Q| (cos θ, sin θ, 0)`; `pressure`; `sigma_xx`, `sigma_yy`, `sigma_xy` |
-/// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area` |
+/// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area`; with `[[population]]` `population` (int32), with `[polarity]` `polarity` `(p_x, p_y, 0)` |
 /// | `fields.pvd`, `cells.pvd` | the time series (each file with its frame's time) |
 ///
 /// Every file also holds its time as the field `TimeValue`. `progress(done, total)` is called

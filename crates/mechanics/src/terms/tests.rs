@@ -360,8 +360,10 @@ fn adhesion_is_the_derivative_of_its_discrete_energy() {
 /// T2.2 of the extensions: a doublet (R = 8, centres 15 apart, γ = 0.02, μ = 5, λ = 3,
 /// κ = 0.1, ξ = 1, no activity) relaxed for 400 TU: its contact, the overlap `Σ φ₁φ₂` and
 /// the length of the contact line (the extent across the line of the nodes where both
-/// fields exceed 0.25), grows with ω ∈ {0, 0.005, 0.01, 0.02}; an isolated cell with
-/// adhesion feels no force.
+/// fields exceed 0.25), grows with ω ∈ {0, 0.005, 0.01, 0.015}. (The extensions' ω = 0.02 is
+/// ω = γ, where the gradient energy `λ(γ ± ω)` of the difference of the two fields vanishes and
+/// the contact breaks into stripes at the lattice scale; scenes refuse ω ≥ γ.) An isolated
+/// cell with adhesion feels no force.
 #[test]
 fn a_doublet_adheres_more_with_omega() {
     let measure = |omega: f64| {
@@ -392,7 +394,7 @@ fn a_doublet_adheres_more_with_omega() {
         }
         (overlap, rows.len())
     };
-    let results: Vec<(f64, usize)> = [0.0, 0.005, 0.01, 0.02]
+    let results: Vec<(f64, usize)> = [0.0, 0.005, 0.01, 0.015]
         .iter()
         .map(|&w| measure(w))
         .collect();
