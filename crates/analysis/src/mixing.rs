@@ -133,7 +133,7 @@ mod tests {
     fn demixing_tells_sorted_from_mixed() {
         let lattice = Lattice::new(32, 32);
         let owner: Vec<i32> = (0..32 * 32)
-            .map(|k| ((k / 32 / 4) * 8 + (k % 32) / 4) as i32)
+            .map(|k: i32| (k / 32 / 4) * 8 + (k % 32) / 4)
             .collect();
         let pairs = contacts(lattice, &owner);
         assert_eq!(pairs.len(), 128);

@@ -168,6 +168,9 @@ enum Command {
         /// Each cell's polarity as an arrow (scenes with [polarity]).
         #[arg(long)]
         polarity: bool,
+        /// Each cell's track: its centre through every frame of the run up to the one drawn.
+        #[arg(long)]
+        tracks: bool,
         /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
         #[arg(long)]
         size: Option<u32>,
@@ -493,6 +496,7 @@ fn real_main() -> Result<ExitCode> {
             flow,
             axes,
             polarity,
+            tracks,
             size,
             range,
             movie,
@@ -520,6 +524,7 @@ fn real_main() -> Result<ExitCode> {
                 flow,
                 axes,
                 polarity,
+                tracks,
                 size,
                 range,
                 movie,

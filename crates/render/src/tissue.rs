@@ -116,6 +116,9 @@ pub struct TissuePicture {
     pub axes: Option<CellAxes>,
     /// Polarities, one arrow per cell.
     pub polarity: Option<CellArrows>,
+    /// Each cell's track, its centres in time order (a jump of more than half the lattice is a
+    /// crossing of the periodic boundary, not drawn).
+    pub tracks: Option<Vec<Vec<[f64; 2]>>>,
     /// The size of marks (defects, the longest axis), in lattice units; about a cell radius.
     pub mark: f64,
     /// The title over the picture.
@@ -136,6 +139,7 @@ pub const PLUS: [u8; 3] = [230, 85, 13];
 pub const MINUS: [u8; 3] = [0, 90, 200];
 const AXIS: [u8; 3] = [200, 20, 20];
 const POLARITY: [u8; 3] = [10, 110, 40];
+const TRACK: [u8; 3] = [60, 60, 160];
 
 const TITLE_PX: u32 = 36;
 const BAR_PX: u32 = 110;
@@ -155,6 +159,7 @@ impl TissuePicture {
             defects: Vec::new(),
             axes: None,
             polarity: None,
+            tracks: None,
             mark: 8.0,
             title: String::new(),
             size,
@@ -473,6 +478,22 @@ impl TissuePicture {
                         c.line((px - ex, py - ey), (px + ex, py + ey), 1.5 * line_w, AXIS);
                         c.disc(px, py, 1.2 * line_w, AXIS);
                     });
+                }
+            }
+        }
+        if let Some(tracks) = &self.tracks {
+            let (hx, hy) = (0.5 * self.lx as f64, 0.5 * self.ly as f64);
+            for track in tracks {
+                for w in track.windows(2) {
+                    let ([x0, y0], [x1, y1]) = (w[0], w[1]);
+                    if !(x0.is_finite() && y0.is_finite() && x1.is_finite() && y1.is_finite())
+                        || (x1 - x0).abs() > hx
+                        || (y1 - y0).abs() > hy
+                    {
+                        continue;
+                    }
+                    let (a, b) = (self.to_pixel(x0, y0), self.to_pixel(x1, y1));
+                    c.line(a, b, line_w, TRACK);
                 }
             }
         }

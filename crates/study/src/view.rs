@@ -115,9 +115,11 @@ impl FromStr for Colour {
             "deformation" => Self::Deformation,
             "id" => Self::Id,
             "population" => Self::Population,
-            _ => return Err(format!(
+            _ => {
+                return Err(format!(
                 "--colour {s}: use none, velocity, pressure, area, deformation, id or population"
-            )),
+            ))
+            }
         })
     }
 }
@@ -139,6 +141,8 @@ pub struct RenderOptions {
     pub axes: bool,
     /// Each cell's polarity, an arrow (scenes with `[polarity]`).
     pub polarity: bool,
+    /// Each cell's track: its centre through every frame up to the one drawn.
+    pub tracks: bool,
     /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
     pub size: Option<u32>,
     /// The colour bar's range (default: each frame's own).
@@ -161,6 +165,7 @@ impl Default for RenderOptions {
             flow: false,
             axes: false,
             polarity: false,
+            tracks: false,
             size: None,
             range: None,
             movie: None,
@@ -185,6 +190,8 @@ pub struct ViewInfo {
 struct Run {
     scene: Scene,
     frames: Vec<PathBuf>,
+    /// Every frame of the run, with its step (the tracks are drawn through all of them).
+    all: Vec<(u64, PathBuf)>,
     notes: FrameNotes,
 }
 
@@ -192,6 +199,7 @@ impl Run {
     fn open(run_dir: &Path, which: &Frames) -> Result<Self> {
         let scene = read_scene(run_dir)?;
         let FrameList { frames: all, notes } = list_frames(run_dir, &scene)?;
+        let every: Vec<(u64, PathBuf)> = all.iter().map(|f| (f.step, f.path.clone())).collect();
         let frames = match which {
             Frames::All => all.into_iter().map(|f| f.path).collect(),
             Frames::Steps(steps) => {
@@ -215,8 +223,31 @@ impl Run {
         Ok(Self {
             scene,
             frames,
+            all: every,
             notes,
         })
+    }
+
+    /// Each cell's centre in every frame of the run up to step `last`, in order (the cells'
+    /// tracks).
+    fn tracks(&self, last: u64) -> Result<Vec<Vec<[f64; 2]>>> {
+        let mut tracks: Vec<Vec<[f64; 2]>> = Vec::new();
+        for (step, path) in self.all.iter().filter(|(s, _)| *s <= last) {
+            let a = rundir::read_npz(path, &["centre"]).map_err(|e| {
+                ViewError::Run(crate::analyze::input(
+                    path,
+                    format!("{e} (frame at step {step})"),
+                ))
+            })?;
+            let centres: Vec<[f64; 2]> = a[0].data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+            if tracks.is_empty() {
+                tracks = vec![Vec::new(); centres.len()];
+            }
+            for (t, c) in tracks.iter_mut().zip(centres) {
+                t.push(c);
+            }
+        }
+        Ok(tracks)
     }
 
     fn load(&self, path: &Path) -> Result<LoadedFrame> {
@@ -409,6 +440,9 @@ fn picture(
             shapes: frame.shapes.clone(),
         });
     }
+    if opts.tracks {
+        p.tracks = Some(run.tracks(frame.step)?);
+    }
     if opts.polarity {
         if let Some(theta) = frame.tissue.terms().state("polarity") {
             p.polarity = Some(CellArrows {
@@ -417,10 +451,21 @@ fn picture(
             });
         }
     }
+    let zetas = &run.scene.file().population;
+    let zeta = if zetas.iter().any(|p| p.zeta.is_some()) {
+        let each: Vec<String> = zetas
+            .iter()
+            .enumerate()
+            .map(|(k, p)| format!("{} {}", p.name(k), p.zeta.unwrap_or(run.scene.zeta())))
+            .collect();
+        each.join(", ")
+    } else {
+        frame.tissue.params().zeta.to_string()
+    };
     p.title = format!(
         "t = {}   ζ = {}   step {}",
         render_time(frame.tissue.time()),
-        frame.tissue.params().zeta,
+        zeta,
         frame.step
     );
     Ok(p)
