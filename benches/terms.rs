@@ -1,0 +1,69 @@
+//! The cost of each physics term (docs/model.md §11) per step: one relaxed step (dt 0.2,
+//! ζ = 0.005) of `large.toml` (960 cells, 400², margin 12, f32 storage) without terms, with
+//! self-propulsion (`[polarity]` α = 0.04, D_r = 4.5e-4, aligning to the velocity), with
+//! adhesion (ω = 0.005), and with two populations of different γ and ζ (±0.005), on one and two
+//! threads. Throughput is in node updates (cells × patch nodes per step).
+//!
+//! Run with `cargo bench -p monolayer-benches --bench terms`.
+
+use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
+use mechanics::terms::{Population, Populations};
+use monolayer_benches::{pool, relaxed_scene};
+
+fn bench_terms(c: &mut Criterion) {
+    let mut g = c.benchmark_group("terms");
+    g.sample_size(10);
+    let base = ["integrator.margin=12".to_string()];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter()
+            .cloned()
+            .chain(extra.iter().map(|s| s.to_string()))
+            .collect()
+    };
+    let cases: [(&str, Vec<String>, bool); 4] = [
+        ("none", with(&[]), false),
+        (
+            "polarity",
+            with(&[
+                "polarity.alpha=0.04",
+                "polarity.rotational_diffusion=4.5e-4",
+                "polarity.align=\"velocity\"",
+                "polarity.align_rate=0.1",
+            ]),
+            false,
+        ),
+        ("adhesion", with(&["adhesion.omega=0.005"]), false),
+        ("populations", with(&[]), true),
+    ];
+    for (name, overrides, populations) in cases {
+        let (t, mut ws, s) =
+            pool(2).install(|| relaxed_scene::<f32>("large.toml", &overrides, 100, 0.005));
+        let n = t.n_cells();
+        let mut t = if populations {
+            let kinds = vec![
+                Population::new().with_gamma(0.01).with_zeta(0.005),
+                Population::new().with_gamma(0.02).with_zeta(-0.005),
+            ];
+            t.with_populations(Populations::new(kinds, &[n / 2, n - n / 2], 1))
+        } else {
+            t
+        };
+        let sp = s.step_params();
+        g.throughput(Throughput::Elements((n * t.cells().patch_len()) as u64));
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            let id = BenchmarkId::new(name, format!("threads={threads}"));
+            g.bench_function(id, |b| {
+                pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
+            });
+        }
+    }
+    g.finish();
+}
+
+#[allow(missing_docs)]
+mod group {
+    criterion::criterion_group!(benches, super::bench_terms);
+}
+use group::benches;
+criterion_main!(benches);
