@@ -172,6 +172,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            kind_constants,
             ..
         } = ws;
         let fused = self.fuses();
@@ -180,7 +181,16 @@ impl<T: Real> Tissue<T> {
             _ => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
-        self.evaluate_fields(shapes, k1, sums, cell_state, cell_force, lap_s1, post);
+        self.evaluate_fields(
+            shapes,
+            k1,
+            sums,
+            cell_state,
+            cell_force,
+            lap_s1,
+            kind_constants,
+            post,
+        );
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -241,6 +251,7 @@ impl<T: Real> Tissue<T> {
             next_centre,
             cell_force,
             lap_s1,
+            kind_constants,
             ..
         } = ws;
         self.evaluate_fields(
@@ -250,6 +261,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            kind_constants,
             Post::Correct {
                 h,
                 k1,
@@ -287,6 +299,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            kind_constants,
             ..
         } = ws;
         self.evaluate_fields(
@@ -296,6 +309,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            kind_constants,
             Post::Nothing,
         );
         if !self.terms.is_empty() {
@@ -338,6 +352,7 @@ impl<T: Real> Tissue<T> {
         cell_state: &mut [CellState],
         cell_force: &mut [[f64; 2]],
         lap_s1: &mut Vec<f64>,
+        kind_constants: &mut Vec<crate::terms::CellConstants>,
         post: Post<'_, T>,
     ) {
         // The lattice buffer of adhesion, made on its first use (the one allocation of a run
@@ -377,6 +392,7 @@ impl<T: Real> Tissue<T> {
             cell_force,
             lap_s1,
             (&self.populations, &self.cell_id, self.active),
+            kind_constants,
             post,
         );
     }
@@ -396,6 +412,7 @@ impl<T: Real> Tissue<T> {
             com,
             cell_force,
             lap_s1,
+            kind_constants,
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
@@ -406,6 +423,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            kind_constants,
             Post::Nothing,
         );
     }

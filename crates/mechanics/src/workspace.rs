@@ -94,6 +94,8 @@ pub struct Workspace<T: Real = f64> {
     pub(crate) cell_force: Vec<[f64; 2]>,
     /// The lattice Laplacian of `s1`, with adhesion only (empty otherwise).
     pub(crate) lap_s1: Vec<f64>,
+    /// Each population's constants in the current evaluation (one entry without populations).
+    pub(crate) kind_constants: Vec<crate::terms::CellConstants>,
 }
 
 impl<T: Real> Workspace<T> {
@@ -111,6 +113,7 @@ impl<T: Real> Workspace<T> {
                 + self.cell_force.capacity())
                 * std::mem::size_of::<[f64; 2]>()
             + self.lap_s1.capacity() * std::mem::size_of::<f64>()
+            + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
             + self.com.heap_bytes()
             + crate::kernels::scratch_bytes()
     }
@@ -132,6 +135,7 @@ impl<T: Real> Workspace<T> {
             com: ComTable::new(lattice),
             cell_force: vec![[0.0; 2]; cells.n_cells()],
             lap_s1: Vec::new(),
+            kind_constants: Vec::with_capacity(4),
         }
     }
 

@@ -168,33 +168,34 @@ impl Populations {
         }
     }
 
-    /// The constants of cell `id` in an evaluation with `params`.
-    #[inline]
-    pub(crate) fn constants(
+    /// The constants of every population in an evaluation with `params` into `out` (one entry,
+    /// the tissue's, without populations), indexed by [`Populations::population`]. Allocates
+    /// only when there are more populations than `out` held before.
+    pub(crate) fn fill_constants(
         &self,
-        id: usize,
         params: &ModelParams,
         active: bool,
         mixed: bool,
-    ) -> CellConstants {
+        out: &mut Vec<CellConstants>,
+    ) {
+        out.clear();
         if self.kinds.is_empty() {
-            return CellConstants {
+            out.push(CellConstants {
                 coef: params.energy.coefficients(),
                 xi: params.xi,
                 zeta_weight: 1.0,
-            };
+            });
+            return;
         }
-        let k = self.population(id);
-        let xi = self.kinds[k].xi.unwrap_or(params.xi);
-        CellConstants {
+        out.extend((0..self.kinds.len()).map(|k| CellConstants {
             coef: self.energy(k, &params.energy).coefficients(),
-            xi,
+            xi: self.kinds[k].xi.unwrap_or(params.xi),
             zeta_weight: if mixed {
                 self.zeta(k, params, active)
             } else {
                 1.0
             },
-        }
+        }));
     }
 
     /// Whether some cell has a non-zero ζ in an evaluation with `params`.

@@ -469,3 +469,34 @@ fn populations_are_dealt_with_their_counts() {
         pops
     );
 }
+
+/// The alignment targets, on a cell given by hand: to the shape, the polarity turns towards
+/// the nearer end of the long axis at rate `J |S| Δ`; to the force, towards the force at rate
+/// `J |F| Δ`; inactive, not at all.
+#[test]
+fn alignment_targets_are_the_shape_axis_and_the_force() {
+    let mut state = crate::CellState::default();
+    state.shape = crate::TracelessTensor::new(0.3, 0.0); // long axis along x, |S| = 0.3
+    state.force = Vector2::new(0.0, 0.02); // along +y
+    let cell = |active| CellContext {
+        id: 0,
+        centre: [0.0; 2],
+        state: &state,
+        population: 0,
+        active,
+    };
+    let rate = |align, theta: f64, active| {
+        let mut out = [0.0];
+        Polarity::new(0.04)
+            .with_alignment(align, 2.0)
+            .rate(&cell(active), &[theta], &mut out);
+        out[0]
+    };
+    // p at +0.3 rad from +x: back towards +x; p at π − 0.3: towards −x (the nearer end).
+    assert!((rate(Align::Shape, 0.3, true) - (-2.0 * 0.3 * 0.3)).abs() < 1e-12);
+    assert!((rate(Align::Shape, std::f64::consts::PI - 0.3, true) - 2.0 * 0.3 * 0.3).abs() < 1e-12);
+    // p along +x, F along +y: turns towards +y, Δ = −π/2.
+    let expected = 2.0 * 0.02 * std::f64::consts::FRAC_PI_2;
+    assert!((rate(Align::Force, 0.0, true) - expected).abs() < 1e-12);
+    assert_eq!(rate(Align::Force, 0.0, false), 0.0);
+}
