@@ -475,9 +475,12 @@ fn populations_are_dealt_with_their_counts() {
 /// `J |F| Δ`; inactive, not at all.
 #[test]
 fn alignment_targets_are_the_shape_axis_and_the_force() {
-    let mut state = crate::CellState::default();
-    state.shape = crate::TracelessTensor::new(0.3, 0.0); // long axis along x, |S| = 0.3
-    state.force = Vector2::new(0.0, 0.02); // along +y
+    // Long axis along x with |S| = 0.3; the force along +y.
+    let state = crate::CellState {
+        shape: crate::TracelessTensor::new(0.3, 0.0),
+        force: Vector2::new(0.0, 0.02),
+        ..Default::default()
+    };
     let cell = |active| CellContext {
         id: 0,
         centre: [0.0; 2],
