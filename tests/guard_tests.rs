@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 35] = [
+const KEYS: [&str; 36] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -154,6 +154,7 @@ const KEYS: [&str; 35] = [
     "polarity.propulsion",
     "polarity.angle",
     "adhesion.omega",
+    "polarity.contact_inhibition",
 ];
 const VALUES: [&str; 36] = [
     "0",

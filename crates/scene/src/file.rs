@@ -228,6 +228,10 @@ pub struct PolaritySpec {
     /// from `[run] seed`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle: Option<f64>,
+    /// Contact inhibition of locomotion η (default 0): the propulsion stalls as
+    /// `α exp(−η max(0, −F·p)/α)` against the cells in front.
+    #[serde(default)]
+    pub contact_inhibition: f64,
 }
 
 /// `[adhesion]`: cell–cell adhesion (docs/model.md §11.2); absent: none.
@@ -332,7 +336,8 @@ impl PolaritySpec {
         let p = Polarity::new(self.alpha)
             .with_rotational_diffusion(self.rotational_diffusion)
             .with_alignment(align, self.align_rate)
-            .with_propulsion(propulsion);
+            .with_propulsion(propulsion)
+            .with_contact_inhibition(self.contact_inhibition);
         match self.angle {
             Some(theta) => p.with_initial_angle(theta),
             None => p,

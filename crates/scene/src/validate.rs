@@ -449,6 +449,15 @@ impl SceneFile {
                     "set align = \"velocity\", \"force\" or \"shape\", or remove align_rate",
                 ));
             }
+            if !(p.contact_inhibition.is_finite() && p.contact_inhibition >= 0.0) {
+                return Err(invalid(
+                    "polarity",
+                    "contact_inhibition",
+                    p.contact_inhibition,
+                    "the contact inhibition must be zero or positive",
+                    "use a value of order 1 (3 stalls a cell pressed with its own force to 5 %), or 0 for none",
+                ));
+            }
             if let Some(a) = p.angle.filter(|a| !a.is_finite()) {
                 return Err(invalid(
                     "polarity",

@@ -7,7 +7,10 @@
 //! ```
 //!
 //! `Δ(f, p)` the signed angle from the alignment target `f_i` to `p_i` ([`Align`]), `J` the
-//! alignment rate per unit of `|f|`, and `D_r` the rotational diffusion constant. The reference
+//! alignment rate per unit of `|f|`, and `D_r` the rotational diffusion constant. Contact
+//! inhibition of locomotion comes in two forms: repolarisation away from the cells a cell
+//! presses on (`Align::Force`, the reference code's default rule) and a stall of the
+//! propulsion against them ([`Polarity::contact_inhibition`]). The reference
 //! code's noise amplitude `D_pol` (a step `θ += √dt D_pol N`) is `D_r = D_pol²/2`.
 
 use nalgebra::Vector2;
@@ -58,6 +61,11 @@ pub struct Polarity {
     pub align_rate: f64,
     /// Every cell's initial angle; `None`: uniform on the circle, drawn from the seed.
     pub initial_angle: Option<f64>,
+    /// Contact inhibition of locomotion η ≥ 0 (0: none): the propulsion stalls against the
+    /// cells in front, `α → α exp(−η max(0, −F_i·p_i)/α)` with `F_i` the interface force of the
+    /// last evaluation, so a cell that presses on a neighbour along its polarity with a force
+    /// `α` pushes with `α e^{−η}`.
+    pub contact_inhibition: f64,
     /// Per population (`crate::terms::Populations`), its own `[α, D_r, J]` where given.
     pub by_population: Vec<[Option<f64>; 3]>,
 }
@@ -72,8 +80,15 @@ impl Polarity {
             align: Align::None,
             align_rate: 0.0,
             initial_angle: None,
+            contact_inhibition: 0.0,
             by_population: Vec::new(),
         }
+    }
+
+    /// With contact inhibition of locomotion `eta` (see [`Polarity::contact_inhibition`]).
+    pub fn with_contact_inhibition(mut self, eta: f64) -> Self {
+        self.contact_inhibition = eta;
+        self
     }
 
     /// With population `k`'s own propulsion, rotational diffusion and alignment rate, where
@@ -169,11 +184,15 @@ impl CellTerm for Polarity {
             return [0.0; 2];
         }
         let [alpha, ..] = self.values(cell.population);
-        let magnitude = match self.propulsion {
+        let mut magnitude = match self.propulsion {
             Propulsion::Cell => alpha,
             Propulsion::Density => alpha * cell.state.area,
         };
         let p = direction(x[0]);
+        if self.contact_inhibition > 0.0 && magnitude != 0.0 {
+            let against = (-cell.state.force.dot(&p)).max(0.0);
+            magnitude *= (-self.contact_inhibition * against / magnitude.abs()).exp();
+        }
         [magnitude * p.x, magnitude * p.y]
     }
 

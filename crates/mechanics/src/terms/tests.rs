@@ -503,3 +503,100 @@ fn alignment_targets_are_the_shape_axis_and_the_force() {
     assert!((rate(Align::Force, 0.0, true) - expected).abs() < 1e-12);
     assert_eq!(rate(Align::Force, 0.0, false), 0.0);
 }
+
+/// Contact inhibition of locomotion: a cell pressed against along its polarity with a force
+/// `α` pushes with `α e^{−η}` (to round-off), and not at all less when the force is behind it;
+/// two cells driven head-on into each other (α = 0.04, 200 TU) press less, so they end farther
+/// apart and overlap less, with η = 3 than without.
+#[test]
+fn contact_inhibition_stalls_the_propulsion() {
+    let state = crate::CellState {
+        force: Vector2::new(-0.04, 0.0),
+        ..Default::default()
+    };
+    let cell = CellContext {
+        id: 0,
+        centre: [0.0; 2],
+        state: &state,
+        population: 0,
+        active: true,
+    };
+    let pol = Polarity::new(0.04).with_contact_inhibition(3.0);
+    let f = pol.force(&cell, &[0.0]);
+    assert!((f[0] - 0.04 * (-3.0f64).exp()).abs() < 1e-15, "{f:?}");
+    let behind = pol.force(&cell, &[std::f64::consts::PI]);
+    assert!((behind[0] + 0.04).abs() < 1e-15, "{behind:?}");
+
+    let head_on = |eta: f64| {
+        let lattice = Lattice::new(80, 48);
+        let shape = PatchShape::new(lattice, 14).unwrap();
+        let cells = init::discs(lattice, shape, &[[28.0, 24.0], [52.0, 24.0]], 8.0, 2.5);
+        let pol = Polarity::new(0.04).with_contact_inhibition(eta);
+        let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(Terms::new(1).with(pol));
+        t.terms_mut()
+            .set_variable("polarity/theta", &[0.0, std::f64::consts::PI])
+            .unwrap();
+        let mut ws = Workspace::new(t.cells());
+        for _ in 0..400 {
+            t.step(&mut ws, &StepParams::default()).unwrap();
+        }
+        let c = t.cells();
+        let overlap: f64 = (0..80)
+            .flat_map(|x| (0..48).map(move |y| (x, y)))
+            .map(|(x, y)| c.value_at(0, x, y) * c.value_at(1, x, y))
+            .sum();
+        let gap = displacement(t.centres()[0], t.centres()[1], 80.0).norm();
+        (gap, overlap)
+    };
+    let (free, inhibited) = (head_on(0.0), head_on(3.0));
+    eprintln!("head-on (distance, overlap): without {free:?}, with eta = 3 {inhibited:?}");
+    assert!(
+        inhibited.0 > free.0 && inhibited.1 < free.1,
+        "{free:?} {inhibited:?}"
+    );
+}
+
+/// A rejected adaptive step draws the same noise again: with rotational diffusion alone, every
+/// accepted step of size h turns each cell by exactly `√h √(2 D_r) N(seed, cell, step)`, however
+/// many attempts it took (the test makes the first attempts too large to be accepted).
+#[test]
+fn a_rejected_adaptive_step_replays_its_noise() {
+    let lattice = Lattice::new(48, 48);
+    let shape = PatchShape::new(lattice, 12).unwrap();
+    let cells = init::discs(lattice, shape, &[[14.0, 14.0], [34.0, 30.0]], 6.0, 2.5);
+    let d_r = 0.01;
+    let pol = Polarity::new(0.04).with_rotational_diffusion(d_r);
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(Terms::new(9).with(pol));
+    let mut ws = Workspace::new(t.cells());
+    let params = crate::AdaptiveParams::new(1e-4, 2.0);
+    let mut ctrl = crate::Controller::new(2.0);
+    for _ in 0..20 {
+        let before = t.terms().state("polarity").unwrap().to_vec();
+        let step = t.iteration();
+        let h = t
+            .step_adaptive(&mut ws, &params, &mut ctrl, f64::INFINITY, &mut ())
+            .unwrap();
+        for (id, (a, b)) in before
+            .iter()
+            .zip(t.terms().state("polarity").unwrap())
+            .enumerate()
+        {
+            let n = NoiseKey {
+                seed: 9,
+                cell: id as u64,
+                step,
+                stage: 0,
+            }
+            .normal();
+            let expected = a + h.sqrt() * (2.0 * d_r).sqrt() * n;
+            assert!(
+                (b - expected).abs() < 1e-14,
+                "step {step}, cell {id}: {b} against {expected}"
+            );
+        }
+    }
+    assert!(
+        ctrl.rejected > 0,
+        "no attempt was rejected, so nothing was tested"
+    );
+}
