@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 36] = [
+const KEYS: [&str; 38] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -155,6 +155,8 @@ const KEYS: [&str; 36] = [
     "polarity.angle",
     "adhesion.omega",
     "polarity.contact_inhibition",
+    "population.0.gamma",
+    "population.1.zeta",
 ];
 const VALUES: [&str; 36] = [
     "0",

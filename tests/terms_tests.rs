@@ -33,3 +33,39 @@ fn soft_cells_deform_more_than_stiff_ones() {
     assert!(soft > 1.5 * stiff, "soft |S| {soft} against stiff {stiff}");
     assert!(a[1] / n[1] > a[0] / n[0], "areas {a:?}");
 }
+
+/// `--set population.K.key=value` changes the K-th `[[population]]` table (so that sweeps can
+/// vary a population's parameters); a position that is not there, or no position, is an error
+/// that says how the tables are numbered.
+#[test]
+fn a_population_is_set_by_its_position() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenes/mixture.toml"
+    ))
+    .unwrap();
+    let s = Scene::parse(
+        &text,
+        &["population.1.gamma=0.02".into(), "population.0.xi=3".into()],
+    )
+    .unwrap();
+    let kinds = s.populations();
+    assert_eq!(kinds.kinds()[1].gamma, Some(0.02));
+    assert_eq!(kinds.kinds()[0].xi, Some(3.0));
+    assert_eq!(
+        kinds.kinds()[0].gamma,
+        Some(0.05),
+        "the rest of the table is kept"
+    );
+    let e = Scene::parse(&text, &["population.2.gamma=0.02".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("2 [[population]] tables, numbered from 0"),
+        "{e}"
+    );
+    let e = Scene::parse(&text, &["population.gamma=0.02".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--set population.0.gamma"), "{e}");
+}

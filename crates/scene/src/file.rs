@@ -492,6 +492,29 @@ fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
             toml::Value::String(v.to_string())
         }
     };
+    // An array of tables (`[[population]]`): `section.K.key` sets the key of its K-th table.
+    if let Some(toml::Value::Array(items)) = table.get_mut(section) {
+        let Some((index, key)) = key.split_once('.') else {
+            return Err(bad(&format!(
+                "[[{section}]] is a list of tables: name one by its position from 0, e.g. --set {section}.0.{key}=..."
+            )));
+        };
+        let n = items.len();
+        let item = index
+            .parse::<usize>()
+            .ok()
+            .and_then(|k| items.get_mut(k))
+            .ok_or_else(|| {
+                bad(&format!(
+                    "the scene has {n} [[{section}]] tables, numbered from 0; {index} is not one of them"
+                ))
+            })?;
+        let toml::Value::Table(item) = item else {
+            return Err(bad("that entry is not a table"));
+        };
+        item.insert(key.to_string(), value);
+        return Ok(());
+    }
     let sec = table
         .entry(section.to_string())
         .or_insert_with(|| toml::Value::Table(toml::Table::new()));
