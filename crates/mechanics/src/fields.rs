@@ -7,7 +7,7 @@ use phasefield::Real;
 use crate::geometry::TracelessTensor;
 use crate::scatter::scatter;
 use crate::tissue::Tissue;
-use crate::workspace::{SumField, Workspace};
+use crate::workspace::{CellState, SumField, Workspace};
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -35,6 +35,13 @@ impl<T: Real> Tissue<T> {
     /// Scatters the tissue velocity `Σ_i φ_i v_i` into the workspace, from the velocities
     /// of the last evaluation.
     pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
+        self.scatter_pair(ws, |c| [c.velocity.x, c.velocity.y]);
+    }
+
+    /// Scatters `Σ_i φ_i a_i` of a per-cell pair `a_i = value(cell state)` of the last
+    /// evaluation into the workspace's two-field lattice buffer
+    /// ([`Workspace::velocity_field`]).
+    fn scatter_pair(&self, ws: &mut Workspace<T>, value: impl Fn(&CellState) -> [f64; 2] + Sync) {
         let Workspace {
             cell_state,
             velocity_field,
@@ -46,8 +53,8 @@ impl<T: Real> Tissue<T> {
             self.cells.phi(),
             velocity_field,
             |i, run, sums| {
-                let [ux, uy] = [cs[i].velocity.x, cs[i].velocity.y];
-                run.add_to([], |s, []| [s.c * ux, s.c * uy], sums);
+                let [a, b] = value(&cs[i]);
+                run.add_to([], |s, []| [s.c * a, s.c * b], sums);
             },
             |_| {},
         );
@@ -79,24 +86,8 @@ impl<T: Real> Tissue<T> {
         f.sigma_yy = (0..n).map(|k| -f.pressure[k] + zeta * f.qxx[k]).collect();
         f.sigma_xy = (0..n).map(|k| -zeta * f.qxy[k]).collect();
         if mixed {
-            let Workspace {
-                cell_state,
-                velocity_field,
-                ..
-            } = ws;
-            let cs: &[_] = cell_state;
-            scatter::<2, T, _, _>(
-                &self.cells,
-                self.cells.phi(),
-                velocity_field,
-                |i, run, sums| {
-                    let [sxx, sxy] = cs[i].shape.components();
-                    run.add_to([], |s, []| [s.c * sxx, s.c * sxy], sums);
-                },
-                |_| {},
-            );
-            f.qxx = velocity_field.field(0);
-            f.qxy = velocity_field.field(1);
+            self.scatter_pair(ws, |c| c.shape.components());
+            [f.qxx, f.qxy] = ws.velocity_field();
         }
         f
     }

@@ -199,7 +199,7 @@ impl<T: Real> Tissue<T> {
         check.check(at, cell_state)?;
         self.cells.swap_phi(phi_old);
         if !self.terms.is_empty() {
-            self.with_terms_view(cell_state, |terms, view| terms.begin(view, view.iteration));
+            self.with_terms_view(cell_state, |terms, view| terms.begin(view));
         }
         if let Some(h) = predict {
             if fused {
@@ -217,21 +217,28 @@ impl<T: Real> Tissue<T> {
         self.params.omega == 0.0
     }
 
-    /// Calls `f` with the terms and what they see of every slot.
-    fn with_terms_view(
-        &mut self,
-        cell_state: &[CellState],
-        f: impl FnOnce(&mut crate::terms::Terms, &CellsView<'_>),
-    ) {
-        let view = CellsView {
-            cells: cell_state,
+    /// What the terms see of every slot, with the per-cell quantities `cells`.
+    fn terms_view<'a>(&'a self, cells: &'a [CellState]) -> CellsView<'a> {
+        CellsView {
+            cells,
             ids: &self.cell_id,
             centres: &self.centre,
             active: self.active,
             populations: &self.populations,
             iteration: self.iteration,
-        };
-        f(&mut self.terms, &view);
+        }
+    }
+
+    /// Calls `f` with the terms and what they see of every slot (the terms are moved out
+    /// for the call, which allocates nothing).
+    fn with_terms_view(
+        &mut self,
+        cell_state: &[CellState],
+        f: impl FnOnce(&mut crate::terms::Terms, &CellsView<'_>),
+    ) {
+        let mut terms = std::mem::take(&mut self.terms);
+        f(&mut terms, &self.terms_view(cell_state));
+        self.terms = terms;
     }
 
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
@@ -370,15 +377,7 @@ impl<T: Real> Tissue<T> {
         let cell_force = if self.terms.is_empty() {
             None
         } else {
-            let view = CellsView {
-                cells: cell_state,
-                ids: &self.cell_id,
-                centres: &self.centre,
-                active: self.active,
-                populations: &self.populations,
-                iteration: self.iteration,
-            };
-            self.terms.forces(&view, cell_force);
+            self.terms.forces(&self.terms_view(cell_state), cell_force);
             Some(&*cell_force)
         };
         evaluate(

@@ -310,9 +310,10 @@ impl Terms {
         }
     }
 
-    /// The start of a step from `iteration`: keeps the state, its rate and the step's noise
-    /// for [`Terms::predict`] and [`Terms::correct`].
-    pub(crate) fn begin(&mut self, view: &CellsView<'_>, iteration: u64) {
+    /// The start of a step from `view.iteration`: keeps the state, its rate and the step's
+    /// noise for [`Terms::predict`] and [`Terms::correct`].
+    pub(crate) fn begin(&mut self, view: &CellsView<'_>) {
+        let iteration = view.iteration;
         let seed = self.seed;
         for (t, e) in self.entries.iter_mut().enumerate() {
             let len = e.len;
@@ -342,7 +343,7 @@ impl Terms {
         }
     }
 
-    /// The predictor `x = x_old + h r_1 + √h b N` from what [`Terms::start`] kept (again
+    /// The predictor `x = x_old + h r_1 + √h b N` from what [`Terms::begin`] kept (again
     /// after a rejected adaptive attempt, with the same noise).
     pub(crate) fn predict(&mut self, h: f64) {
         let sqrt_h = h.sqrt();
