@@ -444,8 +444,13 @@ impl SceneFile {
         if self.population.is_empty() {
             return Populations::default();
         }
-        let kinds = self
-            .population
+        let counts: Vec<usize> = self.population.iter().map(|p| p.count).collect();
+        Populations::new(self.population_kinds(), &counts, self.run.seed)
+    }
+
+    /// The parameters each `[[population]]` overrides, in order.
+    pub fn population_kinds(&self) -> Vec<Population> {
+        self.population
             .iter()
             .map(|p| {
                 let mut k = Population::new();
@@ -456,9 +461,7 @@ impl SceneFile {
                 k.zeta = p.zeta;
                 k
             })
-            .collect();
-        let counts: Vec<usize> = self.population.iter().map(|p| p.count).collect();
-        Populations::new(kinds, &counts, self.run.seed)
+            .collect()
     }
 
     /// The integrator parameters.

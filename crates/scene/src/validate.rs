@@ -700,17 +700,9 @@ impl SceneFile {
     pub(crate) fn stability_estimate(&self) -> f64 {
         let base = self.model_params(self.model.zeta);
         // The smallest over the populations, each with its own constants.
-        self.population
+        self.population_kinds()
             .iter()
-            .map(|p| {
-                let mut m = base;
-                m.energy.gamma = p.gamma.unwrap_or(m.energy.gamma);
-                m.energy.mu = p.mu.unwrap_or(m.energy.mu);
-                m.energy.radius = p.radius.unwrap_or(m.energy.radius);
-                m.xi = p.xi.unwrap_or(m.xi);
-                m.zeta = p.zeta.unwrap_or(m.zeta);
-                m.max_stable_dt()
-            })
+            .map(|p| p.params(&base).max_stable_dt())
             .fold(base.max_stable_dt(), f64::min)
     }
 }

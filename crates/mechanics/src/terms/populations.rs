@@ -12,7 +12,7 @@
 //! so that populations that override nothing step exactly as the tissue without them, to the
 //! bit. A population's ζ acts while the activity is on ([`crate::Tissue::active`]).
 
-use phasefield::{EnergyCoefficients, EnergyParams};
+use phasefield::EnergyCoefficients;
 
 use super::NoiseKey;
 use crate::ModelParams;
@@ -62,6 +62,18 @@ impl Population {
     pub fn with_zeta(mut self, v: f64) -> Self {
         self.zeta = Some(v);
         self
+    }
+
+    /// The model parameters of this population: the tissue's `base` with its own γ, μ, R, ξ
+    /// and ζ where it gives them.
+    pub fn params(&self, base: &ModelParams) -> ModelParams {
+        let mut m = *base;
+        m.energy.gamma = self.gamma.unwrap_or(m.energy.gamma);
+        m.energy.mu = self.mu.unwrap_or(m.energy.mu);
+        m.energy.radius = self.radius.unwrap_or(m.energy.radius);
+        m.xi = self.xi.unwrap_or(m.xi);
+        m.zeta = self.zeta.unwrap_or(m.zeta);
+        m
     }
 }
 
@@ -148,15 +160,10 @@ impl Populations {
         (0..self.kinds.len()).any(|k| self.zeta(k, params, active) != params.zeta)
     }
 
-    /// The energy parameters of population `k` from the tissue's.
-    pub fn energy(&self, k: usize, base: &EnergyParams) -> EnergyParams {
-        let mut e = *base;
-        if let Some(p) = self.kinds.get(k) {
-            e.gamma = p.gamma.unwrap_or(e.gamma);
-            e.mu = p.mu.unwrap_or(e.mu);
-            e.radius = p.radius.unwrap_or(e.radius);
-        }
-        e
+    /// The model parameters of population `k` ([`Population::params`]; the tissue's `base`
+    /// for a population that is not there).
+    pub fn params(&self, k: usize, base: &ModelParams) -> ModelParams {
+        self.kinds.get(k).map_or(*base, |p| p.params(base))
     }
 
     /// The ζ of population `k`, with the activity on or off.
@@ -187,14 +194,17 @@ impl Populations {
             });
             return;
         }
-        out.extend((0..self.kinds.len()).map(|k| CellConstants {
-            coef: self.energy(k, &params.energy).coefficients(),
-            xi: self.kinds[k].xi.unwrap_or(params.xi),
-            zeta_weight: if mixed {
-                self.zeta(k, params, active)
-            } else {
-                1.0
-            },
+        out.extend((0..self.kinds.len()).map(|k| {
+            let own = self.params(k, params);
+            CellConstants {
+                coef: own.energy.coefficients(),
+                xi: own.xi,
+                zeta_weight: if mixed {
+                    self.zeta(k, params, active)
+                } else {
+                    1.0
+                },
+            }
         }));
     }
 
