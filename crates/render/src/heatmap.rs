@@ -179,12 +179,7 @@ fn draw_panel(p: &Heatmap, main: &Area<'_>, bar: &Area<'_>) -> Result<(), String
         .map_err(e)?;
     if let Some((au, av)) = &p.arrows {
         let every = p.arrow_every.max(1);
-        let amax = au
-            .iter()
-            .zip(av)
-            .map(|(a, b)| a.hypot(*b))
-            .filter(|m| m.is_finite())
-            .fold(0.0f64, f64::max);
+        let amax = crate::largest_norm(au, av);
         if amax > 0.0 {
             let len = 0.9 * every as f64 / amax;
             let centre = s / 2;
@@ -216,12 +211,7 @@ fn draw_panel(p: &Heatmap, main: &Area<'_>, bar: &Area<'_>) -> Result<(), String
     }
     if let Some((qxx, qxy)) = &p.director {
         let every = p.arrow_every.max(1);
-        let qmax = qxx
-            .iter()
-            .zip(qxy)
-            .map(|(a, b)| a.hypot(*b))
-            .filter(|m| m.is_finite())
-            .fold(0.0f64, f64::max);
+        let qmax = crate::largest_norm(qxx, qxy);
         if qmax > 0.0 {
             let centre = s / 2;
             let mut lines = Vec::new();

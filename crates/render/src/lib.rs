@@ -121,3 +121,13 @@ pub(crate) const PALETTE: [(u8, u8, u8); 10] = [
     (188, 189, 34),
     (23, 190, 207),
 ];
+
+/// The largest finite length `(a_k² + b_k²)^½` of a two-component field (0 when none is
+/// finite): what arrows and director marks are scaled to.
+pub(crate) fn largest_norm(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| a.hypot(*b))
+        .filter(|m| m.is_finite())
+        .fold(0.0f64, f64::max)
+}

@@ -432,12 +432,7 @@ impl TissuePicture {
             }
         }
         if let Some(f) = &self.flow {
-            let vmax =
-                f.a.iter()
-                    .zip(&f.b)
-                    .map(|(a, b)| a.hypot(*b))
-                    .filter(|m| m.is_finite())
-                    .fold(0.0f64, f64::max);
+            let vmax = crate::largest_norm(&f.a, &f.b);
             if vmax > 0.0 {
                 let len = 0.9 * f.every as f64 / vmax;
                 for (x, y) in sites(f.every) {
@@ -446,15 +441,8 @@ impl TissuePicture {
                     if !(a.is_finite() && b.is_finite()) || a.hypot(b) < 0.05 * f.every as f64 {
                         continue;
                     }
-                    self.periodic(c, x as f64, y as f64, f.every as f64, |c, (px, py), s| {
-                        let tip = (px + a * s, py - b * s);
-                        c.line((px, py), tip, line_w, FLOW);
-                        let (hx, hy) = (-0.35 * a * s, 0.35 * b * s);
-                        for ang in [0.45f64, -0.45] {
-                            let (cs, sn) = (ang.cos(), ang.sin());
-                            let end = (tip.0 + cs * hx - sn * hy, tip.1 + sn * hx + cs * hy);
-                            c.line(tip, end, line_w, FLOW);
-                        }
+                    self.periodic(c, x as f64, y as f64, f.every as f64, |c, p, s| {
+                        arrow(c, p, (a * s, b * s), line_w, FLOW);
                     });
                 }
             }
@@ -509,14 +497,7 @@ impl TissuePicture {
                 }
                 let (a, b) = (p[0] * len, p[1] * len);
                 self.periodic(c, ctr[0], ctr[1], len, |c, (px, py), s| {
-                    let tip = (px + a * s, py - b * s);
-                    c.line((px, py), tip, 1.5 * line_w, POLARITY);
-                    let (hx, hy) = (-0.35 * a * s, 0.35 * b * s);
-                    for ang in [0.45f64, -0.45] {
-                        let (cs, sn) = (ang.cos(), ang.sin());
-                        let end = (tip.0 + cs * hx - sn * hy, tip.1 + sn * hx + cs * hy);
-                        c.line(tip, end, 1.5 * line_w, POLARITY);
-                    }
+                    arrow(c, (px, py), (a * s, b * s), 1.5 * line_w, POLARITY);
                     c.disc(px, py, 1.2 * line_w, POLARITY);
                 });
             }
@@ -595,5 +576,18 @@ impl TissuePicture {
             .map_err(e)?;
         }
         root.present().map_err(|e| e.to_string())
+    }
+}
+
+/// An arrow from the pixel `from` along the lattice vector `(a, b)` in pixels (y up), with a
+/// head of two strokes at ±0.45 rad, a third of the shaft long.
+fn arrow(c: &mut Canvas<'_>, from: (f64, f64), (a, b): (f64, f64), width: f64, colour: [u8; 3]) {
+    let tip = (from.0 + a, from.1 - b);
+    c.line(from, tip, width, colour);
+    let (hx, hy) = (-0.35 * a, 0.35 * b);
+    for ang in [0.45f64, -0.45] {
+        let (cs, sn) = (ang.cos(), ang.sin());
+        let end = (tip.0 + cs * hx - sn * hy, tip.1 + sn * hx + cs * hy);
+        c.line(tip, end, width, colour);
     }
 }

@@ -8,12 +8,16 @@ use rayon::prelude::*;
 use super::*;
 use crate::{ModelParams, StepParams, Tissue, Workspace};
 
-/// One paper cell (R = 8) on a 48² lattice with margin 14, relaxed at rest for 100 TU.
-fn relaxed_cell(terms: Terms) -> (Tissue, Workspace) {
-    let lattice = Lattice::new(48, 48);
-    let shape = PatchShape::new(lattice, 14).expect("margin 14 fits 48²");
-    let cells = init::discs(lattice, shape, &[[24.0, 24.0]], 8.0, 2.5);
-    let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(terms);
+/// One paper cell (R = 8, interface width `lambda`) on an `l × l` lattice with margin
+/// `margin`, relaxed at rest (activity off) for 100 TU, with the terms `terms`.
+fn relaxed(l: usize, margin: usize, lambda: f64, terms: Terms) -> (Tissue, Workspace) {
+    let lattice = Lattice::new(l, l);
+    let shape = PatchShape::new(lattice, margin).expect("the margin fits the lattice");
+    let half = l as f64 / 2.0;
+    let cells = init::discs(lattice, shape, &[[half, half]], 8.0, lambda);
+    let mut p = ModelParams::paper(0.0);
+    p.energy.lambda = lambda;
+    let mut t = Tissue::new(cells, p).with_terms(terms);
     let mut ws = Workspace::new(t.cells());
     t.set_active(false);
     for _ in 0..200 {
@@ -21,6 +25,11 @@ fn relaxed_cell(terms: Terms) -> (Tissue, Workspace) {
     }
     t.set_active(true);
     (t, ws)
+}
+
+/// One paper cell on a 48² lattice with margin 14, relaxed at rest for 100 TU.
+fn relaxed_cell(terms: Terms) -> (Tissue, Workspace) {
+    relaxed(48, 14, 2.5, terms)
 }
 
 /// The displacement of a periodic centre from `a` to `b`, the shortest way round.
@@ -32,20 +41,8 @@ fn displacement(a: [f64; 2], b: [f64; 2], l: f64) -> Vector2<f64> {
 /// One paper cell (R = 8, interface width `lambda`) on 64² with margin 16, relaxed at rest
 /// for 100 TU, with a polarity `alpha` along x.
 fn polar_cell(lambda: f64, alpha: f64) -> (Tissue, Workspace) {
-    let lattice = Lattice::new(64, 64);
-    let shape = PatchShape::new(lattice, 16).unwrap();
-    let cells = init::discs(lattice, shape, &[[32.0, 32.0]], 8.0, lambda);
-    let mut p = ModelParams::paper(0.0);
-    p.energy.lambda = lambda;
     let pol = Polarity::new(alpha).with_initial_angle(0.0);
-    let mut t = Tissue::new(cells, p).with_terms(Terms::new(1).with(pol));
-    let mut ws = Workspace::new(t.cells());
-    t.set_active(false);
-    for _ in 0..200 {
-        t.step(&mut ws, &StepParams::default()).unwrap();
-    }
-    t.set_active(true);
-    (t, ws)
+    relaxed(64, 16, lambda, Terms::new(1).with(pol))
 }
 
 /// T1.1 of the extensions: an isolated polar cell moves along its polarity at α/ξ.
@@ -88,16 +85,21 @@ fn an_isolated_polar_cell_moves_at_alpha_over_xi() {
     );
 }
 
+/// Four cells on 48² (margin 10) at ζ = 0.01, for comparisons to the bit.
+fn four_cells() -> Tissue {
+    let lattice = Lattice::new(48, 48);
+    let shape = PatchShape::new(lattice, 10).unwrap();
+    let centres = [[12.0, 12.0], [25.0, 14.0], [18.0, 30.0], [34.0, 34.0]];
+    let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
+    Tissue::new(cells, ModelParams::paper(0.01))
+}
+
 /// A polarity that pushes with α = 0 and does not turn changes nothing: the step with it is
 /// the step without terms, to the bit (the term path adds an exact zero).
 #[test]
 fn a_term_that_adds_nothing_changes_nothing_to_the_bit() {
     let run = |terms: Option<Terms>| {
-        let lattice = Lattice::new(48, 48);
-        let shape = PatchShape::new(lattice, 10).unwrap();
-        let centres = [[12.0, 12.0], [25.0, 14.0], [18.0, 30.0], [34.0, 34.0]];
-        let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
-        let mut t = Tissue::new(cells, ModelParams::paper(0.01));
+        let mut t = four_cells();
         if let Some(terms) = terms {
             t = t.with_terms(terms);
         }
@@ -423,11 +425,7 @@ fn a_doublet_adheres_more_with_omega() {
 #[test]
 fn uniform_populations_are_the_scalar_model_to_the_bit() {
     let run = |pops: Option<Populations>| {
-        let lattice = Lattice::new(48, 48);
-        let shape = PatchShape::new(lattice, 10).unwrap();
-        let centres = [[12.0, 12.0], [25.0, 14.0], [18.0, 30.0], [34.0, 34.0]];
-        let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
-        let mut t = Tissue::new(cells, ModelParams::paper(0.01));
+        let mut t = four_cells();
         if let Some(p) = pops {
             t = t.with_populations(p);
         }
