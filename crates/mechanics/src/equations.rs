@@ -180,6 +180,30 @@ pub fn adhesion_pressure(c: f64, s1: f64, lap_s1: f64) -> f64 {
     -c * s1 * lap_s1
 }
 
+/// The wall coefficients `[2κ_w/λ, 2ω_wλ]` of the wall energy
+/// `F_wall = Σ_i Σ_x [(κ_w/λ) φ_i² w² + 2ω_wλ ∇φ_i·∇w]` (docs/model.md §11.4), with `w` the
+/// static wall field (`phasefield::WallField`).
+#[inline(always)]
+pub fn wall_coefficients(kappa_w: f64, omega_w: f64, lambda: f64) -> [f64; 2] {
+    [2.0 * kappa_w / lambda, 2.0 * omega_w * lambda]
+}
+
+/// The wall part of `δF/δφ_i` at a node: `(2κ_w/λ) φ_i w² − 2ω_wλ ∇²w`, with `c` =
+/// [`wall_coefficients`] and `lap_w` the lattice Laplacian of `w`.
+#[inline(always)]
+pub fn wall_derivative(c: [f64; 2], phi: f64, w: f64, lap_w: f64) -> f64 {
+    c[0] * phi * (w * w) - c[1] * lap_w
+}
+
+/// The wall part of the pressure, the φ-weighted sum of [`wall_derivative`] over the cells,
+/// `Σ_i φ_i δF_wall/δφ_i = (2κ_w/λ) w² s2 − 2ω_wλ ∇²w s1`, in both pressure forms (the
+/// reference code's: wall terms are interaction terms; the paper form's unweighted sum would
+/// put `−2ω_wλ N ∇²w` wherever the wall field curves, cells there or not).
+#[inline(always)]
+pub fn wall_pressure(c: [f64; 2], s1: f64, s2: f64, w: f64, lap_w: f64) -> f64 {
+    c[0] * (w * w) * s2 - c[1] * lap_w * s1
+}
+
 /// The Heun predictor (a forward-Euler step): `φ* = φⁿ + Δt R(φⁿ)` (docs/model.md §4).
 #[inline(always)]
 pub fn heun_predictor(phi_old: f64, dt: f64, r_old: f64) -> f64 {

@@ -19,13 +19,14 @@ use std::cell::RefCell;
 
 use nalgebra::Vector2;
 use phasefield::kernel::{add_lanes, PaddedParts, PaddedPatch, LANES};
-use phasefield::{Cells, ComTable, PatchShape, Real, Stencil};
+use phasefield::{Cells, ComTable, PatchShape, Real, Stencil, WallField};
 use rayon::prelude::*;
 
 use crate::equations::{
     adhesion_coefficient, adhesion_derivative, adhesion_pressure, adhesion_pressure_cell_part,
     force_density, heun_corrector, heun_predictor, nematic_density, pressure, pressure_cell_part,
     pressure_self_coefficient, pressure_self_part_with, rhs, shape_tensor_density, velocity,
+    wall_derivative, wall_pressure,
 };
 use crate::geometry::TracelessTensor;
 use crate::params::{ModelParams, PressureKind};
@@ -200,6 +201,7 @@ pub(crate) fn evaluate<T: Real>(
     lap_s1: &mut [f64],
     cells_of: (&Populations, &[usize], bool),
     kind_constants: &mut Vec<CellConstants>,
+    walls: Option<WallTerm<'_>>,
     post: Post<'_, T>,
 ) {
     let (pops, ids, active) = cells_of;
@@ -308,6 +310,10 @@ pub(crate) fn evaluate<T: Real>(
     if c_adh != 0.0 {
         add_adhesion_pressure(c_adh, global, lap_s1);
     }
+    // Walls: their part of the pressure.
+    if let Some(walls) = walls {
+        add_wall_pressure(walls, global);
+    }
 
     // 3. Forces, velocities and the right-hand side.
     let g: &LatticeSums<N_SUMS> = global;
@@ -391,9 +397,10 @@ pub(crate) fn evaluate<T: Real>(
             }
         }
     };
+    let sweep = c_adh != 0.0 || walls.is_some();
     assert!(
-        c_adh == 0.0 || matches!(post, Post::Nothing),
-        "adhesion adds to the right-hand side after the force pass, so the Heun update cannot be fused into it"
+        !sweep || matches!(post, Post::Nothing),
+        "adhesion and walls add to the right-hand side after the force pass, so the Heun update cannot be fused into it"
     );
     let cells_iter = rhs_out
         .par_chunks_mut(plen)
@@ -446,14 +453,43 @@ pub(crate) fn evaluate<T: Real>(
                 });
         }
     }
-    if c_adh != 0.0 {
+    if sweep {
+        let lap_s1: &[f64] = lap_s1;
         rhs_out
             .par_chunks_mut(plen)
             .zip(phi.par_chunks(plen))
             .enumerate()
             .for_each(|(i, (out, cell))| {
-                add_adhesion_rhs(c_adh, cells, i, cell, lap_s1, out);
+                add_node_terms_rhs(c_adh, lap_s1, walls, cells, i, cell, out);
             });
+    }
+}
+
+/// The walls of an evaluation: the field in effect and its coefficients
+/// ([`crate::equations::wall_coefficients`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WallTerm<'a> {
+    pub field: &'a WallField,
+    pub coefficients: [f64; 2],
+}
+
+/// The walls' part of the pressure, [`wall_pressure`], added node by node once the scatter
+/// has completed the sums.
+fn add_wall_pressure(walls: WallTerm<'_>, sums: &mut LatticeSums<N_SUMS>) {
+    let lattice = sums.lattice();
+    let ly = lattice.ly;
+    let (w, lap) = (walls.field.w(), walls.field.laplacian());
+    for x in 0..lattice.lx {
+        let ([s1, s2], p) = sums.columns_read_write([I_S1, I_S2], I_P, x);
+        let range = x * ly..(x + 1) * ly;
+        for (((p, &s2), &s1), (&w, &lap)) in p
+            .iter_mut()
+            .zip(s2)
+            .zip(s1)
+            .zip(w[range.clone()].iter().zip(&lap[range]))
+        {
+            *p += wall_pressure(walls.coefficients, s1, s2, w, lap);
+        }
     }
 }
 
@@ -484,22 +520,23 @@ fn add_adhesion_pressure(c: f64, sums: &mut LatticeSums<N_SUMS>, lap_s1: &mut [f
         }
     });
     for x in 0..lx {
-        let (s1, p) = sums.column_pair_mut(I_S1, I_P, x);
+        let ([s1], p) = sums.columns_read_write([I_S1], I_P, x);
         for ((p, &s1), &lap) in p.iter_mut().zip(s1).zip(&lap_s1[x * ly..(x + 1) * ly]) {
             *p += adhesion_pressure(c, s1, lap);
         }
     }
 }
 
-/// Adds the adhesion's part of `−δF/δφ_i`, `c (∇²s1 − ∇²φ_i)` ([`adhesion_derivative`]), to
-/// cell `i`'s right-hand side `out`, node by node (a sweep of its own, run only with
-/// adhesion).
-fn add_adhesion_rhs<T: Real>(
+/// Adds the node-loop terms' part of `−δF/δφ_i` to cell `i`'s right-hand side `out`, node
+/// by node (a sweep of its own, run only with them): the adhesion's `c (∇²s1 − ∇²φ_i)`
+/// ([`adhesion_derivative`], with `c ≠ 0`) and the walls' ([`wall_derivative`]).
+fn add_node_terms_rhs<T: Real>(
     c: f64,
+    lap_s1: &[f64],
+    walls: Option<WallTerm<'_>>,
     cells: &Cells<T>,
     i: usize,
     cell: &[T],
-    lap_s1: &[f64],
     out: &mut [T],
 ) {
     let shape = cells.shape();
@@ -507,7 +544,17 @@ fn add_adhesion_rhs<T: Real>(
     let (xs, ys) = (cells.map().cell_x(shape, i), cells.map().cell_y(shape, i));
     phasefield::for_each_stencil_at(cell, shape, |k, a, b, s| {
         let node = xs[a] as usize * ly + ys[b] as usize;
-        let r = out[k].to_f64() - adhesion_derivative(c, lap_s1[node], s.laplacian());
+        let mut r = out[k].to_f64();
+        if c != 0.0 {
+            r -= adhesion_derivative(c, lap_s1[node], s.laplacian());
+        }
+        if let Some(WallTerm {
+            field,
+            coefficients,
+        }) = walls
+        {
+            r -= wall_derivative(coefficients, s.c, field.w()[node], field.laplacian()[node]);
+        }
         out[k] = T::from_f64(r);
     });
 }

@@ -65,6 +65,7 @@ mod simulation;
 mod step;
 pub mod terms;
 mod tissue;
+pub mod walls;
 mod workspace;
 
 pub use adaptive::{AdaptiveParams, Controller};

@@ -156,22 +156,26 @@ impl<const K: usize> LatticeSums<K> {
         &self.data[start..start + self.lattice.ly]
     }
 
-    /// Lattice column `x` of field `read`, and of field `write` to change (`read < write`).
+    /// Lattice column `x` of the fields `read`, and of field `write` to change (every read
+    /// field before it).
     ///
     /// # Panics
-    /// If `read >= write`, `write >= K` or `x >= lx`.
-    pub(crate) fn column_pair_mut(
+    /// If a read field is not below `write`, `write >= K` or `x >= lx`.
+    pub(crate) fn columns_read_write<const R: usize>(
         &mut self,
-        read: usize,
+        read: [usize; R],
         write: usize,
         x: usize,
-    ) -> (&[f64], &mut [f64]) {
-        assert!(read < write && write < K && x < self.lattice.lx);
+    ) -> ([&[f64]; R], &mut [f64]) {
+        assert!(read.iter().all(|&r| r < write) && write < K && x < self.lattice.lx);
         let (base, stride) = self.locate(x);
         let ly = self.lattice.ly;
         let (a, b) = self.data.split_at_mut(base + write * stride);
-        let r = base + read * stride;
-        (&a[r..r + ly], &mut b[..ly])
+        let a: &[f64] = a;
+        (
+            read.map(|r| &a[base + r * stride..base + r * stride + ly]),
+            &mut b[..ly],
+        )
     }
 
     /// The lattice.

@@ -4,8 +4,8 @@
 use phasefield::Real;
 use rayon::prelude::*;
 
-use crate::equations::{heun_corrector, heun_predictor};
-use crate::kernels::{evaluate, Post};
+use crate::equations::{heun_corrector, heun_predictor, wall_coefficients};
+use crate::kernels::{evaluate, Post, WallTerm};
 use crate::params::StepParams;
 use crate::scatter::LatticeSums;
 use crate::terms::CellsView;
@@ -211,10 +211,19 @@ impl<T: Real> Tissue<T> {
         Ok(())
     }
 
-    /// Whether the Heun update is fused into the force pass: not with adhesion, which adds to
-    /// the right-hand side after it.
+    /// Whether the Heun update is fused into the force pass: not with adhesion or walls,
+    /// which add to the right-hand side after it.
     fn fuses(&self) -> bool {
-        self.params.omega == 0.0
+        self.params.omega == 0.0 && self.wall_field().is_none()
+    }
+
+    /// The walls in effect, with their coefficients.
+    fn wall_term(&self) -> Option<WallTerm<'_>> {
+        let walls = self.walls.as_ref()?;
+        Some(WallTerm {
+            field: walls.field(self.active)?,
+            coefficients: wall_coefficients(walls.kappa, walls.omega, self.params.energy.lambda),
+        })
     }
 
     /// What the terms see of every slot, with the per-cell quantities `cells`.
@@ -392,6 +401,7 @@ impl<T: Real> Tissue<T> {
             lap_s1,
             (&self.populations, &self.cell_id, self.active),
             kind_constants,
+            self.wall_term(),
             post,
         );
     }

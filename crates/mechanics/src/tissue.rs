@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use crate::params::ModelParams;
 use crate::terms::{Populations, Terms};
+use crate::walls::Walls;
 
 /// Side, in nodes, of the blocks of the Morton order used by [`Tissue::sort_cells`]: about
 /// a cell radius, so that a block holds a cell or two.
@@ -36,6 +37,8 @@ pub struct Tissue<T: Real = f64> {
     pub(crate) active: bool,
     /// Per-cell parameters (empty: every cell has `params`').
     pub(crate) populations: Populations,
+    /// Walls (`crate::walls`), if any.
+    pub(crate) walls: Option<Walls>,
 }
 
 impl<T: Real> Tissue<T> {
@@ -44,6 +47,7 @@ impl<T: Real> Tissue<T> {
     pub fn heap_bytes(&self) -> usize {
         self.cells.heap_bytes()
             + self.terms.heap_bytes()
+            + self.walls.as_ref().map_or(0, Walls::heap_bytes)
             + self.centre.capacity() * std::mem::size_of::<[f64; 2]>()
             + self.cell_id.capacity() * std::mem::size_of::<usize>()
     }
@@ -90,6 +94,7 @@ impl<T: Real> Tissue<T> {
             terms: Terms::default(),
             active: true,
             populations: Populations::default(),
+            walls: None,
         };
         let com = ComTable::new(t.cells.lattice());
         let mut centre = std::mem::take(&mut t.centre);
@@ -139,6 +144,7 @@ impl<T: Real> Tissue<T> {
             terms: Terms::default(),
             active: true,
             populations: Populations::default(),
+            walls: None,
         })
     }
 
@@ -163,6 +169,27 @@ impl<T: Real> Tissue<T> {
         );
         self.populations = populations;
         self
+    }
+
+    /// This tissue between walls (`crate::walls`).
+    pub fn with_walls(mut self, walls: Walls) -> Self {
+        assert_eq!(
+            walls.field(false).map(|f| f.lattice()),
+            Some(self.lattice()),
+            "the walls' lattice is the tissue's"
+        );
+        self.walls = Some(walls);
+        self
+    }
+
+    /// The walls, if any.
+    pub fn walls(&self) -> Option<&Walls> {
+        self.walls.as_ref()
+    }
+
+    /// The wall field in effect now (none without walls, or once a wound has opened).
+    pub fn wall_field(&self) -> Option<&phasefield::WallField> {
+        self.walls.as_ref().and_then(|w| w.field(self.active))
     }
 
     /// The populations (empty when every cell has the tissue's parameters).

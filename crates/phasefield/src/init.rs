@@ -5,6 +5,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::lattice::Lattice;
+use crate::walls::WallField;
 use crate::PhaseFieldError;
 use crate::{Cells, PatchShape};
 
@@ -29,6 +30,25 @@ pub enum Layout {
     Positions(Vec<[f64; 2]>),
 }
 
+/// Checks that `n_cells` discs of radius `disc_radius` cover at most
+/// [`MAX_INITIAL_COVERAGE`] of `free_nodes` nodes.
+fn check_fits_in(
+    free_nodes: usize,
+    n_cells: usize,
+    disc_radius: f64,
+) -> Result<(), PhaseFieldError> {
+    let disc = std::f64::consts::PI * disc_radius * disc_radius;
+    let room = MAX_INITIAL_COVERAGE * free_nodes as f64;
+    if n_cells as f64 * disc > room {
+        return Err(PhaseFieldError::TooManyCells {
+            n_cells,
+            max_cells: (room / disc).floor() as usize,
+            disc_radius,
+        });
+    }
+    Ok(())
+}
+
 /// Checks that `n_cells` discs of radius `disc_radius` fit in the domain.
 ///
 /// # Errors
@@ -38,18 +58,7 @@ pub fn check_fits(
     n_cells: usize,
     disc_radius: f64,
 ) -> Result<(), PhaseFieldError> {
-    let covered = n_cells as f64 * std::f64::consts::PI * disc_radius * disc_radius;
-    let max_cells = (MAX_INITIAL_COVERAGE * lattice.len() as f64
-        / (std::f64::consts::PI * disc_radius * disc_radius))
-        .floor() as usize;
-    if covered > MAX_INITIAL_COVERAGE * lattice.len() as f64 {
-        return Err(PhaseFieldError::TooManyCells {
-            n_cells,
-            max_cells,
-            disc_radius,
-        });
-    }
-    Ok(())
+    check_fits_in(lattice.len(), n_cells, disc_radius)
 }
 
 /// The centres of `n_cells` cells for a layout, with initial discs of radius `disc_radius`.
@@ -63,6 +72,32 @@ pub fn positions(
     disc_radius: f64,
     layout: &Layout,
 ) -> Result<Vec<[f64; 2]>, PhaseFieldError> {
+    positions_clear_of(lattice, n_cells, disc_radius, layout, None)
+}
+
+/// The distance from a wall at which a centre may be placed: the initial disc and one node
+/// more, so that no disc starts in a wall's solid.
+pub fn wall_clearance(disc_radius: f64) -> f64 {
+    disc_radius + 1.0
+}
+
+/// [`positions`] with walls: every centre at least [`wall_clearance`] from the solid of
+/// `walls` (random and hexagonal layouts place only there; given positions are checked).
+/// The coverage bound counts the free nodes only.
+///
+/// # Errors
+/// As [`positions`], and [`PhaseFieldError::BadPositions`] for a given centre too close to a
+/// wall.
+pub fn positions_clear_of(
+    lattice: Lattice,
+    n_cells: usize,
+    disc_radius: f64,
+    layout: &Layout,
+    walls: Option<&WallField>,
+) -> Result<Vec<[f64; 2]>, PhaseFieldError> {
+    let clear = |p: [f64; 2]| walls.is_none_or(|w| w.distance_at(p) >= wall_clearance(disc_radius));
+    let free_nodes = walls.map_or(lattice.len(), |w| w.free_nodes());
+    let fits = || check_fits_in(free_nodes, n_cells, disc_radius);
     match layout {
         Layout::Positions(p) => {
             if p.len() != n_cells {
@@ -85,10 +120,19 @@ pub fn positions(
                     )));
                 }
             }
+            if let Some(i) = p.iter().position(|&q| !clear(q)) {
+                return Err(PhaseFieldError::BadPositions(format!(
+                    "position {i} = [{}, {}] is {:.1} nodes from a wall, closer than the initial disc ({:.1} nodes with its edge)",
+                    p[i][0],
+                    p[i][1],
+                    walls.map_or(0.0, |w| w.distance_at(p[i])),
+                    wall_clearance(disc_radius)
+                )));
+            }
             Ok(p.clone())
         }
         Layout::Random { seed } => {
-            check_fits(lattice, n_cells, disc_radius)?;
+            fits()?;
             let mut rng = ChaCha8Rng::seed_from_u64(*seed);
             let mut out: Vec<[f64; 2]> = Vec::with_capacity(n_cells);
             let min_dist = 2.0 * disc_radius;
@@ -122,6 +166,9 @@ pub fn positions(
                     rng.random_range(0.0..lattice.lx as f64),
                     rng.random_range(0.0..lattice.ly as f64),
                 ];
+                if !clear(p) {
+                    continue;
+                }
                 let (ix, iy) = bin_of(p);
                 let mut free = true;
                 'near: for dx in [bx - 1, 0, 1] {
@@ -144,33 +191,65 @@ pub fn positions(
             Ok(out)
         }
         Layout::Hexagonal => {
-            check_fits(lattice, n_cells, disc_radius)?;
-            // Rows of spacing dy = dx·√3/2 with the aspect ratio of the domain.
-            let (lx, ly) = (lattice.lx as f64, lattice.ly as f64);
-            let per_cell = lx * ly / n_cells as f64;
-            let dx = (2.0 * per_cell / 3f64.sqrt()).sqrt();
-            let mut n_cols = ((lx / dx).round() as usize).max(1);
-            let mut n_rows = n_cells.div_ceil(n_cols);
-            if n_cols * n_rows < n_cells {
-                n_cols += 1;
-                n_rows = n_cells.div_ceil(n_cols);
+            fits()?;
+            let len = lattice.len() as f64;
+            if walls.is_none() {
+                return Ok(hexagonal(lattice, n_cells, len));
             }
-            let (sx, sy) = (lx / n_cols as f64, ly / n_rows as f64);
-            let mut out = Vec::with_capacity(n_cells);
-            'rows: for r in 0..n_rows {
-                for c in 0..n_cols {
-                    if out.len() == n_cells {
-                        break 'rows;
-                    }
-                    let shift = if r % 2 == 1 { 0.5 } else { 0.0 };
-                    out.push(
-                        lattice.wrap_point([(c as f64 + 0.25 + shift) * sx, (r as f64 + 0.5) * sy]),
-                    );
+            // With walls: a packing of the domain at the density of the free area, made
+            // denser step by step until enough of its sites are clear of the walls.
+            let mut area = free_nodes as f64;
+            for _ in 0..200 {
+                let n_sites = ((n_cells as f64 * len / area).ceil() as usize).max(n_cells);
+                let sites: Vec<_> = hexagonal(lattice, n_sites, len)
+                    .into_iter()
+                    .filter(|&p| clear(p))
+                    .collect();
+                if sites.len() >= n_cells {
+                    return Ok(spread(sites, n_cells));
                 }
+                area *= 0.97;
             }
-            Ok(out)
+            Err(PhaseFieldError::TooManyCells {
+                n_cells,
+                max_cells: 0,
+                disc_radius,
+            })
         }
     }
+}
+
+/// `n` of `sites` spread evenly through the list (which runs row by row).
+fn spread(sites: Vec<[f64; 2]>, n: usize) -> Vec<[f64; 2]> {
+    let m = sites.len();
+    (0..n).map(|k| sites[k * m / n]).collect()
+}
+
+/// A near-hexagonal packing of `n_cells` sites filling the domain row by row, at the density
+/// `n_cells / area`.
+fn hexagonal(lattice: Lattice, n_cells: usize, area: f64) -> Vec<[f64; 2]> {
+    // Rows of spacing dy = dx·√3/2 with the aspect ratio of the domain.
+    let (lx, ly) = (lattice.lx as f64, lattice.ly as f64);
+    let per_cell = area / n_cells as f64;
+    let dx = (2.0 * per_cell / 3f64.sqrt()).sqrt();
+    let mut n_cols = ((lx / dx).round() as usize).max(1);
+    let mut n_rows = n_cells.div_ceil(n_cols);
+    if n_cols * n_rows < n_cells {
+        n_cols += 1;
+        n_rows = n_cells.div_ceil(n_cols);
+    }
+    let (sx, sy) = (lx / n_cols as f64, ly / n_rows as f64);
+    let mut out = Vec::with_capacity(n_cells);
+    'rows: for r in 0..n_rows {
+        for c in 0..n_cols {
+            if out.len() == n_cells {
+                break 'rows;
+            }
+            let shift = if r % 2 == 1 { 0.5 } else { 0.0 };
+            out.push(lattice.wrap_point([(c as f64 + 0.25 + shift) * sx, (r as f64 + 0.5) * sy]));
+        }
+    }
+    out
 }
 
 /// Cells shaped as discs `φ = (1 − tanh((d − r₀)/λ))/2` of radius `r₀ = disc_radius` around

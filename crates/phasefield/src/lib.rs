@@ -39,6 +39,7 @@ mod real;
 mod runs;
 mod shape;
 mod stencil;
+pub mod walls;
 
 pub use cells::{Cells, PatchMap};
 pub use com::ComTable;
@@ -47,6 +48,7 @@ pub use lattice::{min_image, wrap_real, Lattice};
 pub use real::Real;
 pub use shape::PatchShape;
 pub use stencil::{for_each_stencil, for_each_stencil_at, Stencil};
+pub use walls::{WallField, WallShape};
 
 /// The SIMD machinery of the step's kernels: runs of patch rows, their stencils and lane sums.
 ///
