@@ -243,6 +243,70 @@ pub struct AdhesionSpec {
     pub omega: f64,
 }
 
+/// `[walls] kind`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WallKind {
+    /// Walls along x at the bottom and top rows (periodic in x), the free band `width` wide.
+    Channel,
+    /// Walls on all four edges.
+    Box,
+    /// Free inside a disc of `radius` (or an ellipse of `semi_axes`) centred in the domain.
+    Disc,
+    /// A band across the domain at its middle, `width` wide along x, removed when the
+    /// activity switches on (after `[run] relax_time`): a wound that opens.
+    Wound,
+    /// Walls read from the image or array file `mask`.
+    Mask,
+}
+
+/// `[walls]`: static walls that repel cells (and optionally adhere to them), docs/model.md
+/// §11.4; absent: none.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallsSpec {
+    /// The geometry.
+    pub kind: WallKind,
+    /// The decay length ℓ_w of the wall field `w = e^{−d/ℓ_w}` outside the solid, in nodes
+    /// (default 1; the reference code's examples 0.5–1).
+    #[serde(default = "default_wall_thickness")]
+    pub thickness: f64,
+    /// The wall repulsion κ_w (default 1, the reference code's examples).
+    #[serde(default = "default_wall_kappa")]
+    pub kappa: f64,
+    /// The wall adhesion ω_w (default 0).
+    #[serde(default)]
+    pub omega: f64,
+    /// `"channel"`: the free width in nodes (default `ly − 2`, one solid row at each edge);
+    /// `"wound"`: the band's width (default `lx / 4`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width: Option<f64>,
+    /// `"disc"`: its radius in nodes (default `min(lx, ly)/2 − 1`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// `"disc"`: an ellipse's semi-axes `[a, b]` along x and y instead of `radius`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub semi_axes: Option<[f64; 2]>,
+    /// `"mask"`: a PNG image (`lx` pixels wide, `ly` high, its top row at y = ly − 1) whose
+    /// bright pixels (luminance ≥ ½) are solid, or a `.npy` array of shape `(lx, ly)`,
+    /// indexed `[x, y]`, whose non-zero entries are solid. A relative path is taken from the
+    /// scene file's directory by `monolayer run`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mask: Option<String>,
+    /// `"mask"`: swap solid and free (for a micropattern image whose bright pixels are where
+    /// cells may be; default false).
+    #[serde(default)]
+    pub invert: bool,
+}
+
+fn default_wall_thickness() -> f64 {
+    1.0
+}
+
+fn default_wall_kappa() -> f64 {
+    1.0
+}
+
 /// `[[population]]`: a population of cells with parameters of their own (docs/model.md
 /// §11.3); absent: every cell has `[model]`'s. The counts must add up to `[cells] count`;
 /// cells are dealt to populations by a shuffle drawn from `[run] seed`.
@@ -372,6 +436,9 @@ pub struct SceneFile {
     /// `[[population]]`, when cells differ.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub population: Vec<PopulationSpec>,
+    /// `[walls]`, when the cells are confined.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walls: Option<WallsSpec>,
 }
 
 impl SceneFile {

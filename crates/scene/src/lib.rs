@@ -35,8 +35,12 @@
 
 mod file;
 mod validate;
+mod walls;
 
-pub use file::{CellsSpec, Domain, InitKind, Integrator, Model, Run, SceneFile};
+pub use file::{
+    AdhesionSpec, CellsSpec, Domain, InitKind, Integrator, Model, PolaritySpec, PopulationSpec,
+    Run, SceneFile, WallKind, WallsSpec,
+};
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
 use mechanics::{
@@ -51,6 +55,8 @@ pub struct Scene {
     pub(crate) file: SceneFile,
     /// The initial centres, computed by the validation (which checks that they fit).
     pub(crate) centres: Vec<[f64; 2]>,
+    /// The wall fields of `[walls]`, during and after the relaxation.
+    pub(crate) walls: Option<(phasefield::WallField, Option<phasefield::WallField>)>,
 }
 
 /// When the writers of a run directory fire ([`Scene::output_schedules`]).
@@ -295,11 +301,38 @@ impl Scene {
             f.init_radius(),
             f.model.lambda,
         );
-        Ok(
-            Tissue::new(cells.into_precision::<T>(), self.initial_params())
-                .with_terms(self.file.terms())
-                .with_populations(self.file.populations()),
-        )
+        Ok(self.dressed(Tissue::new(
+            cells.into_precision::<T>(),
+            self.initial_params(),
+        )))
+    }
+
+    /// `tissue` with the scene's terms, populations and walls.
+    fn dressed<T: Real>(&self, tissue: Tissue<T>) -> Tissue<T> {
+        let tissue = tissue
+            .with_terms(self.file.terms())
+            .with_populations(self.file.populations());
+        match self.walls() {
+            Some(walls) => tissue.with_walls(walls),
+            None => tissue,
+        }
+    }
+
+    /// The walls of `[walls]`, if any.
+    pub fn walls(&self) -> Option<mechanics::walls::Walls> {
+        let (during, after) = self.walls.clone()?;
+        let spec = self.file.walls.as_ref()?;
+        let walls = mechanics::walls::Walls::new(during, spec.kappa, spec.omega);
+        Some(if spec.kind == WallKind::Wound {
+            walls.replaced_when_active(after)
+        } else {
+            walls
+        })
+    }
+
+    /// The wall field during the relaxation and after it (none: no walls then), for outputs.
+    pub fn wall_fields(&self) -> Option<(&phasefield::WallField, Option<&phasefield::WallField>)> {
+        self.walls.as_ref().map(|(a, b)| (a, b.as_ref()))
     }
 
     /// The populations of `[[population]]` (empty without), cells dealt by `[run] seed`.
@@ -326,11 +359,10 @@ impl Scene {
         let ids = (0..state.n_cells()).collect();
         let placed = Tissue::from_state(state.clone(), self.initial_params(), 0.0, 0, ids);
         let cells = state.resampled(self.patch_shape(), placed.centres());
-        Ok(
-            Tissue::new(cells.into_precision::<T>(), self.initial_params())
-                .with_terms(self.file.terms())
-                .with_populations(self.file.populations()),
-        )
+        Ok(self.dressed(Tissue::new(
+            cells.into_precision::<T>(),
+            self.initial_params(),
+        )))
     }
 
     /// Checks that a saved state fits the scene: the same lattice and the same number of

@@ -59,7 +59,7 @@ pub(crate) fn sig3(v: f64) -> String {
     }
 }
 
-fn invalid(
+pub(crate) fn invalid(
     section: &'static str,
     key: &'static str,
     value: impl ToString,
@@ -634,14 +634,29 @@ impl SceneFile {
                 }
             }
         }
+        let walls = match &self.walls {
+            Some(spec) => Some(crate::walls::wall_fields(
+                spec,
+                lattice,
+                init::wall_clearance(r0),
+            )?),
+            None => None,
+        };
         let Some(layout) = self.layout() else {
             // The state is read when the tissue is built (`Scene::tissue_from_state`).
             return Ok(Scene {
                 file: self,
                 centres: Vec::new(),
+                walls,
             });
         };
-        let centres = match init::positions(lattice, c.count, r0, &layout) {
+        let centres = match init::positions_clear_of(
+            lattice,
+            c.count,
+            r0,
+            &layout,
+            walls.as_ref().map(|(w, _)| w),
+        ) {
             Ok(centres) => centres,
             Err(e) => {
                 let key = if c.init == InitKind::Positions {
@@ -658,13 +673,18 @@ impl SceneFile {
                         "[...]".into()
                     },
                     e.to_string(),
-                    "use fewer cells, smaller init_radius or a larger [domain]",
+                    if walls.is_some() {
+                        "use fewer cells, smaller init_radius, a larger [domain] or less wall (initial discs stay a disc radius and a node clear of the walls)"
+                    } else {
+                        "use fewer cells, smaller init_radius or a larger [domain]"
+                    },
                 ));
             }
         };
         Ok(Scene {
             file: self,
             centres,
+            walls,
         })
     }
 
@@ -700,9 +720,16 @@ impl SceneFile {
     pub(crate) fn stability_estimate(&self) -> f64 {
         let base = self.model_params(self.model.zeta);
         // The smallest over the populations, each with its own constants.
+        // A wall's repulsion relaxes φ at the rate (2κ_w/λ) w² ≤ 2κ_w/λ, which Heun's method
+        // keeps stable for dt below λ/κ_w.
+        let walls = self
+            .walls
+            .as_ref()
+            .filter(|w| w.kappa > 0.0)
+            .map_or(f64::INFINITY, |w| base.energy.lambda / w.kappa);
         self.population_kinds()
             .iter()
             .map(|p| p.params(&base).max_stable_dt())
-            .fold(base.max_stable_dt(), f64::min)
+            .fold(base.max_stable_dt().min(walls), f64::min)
     }
 }
