@@ -37,6 +37,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod confinement;
 pub mod correlation;
 pub mod crop;
 pub mod defects;

@@ -125,6 +125,9 @@ pub struct TissuePicture {
     pub title: String,
     /// The field's width in pixels (its height follows the lattice's aspect).
     pub size: u32,
+    /// The wall field `w` (index `x * ly + y`; 1 on solid nodes), drawn in grey where no
+    /// cell is.
+    pub walls: Option<Vec<f64>>,
 }
 
 /// Colours of the overlays.
@@ -140,6 +143,7 @@ pub const MINUS: [u8; 3] = [0, 90, 200];
 const AXIS: [u8; 3] = [200, 20, 20];
 const POLARITY: [u8; 3] = [10, 110, 40];
 const TRACK: [u8; 3] = [60, 60, 160];
+const WALL: [u8; 3] = [140, 140, 140];
 
 const TITLE_PX: u32 = 36;
 const BAR_PX: u32 = 110;
@@ -163,6 +167,7 @@ impl TissuePicture {
             mark: 8.0,
             title: String::new(),
             size,
+            walls: None,
         }
     }
 
@@ -211,6 +216,16 @@ impl TissuePicture {
             }
         }
         let len = self.lx * self.ly;
+        if let Some(w) = &self.walls {
+            if w.len() != len {
+                return Err(format!(
+                    "the wall field has {} values for a {}×{} lattice",
+                    w.len(),
+                    self.lx,
+                    self.ly
+                ));
+            }
+        }
         for (name, f) in [("director", &self.director), ("flow", &self.flow)] {
             if let Some(f) = f {
                 if f.a.len() != len || f.b.len() != len || f.every == 0 {
@@ -377,6 +392,14 @@ impl TissuePicture {
                     } else {
                         colours[id as usize]
                     }
+                } else if let Some(w) = &self.walls {
+                    // The wall's grey, fading with its field outside the solid.
+                    let x = (((px as f64 + 0.5) / s) as usize).min(self.lx - 1);
+                    let y = (((qy as f64 + 0.5) / s) as usize).min(self.ly - 1);
+                    let a = w[x * self.ly + y].clamp(0.0, 1.0);
+                    std::array::from_fn(|c| {
+                        (EMPTY[c] as f64 + a * (WALL[c] as f64 - EMPTY[c] as f64)).round() as u8
+                    })
                 } else {
                     EMPTY
                 };

@@ -54,7 +54,10 @@ pub(crate) fn wall_fields(
     };
     let only = |key: &'static str, set: bool, kinds: &[WallKind]| {
         if set && !kinds.contains(&spec.kind) {
-            let names: Vec<_> = kinds.iter().map(|&k| format!("\"{}\"", kind_name(k))).collect();
+            let names: Vec<_> = kinds
+                .iter()
+                .map(|&k| format!("\"{}\"", kind_name(k)))
+                .collect();
             Err(invalid(
                 "walls",
                 key,
@@ -70,7 +73,11 @@ pub(crate) fn wall_fields(
             Ok(())
         }
     };
-    only("width", spec.width.is_some(), &[WallKind::Channel, WallKind::Wound])?;
+    only(
+        "width",
+        spec.width.is_some(),
+        &[WallKind::Channel, WallKind::Wound],
+    )?;
     only("radius", spec.radius.is_some(), &[WallKind::Disc])?;
     only("semi_axes", spec.semi_axes.is_some(), &[WallKind::Disc])?;
     only("mask", spec.mask.is_some(), &[WallKind::Mask])?;
@@ -119,7 +126,9 @@ pub(crate) fn wall_fields(
             } else {
                 "radius"
             };
-            if (0..2).any(|k| !(semi_axes[k].is_finite() && semi_axes[k] >= 2.0 && semi_axes[k] <= largest[k])) {
+            if (0..2).any(|k| {
+                !(semi_axes[k].is_finite() && semi_axes[k] >= 2.0 && semi_axes[k] <= largest[k])
+            }) {
                 return Err(invalid(
                     "walls",
                     key,
@@ -201,14 +210,21 @@ fn read_mask(path: &Path, lattice: Lattice) -> Result<Vec<bool>, SceneError> {
     match ext.as_str() {
         "png" => {
             let mut decoder = png::Decoder::new(&bytes[..]);
-            decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-            let mut reader = decoder
-                .read_info()
-                .map_err(|e| bad(format!("not a readable PNG image: {e}"), "save the mask as an 8-bit PNG"))?;
+            decoder
+                .set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+            let mut reader = decoder.read_info().map_err(|e| {
+                bad(
+                    format!("not a readable PNG image: {e}"),
+                    "save the mask as an 8-bit PNG",
+                )
+            })?;
             let mut buf = vec![0; reader.output_buffer_size()];
-            let info = reader
-                .next_frame(&mut buf)
-                .map_err(|e| bad(format!("not a readable PNG image: {e}"), "save the mask as an 8-bit PNG"))?;
+            let info = reader.next_frame(&mut buf).map_err(|e| {
+                bad(
+                    format!("not a readable PNG image: {e}"),
+                    "save the mask as an 8-bit PNG",
+                )
+            })?;
             let (w, h) = (info.width as usize, info.height as usize);
             if (w, h) != (lx, ly) {
                 return Err(bad(
@@ -236,7 +252,8 @@ fn read_mask(path: &Path, lattice: Lattice) -> Result<Vec<bool>, SceneError> {
         }
         "npy" => {
             let fix = "save a 2-D array of shape (lx, ly), indexed [x, y], of numbers or booleans";
-            let npy = npyz::NpyFile::new(&bytes[..]).map_err(|e| bad(format!("not a readable .npy array: {e}"), fix))?;
+            let npy = npyz::NpyFile::new(&bytes[..])
+                .map_err(|e| bad(format!("not a readable .npy array: {e}"), fix))?;
             let shape = npy.shape().to_vec();
             if shape != [lx as u64, ly as u64] {
                 return Err(bad(
@@ -249,14 +266,20 @@ fn read_mask(path: &Path, lattice: Lattice) -> Result<Vec<bool>, SceneError> {
                 npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Bool => npy
                     .into_vec::<bool>()
                     .map(|v| v.into_iter().map(|b| f64::from(u8::from(b))).collect()),
-                npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Uint && t.size_field() == 1 => {
-                    npy.into_vec::<u8>().map(|v| v.into_iter().map(f64::from).collect())
+                npyz::DType::Plain(t)
+                    if t.type_char() == npyz::TypeChar::Uint && t.size_field() == 1 =>
+                {
+                    npy.into_vec::<u8>()
+                        .map(|v| v.into_iter().map(f64::from).collect())
                 }
                 npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Int => npy
                     .into_vec::<i64>()
                     .map(|v| v.into_iter().map(|x| x as f64).collect()),
-                npyz::DType::Plain(t) if t.type_char() == npyz::TypeChar::Float && t.size_field() == 4 => {
-                    npy.into_vec::<f32>().map(|v| v.into_iter().map(f64::from).collect())
+                npyz::DType::Plain(t)
+                    if t.type_char() == npyz::TypeChar::Float && t.size_field() == 4 =>
+                {
+                    npy.into_vec::<f32>()
+                        .map(|v| v.into_iter().map(f64::from).collect())
                 }
                 _ => npy.into_vec::<f64>(),
             }

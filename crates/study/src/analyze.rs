@@ -413,6 +413,9 @@ pub(crate) fn load_frame(
     )
     .with_populations(scene.populations())
     .with_terms(scene.terms());
+    if let Some(walls) = scene.walls() {
+        tissue = tissue.with_walls(walls);
+    }
     // The terms act as they did in the run: from the end of the relaxation, with the state
     // the frame holds.
     tissue.set_active(time >= scene.file().run.relax_time * (1.0 - 1e-12));
@@ -576,7 +579,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let mut obs = String::new();
     row!(
         obs,
-        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order"
+        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap"
     );
     let mut defects_csv = String::new();
     // Axes and angle conventions are in the README: a comment line here would be taken for
@@ -601,9 +604,22 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     };
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
+    // A wound's band: the solid of the walls during the relaxation, when they open after it.
+    let wound: Option<Vec<bool>> = scene
+        .walls()
+        .filter(|w| w.open_when_active())
+        .and_then(|w| {
+            w.field(false)
+                .map(|f| (0..lattice.len()).map(|k| f.is_solid(k)).collect())
+        });
     for path in &selected {
         let frame = load_frame(path, &scene, &shape, lattice)?;
         let (demix, polar) = mixing_and_order(&frame, &shape);
+        let gap = wound.as_ref().map_or(f64::NAN, |band| {
+            let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
+            let s1: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
+            analysis::confinement::uncovered_fraction(&s1, band)
+        });
         let LoadedFrame {
             tissue,
             shapes,
@@ -656,7 +672,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         };
         row!(
             obs,
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -667,7 +683,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             rate,
             rms(&[&svx, &svy]),
             demix,
-            polar
+            polar,
+            gap
         );
         prev_time = Some(time);
         info.frames += 1;

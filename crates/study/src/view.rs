@@ -356,6 +356,7 @@ fn picture(
         phi: frame.phi.clone(),
     };
     p.mark = radius;
+    p.walls = frame.tissue.wall_field().map(|w| w.w().to_vec());
     let need_fields = opts.director || opts.defects || opts.flow || opts.colour == Colour::Pressure;
     let f: Option<TissueFields> = need_fields.then(|| frame.tissue.fields(ws));
     let signed = opts.colour == Colour::Pressure;
