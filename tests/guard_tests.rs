@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 38] = [
+const KEYS: [&str; 45] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -157,8 +157,15 @@ const KEYS: [&str; 38] = [
     "polarity.contact_inhibition",
     "population.0.gamma",
     "population.1.zeta",
+    "walls.kind",
+    "walls.kind",
+    "walls.thickness",
+    "walls.kappa",
+    "walls.omega",
+    "walls.width",
+    "walls.radius",
 ];
-const VALUES: [&str; 36] = [
+const VALUES: [&str; 40] = [
     "0",
     "-1",
     "1",
@@ -195,6 +202,10 @@ const VALUES: [&str; 36] = [
     "\"force\"",
     "\"shape\"",
     "\"density\"",
+    "\"channel\"",
+    "\"disc\"",
+    "\"wound\"",
+    "\"box\"",
 ];
 
 /// Stands for the path of a real frame of the base scene (`frame_path`) among [`VALUES`].
@@ -305,21 +316,24 @@ fn fuzzed_scenes_end_in_a_clean_error_or_a_valid_run() {
     let rng = TestRng::deterministic_rng(config.rng_algorithm);
     let mut runner = TestRunner::new_with_rng(config, rng);
     // A third of the cases start from a saved frame of the base scene, so that overrides meet
-    // `init = "frame"` too.
+    // `init = "frame"` too; half have a channel, so that the wall keys meet walls.
     let overrides = (
         prop::collection::vec((0..KEYS.len(), 0..VALUES.len()), 1..=3),
         0..3,
+        proptest::bool::ANY,
     )
-        .prop_map(|(v, base)| {
+        .prop_map(|(v, base, walls)| {
             let from_frame = (base == 0).then(|| {
                 [
                     "cells.init=\"frame\"".to_string(),
                     format!("cells.from={}", frame_path()),
                 ]
             });
+            let channel = walls.then(|| "walls.kind=\"channel\"".to_string());
             from_frame
                 .into_iter()
                 .flatten()
+                .chain(channel)
                 .chain(v.into_iter().map(|(k, x)| match VALUES[x] {
                     FRAME => format!("{}={}", KEYS[k], frame_path()),
                     v => format!("{}={v}", KEYS[k]),

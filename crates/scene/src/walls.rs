@@ -132,7 +132,7 @@ pub(crate) fn wall_fields(
                 return Err(invalid(
                     "walls",
                     key,
-                    format!("{:?}", semi_axes),
+                    spec.radius.map_or_else(|| format!("{semi_axes:?}"), |r| r.to_string()),
                     format!(
                         "the disc must lie inside the domain with a solid rim: at most {} along x and {} along y, and at least 2",
                         largest[0], largest[1]
@@ -298,5 +298,202 @@ fn read_mask(path: &Path, lattice: Lattice) -> Result<Vec<bool>, SceneError> {
             "the mask must be a .png or a .npy file".into(),
             "convert it to PNG (bright pixels solid) or to a .npy array (non-zero solid)",
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Scene;
+    use npyz::WriterBuilder;
+
+    const BASE: &str = "[domain]\nlx = 40\nly = 30\n[cells]\ncount = 2\nradius = 6.0\n[integrator]\nmargin = 12\n[run]\ntime = 1\n";
+
+    fn parse(set: &[&str]) -> Result<Scene, SceneError> {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        Scene::parse(BASE, &set)
+    }
+
+    fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(shape: &[u64], data: &[T]) -> Vec<u8> {
+        let mut buf = Vec::new();
+        let mut w = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(shape)
+            .writer(&mut buf)
+            .begin_nd()
+            .unwrap();
+        w.extend(data.iter().copied()).unwrap();
+        w.finish().unwrap();
+        buf
+    }
+
+    /// A PNG of `w × h` pixels with `channels` samples each, bright where `bright(col, row)`.
+    fn png(w: u32, h: u32, color: png::ColorType, bright: impl Fn(u32, u32) -> bool) -> Vec<u8> {
+        let channels = color.samples();
+        let mut data = Vec::new();
+        for row in 0..h {
+            for col in 0..w {
+                let v = if bright(col, row) { 230 } else { 20 };
+                data.extend(std::iter::repeat_n(v, channels));
+            }
+        }
+        let mut out = Vec::new();
+        let mut enc = png::Encoder::new(&mut out, w, h);
+        enc.set_color(color);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.write_header().unwrap().write_image_data(&data).unwrap();
+        out
+    }
+
+    /// A PNG's top row is the lattice's top (y = ly − 1), its left column x = 0, in grey and in
+    /// colour; `invert` swaps solid and free; a `.npy` array is indexed `[x, y]`.
+    #[test]
+    fn masks_are_read_with_the_lattice_orientation() {
+        let dir = tempfile::tempdir().unwrap();
+        let l = Lattice::new(40, 30);
+        // Bright: the top 3 rows and the left 2 columns.
+        let bright = |col: u32, row: u32| row < 3 || col < 2;
+        for color in [
+            png::ColorType::Grayscale,
+            png::ColorType::Rgb,
+            png::ColorType::Rgba,
+        ] {
+            let path = dir.path().join("m.png");
+            std::fs::write(&path, png(40, 30, color, bright)).unwrap();
+            let solid = read_mask(&path, l).unwrap();
+            for x in 0..40 {
+                for y in 0..30 {
+                    let expected = y >= 27 || x < 2;
+                    assert_eq!(solid[l.index(x, y)], expected, "({x}, {y}) {color:?}");
+                }
+            }
+            let m = format!("walls.mask={:?}", path.display().to_string());
+            let s = parse(&["walls.kind=\"mask\"", &m]).unwrap();
+            let (f, after) = s.wall_fields().unwrap();
+            assert!(f.is_solid(l.index(20, 29)) && !f.is_solid(l.index(20, 10)));
+            assert!(after.is_some(), "a mask stays after the relaxation");
+            let set = [
+                "walls.kind=\"mask\"".to_string(),
+                m,
+                "walls.invert=true".into(),
+            ];
+            let file = crate::SceneFile::parse(BASE, &set).unwrap();
+            let (f, _) = wall_fields(file.walls.as_ref().unwrap(), l, 0.0).unwrap();
+            assert!(!f.is_solid(l.index(20, 29)) && f.is_solid(l.index(20, 10)));
+        }
+        let path = dir.path().join("m.npy");
+        let values: Vec<f64> = (0..40 * 30)
+            .map(|k| if k / 30 == 5 { 1.0 } else { 0.0 })
+            .collect();
+        std::fs::write(&path, npy(&[40, 30], &values)).unwrap();
+        let solid = read_mask(&path, l).unwrap();
+        assert!((0..30).all(|y| solid[l.index(5, y)]));
+        assert_eq!(solid.iter().filter(|&&s| s).count(), 30);
+        let bools: Vec<bool> = values.iter().map(|&v| v != 0.0).collect();
+        std::fs::write(&path, npy(&[40, 30], &bools)).unwrap();
+        assert_eq!(read_mask(&path, l).unwrap(), solid);
+    }
+
+    /// Bad `[walls]` values and bad mask files end in an error naming the key and a fix.
+    #[test]
+    fn bad_walls_name_their_key() {
+        let dir = tempfile::tempdir().unwrap();
+        let small = dir.path().join("small.png");
+        std::fs::write(&small, png(10, 10, png::ColorType::Grayscale, |c, _| c < 3)).unwrap();
+        let shape = dir.path().join("shape.npy");
+        std::fs::write(&shape, npy(&[30, 40], &vec![0u8; 1200])).unwrap();
+        let text = dir.path().join("text.png");
+        std::fs::write(&text, "not an image").unwrap();
+        let mask = |p: &std::path::Path| format!("walls.mask={:?}", p.display().to_string());
+        let (small, shape, text) = (mask(&small), mask(&shape), mask(&text));
+        let missing = mask(&dir.path().join("none.png"));
+        let cases: &[(&[&str], &[&str])] = &[
+            (
+                &["walls.kind=\"channel\"", "walls.width=40"],
+                &["[walls] width", "up to 28"],
+            ),
+            (
+                &["walls.kind=\"channel\"", "walls.thickness=0"],
+                &["[walls] thickness"],
+            ),
+            (
+                &["walls.kind=\"box\"", "walls.kappa=-1"],
+                &["[walls] kappa"],
+            ),
+            (
+                &["walls.kind=\"disc\"", "walls.width=10"],
+                &["[walls] width", "kind = \"channel\" or \"wound\""],
+            ),
+            (
+                &["walls.kind=\"disc\"", "walls.radius=20"],
+                &["[walls] radius = 20:", "14 along y"],
+            ),
+            (
+                &["walls.kind=\"mask\""],
+                &["[walls] mask", "needs the mask file"],
+            ),
+            (
+                &["walls.kind=\"mask\"", &small],
+                &["[walls] mask", "10×10 pixels", "lx = 10, ly = 10"],
+            ),
+            (
+                &["walls.kind=\"mask\"", &shape],
+                &["[walls] mask", "shape is [30, 40]"],
+            ),
+            (
+                &["walls.kind=\"mask\"", &text],
+                &["[walls] mask", "not a readable PNG"],
+            ),
+            (
+                &["walls.kind=\"mask\"", &missing],
+                &["[walls] mask", "cannot read"],
+            ),
+            (
+                &["walls.kind=\"channel\"", "walls.invert=true"],
+                &["[walls] invert"],
+            ),
+            (
+                &["walls.kind=\"disc\"", "walls.radius=4"],
+                &["[cells] count", "clear of the walls"],
+            ),
+        ];
+        for (set, needles) in cases {
+            let e = match parse(set) {
+                Ok(_) => panic!("{set:?} must fail"),
+                Err(e) => e.to_string(),
+            };
+            for n in *needles {
+                assert!(e.contains(n), "{set:?}: {e:?} lacks {n:?}");
+            }
+        }
+        // A stiff wall needs a smaller step: the estimate λ/κ_w.
+        let e = parse(&[
+            "walls.kind=\"channel\"",
+            "walls.kappa=20",
+            "model.zeta=0.005",
+            "integrator.dt=0.5",
+        ])
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("dt"), "{e}");
+    }
+
+    /// Initial discs stay clear of the walls in every layout.
+    #[test]
+    fn initial_discs_avoid_the_walls() {
+        for init in ["\"random\"", "\"hexagonal\""] {
+            let s = Scene::parse(
+                "[domain]\nlx = 80\nly = 60\n[cells]\ncount = 12\nradius = 8.0\n[walls]\nkind = \"disc\"\n[run]\ntime = 1\n",
+                &[format!("cells.init={init}")],
+            )
+            .unwrap();
+            let (f, _) = s.wall_fields().unwrap();
+            for c in &s.centres {
+                assert!(
+                    f.distance_at(*c) >= phasefield::init::wall_clearance(4.0),
+                    "{init}: {c:?}"
+                );
+            }
+        }
     }
 }
