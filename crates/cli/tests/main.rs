@@ -8,3 +8,4 @@ mod from_state;
 mod signals;
 mod terms;
 mod view;
+mod walls;

@@ -608,7 +608,7 @@ fn field_arrays(frame: &LoadedFrame, f: &TissueFields, nx: usize, ny: usize) -> 
             (s * th.cos(), s * th.sin())
         })
         .unzip();
-    vec![
+    let mut arrays = vec![
         VtkArray::new("phi_sum", 1, VtkValues::F32(phi_sum)),
         VtkArray::new("cell_id", 1, VtkValues::I32(owner)),
         VtkArray::new("velocity", 3, interleave(&[&f.vx, &f.vy, &zero])),
@@ -618,7 +618,11 @@ fn field_arrays(frame: &LoadedFrame, f: &TissueFields, nx: usize, ny: usize) -> 
         VtkArray::new("sigma_xx", 1, f32s(&f.sigma_xx)),
         VtkArray::new("sigma_yy", 1, f32s(&f.sigma_yy)),
         VtkArray::new("sigma_xy", 1, f32s(&f.sigma_xy)),
-    ]
+    ];
+    if let Some(w) = frame.tissue.wall_field() {
+        arrays.push(VtkArray::new("wall", 1, f32s(w.w())));
+    }
+    arrays
 }
 
 /// The points and point arrays of one frame's `.vtp` (see [`export_vtk`]).
@@ -675,7 +679,7 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
 ///
 /// | file | what |
 /// |---|---|
-/// | `fields_STEP.vti` | ImageData `lx × ly × 1`, spacing 1; point arrays (float32 unless said): `phi_sum` `Σ_i φ_i`; `cell_id` (int32) the cell with the largest `φ_i` at the node, −1 where none exceeds ½; `velocity` `(v_x, v_y, 0)`; `Q` `(Q_xx, Q_xy)`; `director` `|Q| (cos θ, sin θ, 0)`; `pressure`; `sigma_xx`, `sigma_yy`, `sigma_xy` |
+/// | `fields_STEP.vti` | ImageData `lx × ly × 1`, spacing 1; point arrays (float32 unless said): `phi_sum` `Σ_i φ_i`; `cell_id` (int32) the cell with the largest `φ_i` at the node, −1 where none exceeds ½; `velocity` `(v_x, v_y, 0)`; `Q` `(Q_xx, Q_xy)`; `director` `|Q| (cos θ, sin θ, 0)`; `pressure`; `sigma_xx`, `sigma_yy`, `sigma_xy`; with `[walls]` `wall`, the wall field `w` in effect at the frame's time |
 /// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area`; with `[[population]]` `population` (int32), with `[polarity]` `polarity` `(p_x, p_y, 0)` |
 /// | `fields.pvd`, `cells.pvd` | the time series (each file with its frame's time) |
 ///
