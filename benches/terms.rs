@@ -1,8 +1,8 @@
 //! The cost of each physics term (docs/model.md §11) per step: one relaxed step (dt 0.2,
 //! ζ = 0.005) of `large.toml` (960 cells, 400², margin 12, f32 storage) without terms, with
 //! self-propulsion (`[polarity]` α = 0.04, D_r = 4.5e-4, aligning to the velocity), with
-//! adhesion (ω = 0.005), and with two populations of different γ and ζ (±0.005), on one and two
-//! threads. Throughput is in node updates (cells × patch nodes per step).
+//! adhesion (ω = 0.005), with two populations of different γ and ζ (±0.005), and in a channel
+//! (`[walls] kind = "channel"`, κ_w = 1, ℓ_w = 1), on one and two threads. Throughput is in node updates (cells × patch nodes per step).
 //!
 //! Run with `cargo bench -p monolayer-benches --bench terms`.
 
@@ -20,7 +20,7 @@ fn bench_terms(c: &mut Criterion) {
             .chain(extra.iter().map(|s| s.to_string()))
             .collect()
     };
-    let cases: [(&str, Vec<String>, bool); 4] = [
+    let cases: [(&str, Vec<String>, bool); 5] = [
         ("none", with(&[]), false),
         (
             "polarity",
@@ -34,6 +34,7 @@ fn bench_terms(c: &mut Criterion) {
         ),
         ("adhesion", with(&["adhesion.omega=0.005"]), false),
         ("populations", with(&[]), true),
+        ("walls", with(&["walls.kind=\"channel\""]), false),
     ];
     for (name, overrides, populations) in cases {
         let (t, mut ws, s) =
