@@ -214,4 +214,3 @@ fn wall_adhesion_spreads_a_cell_along_the_wall() {
     }
     assert!(results[2].1 < 0.25, "{results:?}");
 }
-
