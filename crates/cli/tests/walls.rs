@@ -4,7 +4,7 @@
 
 use crate::common::{bin, scene_path, stderr};
 
-/// The wound scene, shrunk (80 × 50, 15 cells), relaxed 50 TU and run 100 TU, on two
+/// The wound scene, shrunk (80 × 50, 15 cells), relaxed 50 TU and run 200 TU, on two
 /// threads, is the same run on one thread to the byte; its gap is 1 while the band stands
 /// and falls after it opens; render and VTK show the wall during the relaxation only.
 #[test]
@@ -25,7 +25,7 @@ fn a_wound_opens_closes_and_is_drawn() {
                 "--set",
                 "cells.count=15",
             ])
-            .args(["--set", "run.relax_time=50", "--set", "run.time=100"])
+            .args(["--set", "run.relax_time=50", "--set", "run.time=200"])
             .args([
                 "--set",
                 "run.output_every=25",
@@ -71,7 +71,7 @@ fn a_wound_opens_closes_and_is_drawn() {
         }
     }
     let last = gaps.last().unwrap().1;
-    assert!(last < 0.8, "the gap does not close: {gaps:?}");
+    assert!(last < 0.75, "the gap does not close: {gaps:?}");
 
     // VTK: the wall field while the band stands, none after.
     let vtk = dir.path().join("vtk");
