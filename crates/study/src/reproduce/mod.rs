@@ -11,6 +11,7 @@
 //!
 //! The settings of each figure are written at the top of its `verdict.md`.
 
+mod channel;
 mod contractile;
 mod defect_fields;
 mod defects;
@@ -138,11 +139,13 @@ pub enum Figure {
     Stability,
     /// The threshold of the random packing against the run length.
     RunLength,
+    /// The critical width of flow in a channel against the activity (issue 28).
+    Channel,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 8] = [
+    pub const ALL: [Figure; 9] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -151,6 +154,7 @@ impl Figure {
         Self::Scaling,
         Self::Stability,
         Self::RunLength,
+        Self::Channel,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -164,6 +168,7 @@ impl Figure {
             Self::Scaling => "scaling",
             Self::Stability => "stability",
             Self::RunLength => "run-length",
+            Self::Channel => "channel",
         }
     }
 
@@ -182,6 +187,7 @@ impl Figure {
             Self::RunLength => {
                 "The threshold of the random packing against the run length (issue 26)"
             }
+            Self::Channel => "The critical width of flow in a channel (issue 28)",
         }
     }
 }
@@ -398,6 +404,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Scaling => scaling::make(p, &dir)?,
         Figure::Stability => stability::make(p, &dir)?,
         Figure::RunLength => run_length::make(p, &dir)?,
+        Figure::Channel => channel::make(p, &dir)?,
     };
     let wall_s = start.elapsed().as_secs_f64();
     write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;
