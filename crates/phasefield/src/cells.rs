@@ -221,6 +221,90 @@ impl<T: Real> Cells<T> {
         self.map = map;
     }
 
+    /// Splits cell `cell_idx` in two along the line through `centre` normal to `direction`
+    /// (a unit vector), for a cell division: the cell keeps `φ_a = φ χ` and a new cell, added
+    /// in the last slot on the same patch, gets `φ_b = φ − φ_a`, with
+    /// `χ = ½ [1 + tanh(d/width)]` and `d` the periodic displacement of each node from
+    /// `centre` along `direction`. So `φ_a + φ_b = φ` at every node up to one rounding of the
+    /// storage precision, and the new cell lies on the side `−direction`. Returns the new
+    /// slot. The field vector grows by one patch (`Vec`'s amortised growth: a run of
+    /// divisions reallocates O(log N) times).
+    ///
+    /// # Panics
+    /// If `cell_idx` is out of range or `width` is not positive.
+    pub fn split(
+        &mut self,
+        cell_idx: usize,
+        centre: [f64; 2],
+        direction: [f64; 2],
+        width: f64,
+    ) -> usize {
+        assert!(cell_idx < self.n_cells, "no cell {cell_idx}");
+        assert!(width > 0.0, "the split's width must be positive");
+        let plen = self.shape.len();
+        let (nx, ny) = (self.shape.nx, self.shape.ny);
+        let new = self.n_cells;
+        self.phi
+            .extend_from_within(cell_idx * plen..(cell_idx + 1) * plen);
+        self.map.origin.push(self.map.origin[cell_idx]);
+        self.map.offset.push(self.map.offset[cell_idx]);
+        self.map
+            .lat_x
+            .extend_from_within(cell_idx * nx..(cell_idx + 1) * nx);
+        self.map
+            .lat_y
+            .extend_from_within(cell_idx * ny..(cell_idx + 1) * ny);
+        self.n_cells += 1;
+        let l = self.lattice;
+        let (head, tail) = self.phi.split_at_mut(new * plen);
+        let a_part = &mut head[cell_idx * plen..(cell_idx + 1) * plen];
+        for a in 0..nx {
+            let x = self.map.lat_x[cell_idx * nx + a] as f64;
+            let dx = crate::min_image(x - centre[0], l.lx as f64);
+            for b in 0..ny {
+                let y = self.map.lat_y[cell_idx * ny + b] as f64;
+                let dy = crate::min_image(y - centre[1], l.ly as f64);
+                let chi = 0.5 * (1.0 + ((dx * direction[0] + dy * direction[1]) / width).tanh());
+                let k = a * ny + b;
+                let mother = a_part[k].to_f64();
+                let keep = T::from_f64(mother * chi);
+                a_part[k] = keep;
+                tail[k] = T::from_f64(mother - keep.to_f64());
+            }
+        }
+        new
+    }
+
+    /// Removes cell `cell_idx`, moving the cell of the last slot into its place (the order of
+    /// the others is kept); returns the slot the moved cell came from (`None` when the removed
+    /// cell was the last). Allocates nothing.
+    ///
+    /// # Panics
+    /// If `cell_idx` is out of range.
+    pub fn swap_remove(&mut self, cell_idx: usize) -> Option<usize> {
+        assert!(cell_idx < self.n_cells, "no cell {cell_idx}");
+        let last = self.n_cells - 1;
+        let plen = self.shape.len();
+        let (nx, ny) = (self.shape.nx, self.shape.ny);
+        if cell_idx != last {
+            self.phi
+                .copy_within(last * plen..(last + 1) * plen, cell_idx * plen);
+            self.map
+                .lat_x
+                .copy_within(last * nx..(last + 1) * nx, cell_idx * nx);
+            self.map
+                .lat_y
+                .copy_within(last * ny..(last + 1) * ny, cell_idx * ny);
+        }
+        self.phi.truncate(last * plen);
+        self.map.lat_x.truncate(last * nx);
+        self.map.lat_y.truncate(last * ny);
+        self.map.origin.swap_remove(cell_idx);
+        self.map.offset.swap_remove(cell_idx);
+        self.n_cells = last;
+        (cell_idx != last).then_some(last)
+    }
+
     /// The same fields stored with another patch shape (e.g. the full domain, or another
     /// margin), each new patch centred on `centres[i]`; values outside the old patch are zero,
     /// values outside the new one are dropped. Allocates; meant for set-up and studies.
@@ -448,6 +532,80 @@ fn min_image_int(d: i64, l: i64) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A split conserves the field node by node (to one rounding of the storage precision),
+    /// puts the two parts on either side of the line, and a swap_remove moves the last cell
+    /// into the freed slot with its patch.
+    #[test]
+    fn a_split_conserves_the_field_and_swap_remove_keeps_the_others() {
+        let lattice = Lattice::new(48, 40);
+        let shape = PatchShape::new(lattice, 12).unwrap();
+        let centres = [[10.0, 10.0], [46.5, 20.0], [30.0, 30.0]];
+        let cells64 = crate::init::discs(lattice, shape, &centres, 7.0, 2.5);
+        fn check<T: Real>(mut cells: Cells<T>, tol: f64) {
+            let before: Vec<f64> = cells.cell_phi(1).iter().map(|v| v.to_f64()).collect();
+            let origin = cells.map().origin[1];
+            let dir = [0.6f64, 0.8];
+            // Across the periodic edge at x = 0.
+            let new = cells.split(1, [46.5, 20.0], dir, 2.5);
+            assert_eq!((new, cells.n_cells()), (3, 4));
+            assert_eq!(cells.map().origin[3], origin);
+            let (a, b) = (cells.cell_phi(1), cells.cell_phi(3));
+            let mut worst: f64 = 0.0;
+            for k in 0..before.len() {
+                worst = worst.max((a[k].to_f64() + b[k].to_f64() - before[k]).abs());
+            }
+            assert!(worst <= tol, "{worst:e}");
+            let sum: f64 = (0..before.len())
+                .map(|k| a[k].to_f64() + b[k].to_f64() - before[k])
+                .sum();
+            assert!(sum.abs() <= tol * before.len() as f64, "{sum:e}");
+            // Each part on its side: the first moment along the direction.
+            let l = cells.lattice();
+            let moment = |i: usize| -> f64 {
+                let (mut m, mut w) = (0.0, 0.0);
+                for x in 0..l.lx {
+                    for y in 0..l.ly {
+                        let v = cells.value_at(i, x, y);
+                        let dx = crate::min_image(x as f64 - 46.5, l.lx as f64);
+                        let dy = crate::min_image(y as f64 - 20.0, l.ly as f64);
+                        m += v * (dx * dir[0] + dy * dir[1]);
+                        w += v;
+                    }
+                }
+                m / w
+            };
+            assert!(
+                moment(1) > 2.0 && moment(3) < -2.0,
+                "{} {}",
+                moment(1),
+                moment(3)
+            );
+            // Remove cell 0: the last (the new part) moves into slot 0 with its patch.
+            let last: Vec<f64> = cells.cell_phi(3).iter().map(|v| v.to_f64()).collect();
+            let kept: Vec<f64> = cells.cell_phi(2).iter().map(|v| v.to_f64()).collect();
+            assert_eq!(cells.swap_remove(0), Some(3));
+            assert_eq!(cells.n_cells(), 3);
+            assert_eq!(cells.map().origin[0], origin);
+            assert!(cells
+                .cell_phi(0)
+                .iter()
+                .zip(&last)
+                .all(|(a, b)| a.to_f64() == *b));
+            assert!(cells
+                .cell_phi(2)
+                .iter()
+                .zip(&kept)
+                .all(|(a, b)| a.to_f64() == *b));
+            assert_eq!(cells.swap_remove(2), None);
+            assert_eq!(cells.phi().len(), 2 * cells.patch_len());
+        }
+        check(cells64.clone(), 2.0 * f64::EPSILON);
+        check(
+            cells64.into_precision::<f32>(),
+            2.0 * f64::from(f32::EPSILON),
+        );
+    }
 
     /// A move keeps every value on its lattice node, and the wrapped columns and rows keep
     /// their far-edge values: exactly the move that only changes the origin and the storage

@@ -45,11 +45,11 @@ fn widths(scale: Scale) -> Vec<usize> {
 /// channel does not flow (its ratio at most [`FLOWS`]) or when no width is below ½.
 pub(crate) fn critical_width(widths: &[f64], ratio: &[f64]) -> Option<f64> {
     let widest = *ratio.last()?;
-    if !(widest > FLOWS) {
+    if widest.is_nan() || widest <= FLOWS {
         return None;
     }
     let f: Vec<f64> = ratio.iter().map(|r| (r - 1.0) / (widest - 1.0)).collect();
-    let below = (0..f.len()).rev().find(|&k| !(f[k] >= 0.5))?;
+    let below = (0..f.len()).rev().find(|&k| f[k].is_nan() || f[k] < 0.5)?;
     let k = below + 1;
     let t = (0.5 - f[below]) / (f[k] - f[below]);
     Some(widths[below] + t * (widths[k] - widths[below]))
@@ -76,7 +76,9 @@ pub(crate) fn exponent(
         let wc: Vec<Option<f64>> = (0..zetas.len())
             .map(|z| {
                 let mean: Vec<f64> = (0..widths.len())
-                    .map(|w| seeds.iter().map(|&s| ratio[s][z][w]).sum::<f64>() / seeds.len() as f64)
+                    .map(|w| {
+                        seeds.iter().map(|&s| ratio[s][z][w]).sum::<f64>() / seeds.len() as f64
+                    })
                     .collect();
                 critical_width(widths, &mean)
             })
@@ -86,7 +88,14 @@ pub(crate) fn exponent(
             .zip(&wc)
             .filter_map(|(z, w)| w.map(|w| (z.ln(), w.ln())))
             .unzip();
-        (if x.len() >= 2 { slope(&x, &y) } else { f64::NAN }, wc)
+        (
+            if x.len() >= 2 {
+                slope(&x, &y)
+            } else {
+                f64::NAN
+            },
+            wc,
+        )
     };
     let all: Vec<usize> = (0..ratio.len()).collect();
     let (b, wc) = fit(&all);
@@ -95,7 +104,14 @@ pub(crate) fn exponent(
         return (b, f64::NAN, wc);
     }
     let leave: Vec<f64> = (0..n)
-        .map(|out| fit(&all.iter().copied().filter(|&s| s != out).collect::<Vec<_>>()).0)
+        .map(|out| {
+            fit(&all
+                .iter()
+                .copied()
+                .filter(|&s| s != out)
+                .collect::<Vec<_>>())
+            .0
+        })
         .collect();
     if leave.iter().any(|v| !v.is_finite()) {
         return (b, f64::NAN, wc);
@@ -117,9 +133,15 @@ pub(crate) fn verdict(b: f64, se: f64) -> (Verdict, String) {
     }
     let off = (b - CONTINUUM).abs() / se.max(1e-12);
     if off <= 2.0 && se < 0.25 {
-        (Verdict::Holds, format!("the exponent is {} standard errors from −½", g(off)))
+        (
+            Verdict::Holds,
+            format!("the exponent is {} standard errors from −½", g(off)),
+        )
     } else if off > 3.0 {
-        (Verdict::DoesNotHold, format!("the exponent is {} standard errors from −½", g(off)))
+        (
+            Verdict::DoesNotHold,
+            format!("the exponent is {} standard errors from −½", g(off)),
+        )
     } else {
         (
             Verdict::Inconclusive,
@@ -135,7 +157,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     };
     let lx = 200usize;
     let ws = widths(p.scale);
-    let zetas: Vec<f64> = ZETAS[1..].iter().map(|z| z.parse().expect("a number")).collect();
+    let zetas: Vec<f64> = ZETAS[1..]
+        .iter()
+        .map(|z| z.parse().expect("a number"))
+        .collect();
     let mut recs: Vec<(usize, Vec<Rec>)> = Vec::new();
     for &w in &ws {
         let ly = w + 2;
@@ -186,7 +211,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .map(|&s| {
             ZETAS[1..]
                 .iter()
-                .map(|z| ws.iter().map(|&w| v_of(w, z, s) / v_of(w, "0", s)).collect())
+                .map(|z| {
+                    ws.iter()
+                        .map(|&w| v_of(w, z, s) / v_of(w, "0", s))
+                        .collect()
+                })
                 .collect()
         })
         .collect();
@@ -210,7 +239,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             ys.push(r.0);
             es.push(if r.1.is_finite() { r.1 } else { 0.0 });
         }
-        plot.series.push(Series::new(format!("ζ = {z}")).with_points(&wf, &ys, &es));
+        plot.series
+            .push(Series::new(format!("ζ = {z}")).with_points(&wf, &ys, &es));
     }
     for (w, _) in &recs {
         let v = mean_se(&seeds.iter().map(|&s| v_of(*w, "0", s)).collect::<Vec<_>>());
@@ -223,17 +253,21 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .zip(&wc)
         .filter_map(|(z, w)| w.map(|w| (*z, w)))
         .unzip();
-    let mut wplot = Plot::new(
-        "Critical width against activity",
-        "ζ",
-        "W_c (nodes)",
-    );
+    let mut wplot = Plot::new("Critical width against activity", "ζ", "W_c (nodes)");
     (wplot.log_x, wplot.log_y) = (true, true);
     if !x.is_empty() {
-        wplot.series.push(Series::new("W_c (seed means)").with_points(&x, &y, &vec![0.0; x.len()]).markers_only());
+        wplot.series.push(
+            Series::new("W_c (seed means)")
+                .with_points(&x, &y, &vec![0.0; x.len()])
+                .markers_only(),
+        );
         let c = y[0] * x[0].powf(-CONTINUUM);
         let line: Vec<f64> = x.iter().map(|z| c * z.powf(CONTINUUM)).collect();
-        wplot.series.push(Series::new("∝ ζ^(−1/2)").with_points(&x, &line, &vec![0.0; x.len()]).line_only());
+        wplot.series.push(
+            Series::new("∝ ζ^(−1/2)")
+                .with_points(&x, &line, &vec![0.0; x.len()])
+                .line_only(),
+        );
     }
     drawn(wplot.save_png(&dir.join("channel_critical_width.png")))?;
     let (v, reason) = verdict(b, se);
