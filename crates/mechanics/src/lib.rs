@@ -54,6 +54,7 @@
 #![deny(missing_docs)]
 
 pub mod adaptive;
+pub mod division;
 pub mod equations;
 mod fields;
 mod geometry;

@@ -139,6 +139,26 @@ impl<T: Real> Workspace<T> {
         }
     }
 
+    /// Resizes the per-cell buffers for `cells` after its number of cells changed (a
+    /// division or a removal): the buffers grow as `Vec`s do, so a run of divisions
+    /// reallocates O(log N) times, and a step after a fit allocates nothing. What they held
+    /// is not kept; the next step overwrites it.
+    pub fn fit(&mut self, cells: &Cells<T>) {
+        let n = cells.n_cells();
+        let len = n * cells.patch_len();
+        for v in [&mut self.phi_old, &mut self.k1, &mut self.k2] {
+            v.resize(len, T::default());
+        }
+        self.cell_state.resize(n, CellState::default());
+        for v in [
+            &mut self.observed_centre,
+            &mut self.next_centre,
+            &mut self.cell_force,
+        ] {
+            v.resize(n, [0.0; 2]);
+        }
+    }
+
     /// The per-cell quantities of the last evaluation, by slot.
     pub fn cell_states(&self) -> &[CellState] {
         &self.cell_state

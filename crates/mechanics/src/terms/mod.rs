@@ -281,6 +281,33 @@ impl Terms {
         }
     }
 
+    /// Allocates and initialises the state of the identities `n..n_new` (new cells of a
+    /// division), keeping the state of the others; a no-op when it is there already.
+    pub(crate) fn extend_to(&mut self, n_new: usize) {
+        if n_new <= self.n || self.entries.is_empty() {
+            self.n = self.n.max(n_new);
+            return;
+        }
+        let (n, seed) = (self.n, self.seed);
+        for (t, e) in self.entries.iter_mut().enumerate() {
+            let len = e.len;
+            for v in [&mut e.x, &mut e.old, &mut e.rate1, &mut e.kick] {
+                v.resize(n_new * len, 0.0);
+            }
+            for id in n..n_new {
+                let key = |k: u64| NoiseKey {
+                    seed,
+                    cell: id as u64,
+                    step: 0,
+                    stage: INITIAL_STAGE + ((t as u64) << 16) + k,
+                };
+                e.term
+                    .initial_state(id, &key, &mut e.x[id * len..(id + 1) * len]);
+            }
+        }
+        self.n = n_new;
+    }
+
     /// Bytes of heap memory held by the state.
     pub(crate) fn heap_bytes(&self) -> usize {
         self.entries

@@ -143,6 +143,16 @@ impl Populations {
         &self.kinds
     }
 
+    /// Assigns the new identity `id` (the next one, `of_cell().len()`) to population `kind`:
+    /// a daughter of a division, in its mother's population. A no-op without populations.
+    pub(crate) fn add_cell(&mut self, id: usize, kind: u16) {
+        if self.kinds.is_empty() {
+            return;
+        }
+        assert_eq!(id, self.of_cell.len(), "identities are added in order");
+        self.of_cell.push(kind);
+    }
+
     /// The population of every cell, by identity.
     pub fn of_cell(&self) -> &[u16] {
         &self.of_cell

@@ -1,0 +1,216 @@
+//! Tests of division (T5.1–T5.3 of the extensions).
+
+use phasefield::{init, Lattice, PatchShape};
+use rayon::prelude::*;
+
+use super::*;
+use crate::terms::{Polarity, Terms};
+use crate::{ModelParams, StepParams};
+
+/// One paper cell (R = 8) on `l × l`, margin 16, relaxed at rest for 100 TU.
+fn relaxed_cell(l: usize) -> (Tissue, Workspace) {
+    let lattice = Lattice::new(l, l);
+    let shape = PatchShape::new(lattice, 16).unwrap();
+    let c = l as f64 / 2.0;
+    let cells = init::discs(lattice, shape, &[[c, c]], 8.0, 2.5);
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0))
+        .with_terms(Terms::new(3).with(Polarity::new(0.0)));
+    let mut ws = Workspace::new(t.cells());
+    for _ in 0..200 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    (t, ws)
+}
+
+/// T5.1: the split conserves φ node by node (to one rounding; the sum over the lattice of
+/// `φ_a + φ_b − φ_m` is below 1e-12 of the cell's mass), the daughters get new identities, a
+/// fresh polarity each and one slot each, and after 50 TU their centres lie on either side of
+/// the mother's, more than R/2 from it along the division axis.
+#[test]
+fn a_division_conserves_the_field_and_the_daughters_separate() {
+    let (mut t, mut ws) = relaxed_cell(64);
+    let l = t.lattice();
+    let mut mother = vec![0.0; l.len()];
+    for x in 0..l.lx {
+        for y in 0..l.ly {
+            mother[l.index(x, y)] = t.cells().value_at(0, x, y);
+        }
+    }
+    let c0 = t.centres()[0];
+    let d = t.divide(0, [1.0, 0.0]);
+    assert_eq!(d.mother, 0);
+    assert_eq!(d.daughters, [1, 2]);
+    assert_eq!(d.slots, [0, 1]);
+    assert_eq!(t.cell_ids(), &[1, 2]);
+    // φ_a + φ_b = φ_m at every node, to one rounding.
+    let l = t.lattice();
+    let (mut worst, mut sum, mut mass): (f64, f64, f64) = (0.0, 0.0, 0.0);
+    for x in 0..l.lx {
+        for y in 0..l.ly {
+            let (fa, fb) = (t.cells().value_at(0, x, y), t.cells().value_at(1, x, y));
+            let fm = mother[l.index(x, y)];
+            worst = worst.max((fa + fb - fm).abs());
+            sum += fa + fb - fm;
+            mass += fm;
+        }
+    }
+    assert!(worst <= 2.0 * f64::EPSILON, "{worst:e}");
+    assert!(sum.abs() < 1e-12 * mass, "{sum:e} of {mass}");
+    // A fresh polarity each: the daughters' angles are their own draws.
+    let theta = t.terms().state("polarity").unwrap();
+    assert_eq!(theta.len(), 3);
+    assert!(theta[1] != theta[2] && theta[1] != theta[0]);
+    ws.fit(t.cells());
+    for _ in 0..100 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    let dx = |c: [f64; 2]| phasefield::min_image(c[0] - c0[0], l.lx as f64);
+    let (xa, xb) = (dx(t.centres()[0]), dx(t.centres()[1]));
+    eprintln!("daughters at {xa:.2} and {xb:.2} from the mother's centre after 50 TU");
+    assert!(xa > 4.0 && xb < -4.0, "{xa} {xb}");
+}
+
+/// A small tissue of cells of radius 5 under a fast clock (`T₀ = 40`, `k = 0.05`), stepped
+/// for `time` TU on the current thread pool: its lineage and its fields.
+fn colony(time: f64, axis: SplitAxis) -> (Tissue, Proliferation) {
+    let lattice = Lattice::new(96, 96);
+    let shape = PatchShape::new(lattice, 10).unwrap();
+    let cells = init::discs(lattice, shape, &[[30.0, 40.0], [66.0, 50.0]], 3.0, 2.5);
+    let mut p = ModelParams::paper(0.0);
+    p.energy.radius = 5.0;
+    let mut t = Tissue::new(cells, p).with_terms(Terms::new(5).with(Polarity::new(0.01)));
+    let mut ws = Workspace::new(t.cells());
+    let mut clock = Proliferation::new(40.0, 0.05, 9, &t)
+        .with_axis(axis)
+        .with_max_cells(40);
+    let sp = StepParams::default();
+    for _ in 0..(time / sp.dt) as usize {
+        t.step(&mut ws, &sp).unwrap();
+        clock.divide_due(&mut t, &mut ws);
+    }
+    (t, clock)
+}
+
+/// T5.3: every cell but the founders has a parent whose life ended by division at the
+/// daughter's birth, and a generation one more than its parent's; the living cells are
+/// exactly those whose life has not ended; and the colony is the same, to the bit, on one
+/// thread and on two.
+#[test]
+fn the_lineage_is_whole_and_independent_of_threads() {
+    let run = |threads: usize, axis| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| colony(160.0, axis))
+    };
+    for axis in [SplitAxis::Long, SplitAxis::Random] {
+        let (t, clock) = run(2, axis);
+        let records: Vec<&LineageRecord> = clock.lineage().collect();
+        let n_div = records
+            .iter()
+            .filter(|r| matches!(r.death, Some((_, Ending::Division))))
+            .count();
+        eprintln!(
+            "{axis:?}: {} cells now, {} in the lineage, {n_div} divisions, generations up to {}",
+            t.n_cells(),
+            records.len(),
+            records.iter().map(|r| r.generation).max().unwrap()
+        );
+        assert!(n_div >= 4, "too few divisions to test: {n_div}");
+        for r in &records {
+            match r.parent {
+                None => assert_eq!(r.generation, 0),
+                Some(p) => {
+                    let parent = records.iter().find(|q| q.id == p).expect("a parent");
+                    assert_eq!(parent.death, Some((r.birth, Ending::Division)), "{r:?}");
+                    assert_eq!(r.generation, parent.generation + 1);
+                }
+            }
+        }
+        let mut living: Vec<usize> = records
+            .iter()
+            .filter(|r| r.death.is_none())
+            .map(|r| r.id)
+            .collect();
+        let mut ids = t.cell_ids().to_vec();
+        living.sort_unstable();
+        ids.sort_unstable();
+        assert_eq!(living, ids);
+        let (t1, _) = run(1, axis);
+        assert_eq!(t1.cell_ids(), t.cell_ids());
+        assert!(
+            t1.cells().phi() == t.cells().phi(),
+            "1 and 2 threads differ"
+        );
+    }
+}
+
+/// T5.2: one cell at low density (200² periodic, no activity) under `T₀ = 300`, `k = 0.01`
+/// grows exponentially at the rate λ of the clock, `2 e^{−λT₀} k/(k + λ) = 1` (the
+/// Euler–Lotka equation of a cycle `T₀ + Exp(1/k)`: λ = 1.78e-3, a doubling time of 389 TU
+/// against the mean cycle of 400), over three generations and 20 seeds: the least-squares
+/// slope of `ln ⟨N⟩` from T₀ to 1300 TU, within 15 % (measured: −0.2 %, ⟨N⟩ = 6.75 at
+/// 1300 TU; 5 s on 2 cores).
+#[test]
+fn a_colony_grows_at_the_rate_of_its_clock() {
+    let (t0, k) = (300.0, 0.01);
+    // λ by bisection.
+    let f = |l: f64| 2.0 * (-l * t0).exp() * k / (k + l) - 1.0;
+    let (mut lo, mut hi) = (0.0, 0.01);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let lambda = 0.5 * (lo + hi);
+    let dt = 0.5;
+    let end = 1300.0;
+    let samples = (end / 50.0) as usize;
+    let counts: Vec<Vec<f64>> = (0..20u64)
+        .into_par_iter()
+        .map(|seed| {
+            let lattice = Lattice::new(200, 200);
+            let shape = PatchShape::new(lattice, 16).unwrap();
+            let cells = init::discs(lattice, shape, &[[100.0, 100.0]], 8.0, 2.5);
+            let mut t = Tissue::new(cells, ModelParams::paper(0.0));
+            let mut ws = Workspace::new(t.cells());
+            // The founder starts its cycle at birth, as every later cell does.
+            let mut clock = Proliferation::new(t0, k, seed, &t).with_axis(SplitAxis::Random);
+            clock.lineage[0].birth = 0.0;
+            let mut n = Vec::new();
+            for step in 0..(end / dt) as usize {
+                if step % 100 == 0 {
+                    n.push(t.n_cells() as f64);
+                }
+                t.step(&mut ws, &StepParams::new(dt, 1)).unwrap();
+                clock.divide_due(&mut t, &mut ws);
+            }
+            n
+        })
+        .collect();
+    let mean: Vec<f64> = (0..samples)
+        .map(|s| counts.iter().map(|c| c[s]).sum::<f64>() / counts.len() as f64)
+        .collect();
+    let (x, y): (Vec<f64>, Vec<f64>) = (0..samples)
+        .map(|s| (s as f64 * 50.0, mean[s].ln()))
+        .filter(|&(time, _)| time >= t0)
+        .unzip();
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let slope = x
+        .iter()
+        .zip(&y)
+        .map(|(a, b)| (a - mx) * (b - my))
+        .sum::<f64>()
+        / x.iter().map(|a| (a - mx) * (a - mx)).sum::<f64>();
+    eprintln!(
+        "growth rate {slope:.3e} /TU against the clock's {lambda:.3e} ({:+.1} %); <N> at 1300 TU: {:.2}",
+        100.0 * (slope / lambda - 1.0),
+        mean.last().unwrap()
+    );
+    assert!((slope / lambda - 1.0).abs() < 0.15);
+}
