@@ -16,6 +16,7 @@
 use phasefield::{ComTable, Real};
 
 use crate::terms::NoiseKey;
+
 use crate::tissue::Tissue;
 use crate::workspace::Workspace;
 
@@ -300,6 +301,54 @@ impl Proliferation {
             r.death = Some((time, Ending::Removal));
         }
     }
+}
+
+/// Removes, in the order of their identities, the cells whose area `A_i = Σ φ_i²` (from the
+/// last evaluation in `ws`) is below `fraction` of their target area `πR_i²`: the extrusion
+/// rule of docs/model.md §11.5 (a cell squeezed out of the layer loses its area in 2D). Keeps
+/// at least one cell; records each removal in `lineage` when given, and fits `ws`. Returns the
+/// removed identities.
+pub fn remove_extruded<T: Real>(
+    tissue: &mut Tissue<T>,
+    ws: &mut Workspace<T>,
+    fraction: f64,
+    mut lineage: Option<&mut Proliferation>,
+) -> Vec<usize> {
+    let base = tissue.params.energy.radius;
+    let pops = tissue.populations.clone();
+    let mut small: Vec<usize> = (0..tissue.n_cells())
+        .filter(|&slot| {
+            let id = tissue.cell_ids()[slot];
+            let r = pops
+                .kinds()
+                .get(pops.population(id))
+                .and_then(|k| k.radius)
+                .unwrap_or(base);
+            ws.cell(slot).area < fraction * std::f64::consts::PI * r * r
+        })
+        .map(|slot| tissue.cell_ids()[slot])
+        .collect();
+    small.sort_unstable();
+    let mut out = Vec::new();
+    for id in small {
+        if tissue.n_cells() == 1 {
+            break;
+        }
+        let slot = tissue
+            .cell_ids()
+            .iter()
+            .position(|&i| i == id)
+            .expect("a listed cell is there");
+        tissue.remove(slot);
+        if let Some(l) = lineage.as_deref_mut() {
+            l.removed(id, tissue.time());
+        }
+        out.push(id);
+    }
+    if !out.is_empty() {
+        ws.fit(tissue.cells());
+    }
+    out
 }
 
 #[cfg(test)]

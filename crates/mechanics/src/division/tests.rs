@@ -214,3 +214,36 @@ fn a_colony_grows_at_the_rate_of_its_clock() {
     );
     assert!((slope / lambda - 1.0).abs() < 0.15);
 }
+
+/// The extrusion rule removes exactly the cells below the area fraction, records their end
+/// in the lineage, and the tissue steps on with the others: three cells, one of them scaled
+/// to a third of its field (an area of a ninth).
+#[test]
+fn cells_below_the_area_fraction_are_removed() {
+    let lattice = Lattice::new(96, 64);
+    let shape = PatchShape::new(lattice, 14).unwrap();
+    let cells = init::discs(
+        lattice,
+        shape,
+        &[[20.0, 32.0], [48.0, 32.0], [76.0, 32.0]],
+        8.0,
+        2.5,
+    );
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0));
+    let plen = t.cells().patch_len();
+    for v in &mut t.phi_mut()[plen..2 * plen] {
+        *v /= 3.0;
+    }
+    let mut ws = Workspace::new(t.cells());
+    let mut clock = Proliferation::new(1e9, 1.0, 1, &t);
+    t.refresh(&mut ws);
+    let removed = remove_extruded(&mut t, &mut ws, 0.2, Some(&mut clock));
+    assert_eq!(removed, vec![1]);
+    assert_eq!(t.cell_ids(), &[0, 2]);
+    let r = clock.lineage().find(|r| r.id == 1).unwrap();
+    assert_eq!(r.death, Some((0.0, Ending::Removal)));
+    for _ in 0..10 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    assert!(remove_extruded(&mut t, &mut ws, 0.2, None).is_empty());
+}
