@@ -135,6 +135,9 @@ pub struct Proliferation {
     pub axis: SplitAxis,
     /// At most this many cells: a cell due to divide waits while the tissue has them.
     pub max_cells: usize,
+    /// Contact inhibition of proliferation: a cell due to divide waits while its pressure
+    /// ([`cell_pressure`]) is above this (none: never waits).
+    pub pressure_gate: Option<f64>,
     seed: u64,
     lineage: Vec<LineageRecord>,
 }
@@ -153,6 +156,7 @@ impl Proliferation {
             rate,
             axis: SplitAxis::Long,
             max_cells: usize::MAX,
+            pressure_gate: None,
             seed,
             lineage: Vec::new(),
         };
@@ -182,6 +186,13 @@ impl Proliferation {
     /// The same clock with the split along `axis`.
     pub fn with_axis(mut self, axis: SplitAxis) -> Self {
         self.axis = axis;
+        self
+    }
+
+    /// The same clock with contact inhibition of proliferation: a cell due to divide waits
+    /// while its pressure is above `p_max`.
+    pub fn with_pressure_gate(mut self, p_max: f64) -> Self {
+        self.pressure_gate = Some(p_max);
         self
     }
 
@@ -244,6 +255,9 @@ impl Proliferation {
                     .is_some_and(|r| r.id == id && now - r.birth >= r.cycle)
             })
             .collect();
+        if let Some(p_max) = self.pressure_gate {
+            due.retain(|&(_, slot)| cell_pressure(tissue, ws, slot) <= p_max);
+        }
         due.sort_unstable();
         let mut out = Vec::with_capacity(due.len());
         for (id, slot) in due {
@@ -301,6 +315,28 @@ impl Proliferation {
             r.death = Some((time, Ending::Removal));
         }
     }
+}
+
+/// The pressure of the cell in slot `slot`, `p_i = Σ_x φ_i P / Σ_x φ_i`, the tissue pressure
+/// `P` of the last evaluation in `ws` weighted by the cell's field.
+pub fn cell_pressure<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, slot: usize) -> f64 {
+    let cells = tissue.cells();
+    let shape = cells.shape();
+    let ly = cells.lattice().ly;
+    let (xs, ys) = (
+        cells.map().cell_x(shape, slot),
+        cells.map().cell_y(shape, slot),
+    );
+    let phi = cells.cell_phi(slot);
+    let (mut num, mut den) = (0.0, 0.0);
+    for (a, &x) in xs.iter().enumerate() {
+        for (b, &y) in ys.iter().enumerate() {
+            let w = phi[a * shape.ny + b].to_f64();
+            num += w * ws.sum(crate::SumField::P, x as usize * ly + y as usize);
+            den += w;
+        }
+    }
+    num / den
 }
 
 /// Removes, in the order of their identities, the cells whose area `A_i = Σ φ_i²` (from the

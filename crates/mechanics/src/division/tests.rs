@@ -247,3 +247,52 @@ fn cells_below_the_area_fraction_are_removed() {
     }
     assert!(remove_extruded(&mut t, &mut ws, 0.2, None).is_empty());
 }
+
+/// T5.4: contact inhibition of proliferation. A confluent tissue (the paper's density, 30
+/// cells on 71²) under a fast clock (`T₀ = 40`, `k = 0.05`) divides less with the pressure
+/// gate than without it, over 200 TU, the gate at the median cell pressure of the relaxed
+/// tissue (9.3e-3; the cells' pressures span 5.4e-3 to 1.3e-2). Measured: 170 divisions
+/// without the gate (the tissue reaches its cap of 200 cells), 3 with it, since every
+/// division raises the pressure of the cells around. Asserted: fewer than three quarters.
+#[test]
+fn a_pressure_gate_slows_division_at_confluence() {
+    let lattice = Lattice::new(71, 71);
+    let shape = PatchShape::new(lattice, 14).unwrap();
+    let centres = init::positions(lattice, 30, 4.0, &init::Layout::Random { seed: 3 }).unwrap();
+    let cells = init::discs(lattice, shape, &centres, 4.0, 2.5);
+    let mut t0 = Tissue::new(cells, ModelParams::paper(0.0));
+    let mut ws0 = Workspace::new(t0.cells());
+    for _ in 0..200 {
+        t0.step(&mut ws0, &StepParams::default()).unwrap();
+    }
+    t0.refresh(&mut ws0);
+    let mut p: Vec<f64> = (0..t0.n_cells())
+        .map(|s| cell_pressure(&t0, &ws0, s))
+        .collect();
+    p.sort_by(f64::total_cmp);
+    let median = p[p.len() / 2];
+    let divisions = |gate: Option<f64>| {
+        let (mut t, mut ws) = (t0.clone(), Workspace::new(t0.cells()));
+        let mut clock = Proliferation::new(40.0, 0.05, 4, &t).with_max_cells(200);
+        if let Some(g) = gate {
+            clock = clock.with_pressure_gate(g);
+        }
+        let mut n = 0;
+        for _ in 0..400 {
+            t.step(&mut ws, &StepParams::default()).unwrap();
+            n += clock.divide_due(&mut t, &mut ws).len();
+        }
+        n
+    };
+    let (free, gated) = (divisions(None), divisions(Some(median)));
+    eprintln!(
+        "pressures {:.2e} .. {:.2e}, median {median:.2e}; divisions in 200 TU: {free} without the gate, {gated} with it",
+        p[0],
+        p[p.len() - 1]
+    );
+    assert!(free >= 20, "{free}");
+    assert!(
+        (gated as f64) < 0.75 * free as f64,
+        "{gated} against {free}"
+    );
+}
