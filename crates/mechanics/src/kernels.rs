@@ -52,6 +52,11 @@ thread_local! {
     /// allocates nothing. A cell's results depend only on its own values, never on what the
     /// scratch held before, so they do not depend on which thread computed them.
     static PADDED: RefCell<PaddedPatch<N_GATHERED>> = RefCell::new(PaddedPatch::new());
+
+    /// Each thread's gathered node-term coefficients (`a`, `b` of [`NodeTerms`]) beside the
+    /// patch in [`PADDED`], in the same layout: used only with adhesion or walls, and made on
+    /// the first evaluation that has them.
+    static NODE_TERMS: RefCell<PaddedPatch<2>> = RefCell::new(PaddedPatch::new());
 }
 
 /// Sizes the scratch of every thread of the current rayon pool (the global one outside a pool)
@@ -199,6 +204,7 @@ pub(crate) fn evaluate<T: Real>(
     cell_state: &mut [CellState],
     cell_force: Option<&[[f64; 2]]>,
     lap_s1: &mut [f64],
+    node_buf: &mut [f64],
     cells_of: (&Populations, &[usize], bool),
     kind_constants: &mut Vec<CellConstants>,
     walls: Option<WallTerm<'_>>,
@@ -314,10 +320,17 @@ pub(crate) fn evaluate<T: Real>(
     if let Some(walls) = walls {
         add_wall_pressure(walls, global);
     }
+    // The node terms' per-node coefficients, gathered by the force pass.
+    let node_terms = (c_adh != 0.0 || walls.is_some()).then(|| {
+        fill_node_terms(c_adh, lap_s1, walls, node_buf);
+        let (a, b) = node_buf.split_at(node_buf.len() / 2);
+        NodeTerms { a, b, c_adh }
+    });
 
     // 3. Forces, velocities and the right-hand side.
     let g: &LatticeSums<N_SUMS> = global;
     let map = cells.map();
+    let map_lx = cells.lattice().lx;
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
         let CellConstants { coef, xi, .. } = constants(i);
@@ -362,16 +375,39 @@ pub(crate) fn evaluate<T: Real>(
             st.force = Vector2::from(force);
             st.velocity = Vector2::from(v);
             let area_factor = coef.area_factor(st.area);
-            run.write_to(
-                [s2],
-                move |s, [s2]| {
-                    let others = s2 - s.c * s.c;
-                    let dfdphi =
-                        coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
-                    [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
-                },
-                [flat],
-            );
+            match node_terms {
+                None => run.write_to(
+                    [s2],
+                    move |s, [s2]| {
+                        let others = s2 - s.c * s.c;
+                        let dfdphi =
+                            coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
+                        [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
+                    },
+                    [flat],
+                ),
+                // Adhesion and walls: their derivative `a φ + b + c ∇²φ` (see `NodeTerms`),
+                // with `a` and `b` gathered beside the patch (a branch outside the node loops).
+                Some(NodeTerms { a, b, c_adh }) => NODE_TERMS.with_borrow_mut(|extra| {
+                    extra.prepare(shape);
+                    extra.gather(xs, g.cell_runs(i), |x| {
+                        let ly = a.len() / map_lx;
+                        [&a[x * ly..(x + 1) * ly], &b[x * ly..(x + 1) * ly]]
+                    });
+                    let [ea, eb] = extra.gathered();
+                    run.write_to(
+                        [s2, ea, eb],
+                        move |s, [s2, ea, eb]| {
+                            let others = s2 - s.c * s.c;
+                            let lap = s.laplacian();
+                            let dfdphi = coef.free_energy_derivative(s.c, lap, area_factor, others)
+                                + node_derivative(ea, eb, c_adh, s.c, lap);
+                            [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
+                        },
+                        [flat],
+                    )
+                }),
+            }
             padded.store(out);
         });
         // The Heun update of this cell, while its fields are in cache.
@@ -397,11 +433,6 @@ pub(crate) fn evaluate<T: Real>(
             }
         }
     };
-    let sweep = c_adh != 0.0 || walls.is_some();
-    assert!(
-        !sweep || matches!(post, Post::Nothing),
-        "adhesion and walls add to the right-hand side after the force pass, so the Heun update cannot be fused into it"
-    );
     let cells_iter = rhs_out
         .par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
@@ -452,16 +483,6 @@ pub(crate) fn evaluate<T: Real>(
                     body(i, out, cell, st, post)
                 });
         }
-    }
-    if sweep {
-        let lap_s1: &[f64] = lap_s1;
-        rhs_out
-            .par_chunks_mut(plen)
-            .zip(phi.par_chunks(plen))
-            .enumerate()
-            .for_each(|(i, (out, cell))| {
-                add_node_terms_rhs(c_adh, lap_s1, walls, cells, i, cell, out);
-            });
     }
 }
 
@@ -527,34 +548,52 @@ fn add_adhesion_pressure(c: f64, sums: &mut LatticeSums<N_SUMS>, lap_s1: &mut [f
     }
 }
 
-/// Adds the node-loop terms' part of `−δF/δφ_i` to cell `i`'s right-hand side `out`, node
-/// by node (a sweep of its own, run only with them): the adhesion's `c (∇²s1 − ∇²φ_i)`
-/// ([`adhesion_derivative`], with `c ≠ 0`) and the walls' ([`wall_derivative`]).
-fn add_node_terms_rhs<T: Real>(
-    c: f64,
-    lap_s1: &[f64],
-    walls: Option<WallTerm<'_>>,
-    cells: &Cells<T>,
-    i: usize,
-    cell: &[T],
-    out: &mut [T],
-) {
-    let shape = cells.shape();
-    let ly = cells.lattice().ly;
-    let (xs, ys) = (cells.map().cell_x(shape, i), cells.map().cell_y(shape, i));
-    phasefield::for_each_stencil_at(cell, shape, |k, a, b, s| {
-        let node = xs[a] as usize * ly + ys[b] as usize;
-        let mut r = out[k].to_f64();
-        if c != 0.0 {
-            r -= adhesion_derivative(c, lap_s1[node], s.laplacian());
-        }
-        if let Some(WallTerm {
-            field,
-            coefficients,
-        }) = walls
-        {
-            r -= wall_derivative(coefficients, s.c, field.w()[node], field.laplacian()[node]);
-        }
-        out[k] = T::from_f64(r);
-    });
+/// The node terms' coefficients of an evaluation: their derivative is linear in `φ_i`,
+/// `δF_node/δφ_i = a φ_i + b + c_adh ∇²φ_i`, with the lattice fields
+/// `a = (2κ_w/λ) w²` and `b = −2ω_wλ ∇²w − c_adh ∇²s1` (index `x * ly + y`): the walls'
+/// [`wall_derivative`] and the adhesion's [`adhesion_derivative`] split by linearity.
+#[derive(Debug, Clone, Copy)]
+struct NodeTerms<'a> {
+    a: &'a [f64],
+    b: &'a [f64],
+    c_adh: f64,
+}
+
+/// [`NodeTerms`]' `a` and `b` into the two halves of `out` (two lattice fields).
+fn fill_node_terms(c_adh: f64, lap_s1: &[f64], walls: Option<WallTerm<'_>>, out: &mut [f64]) {
+    let (a, b) = out.split_at_mut(out.len() / 2);
+    const CHUNK: usize = 4096;
+    a.par_chunks_mut(CHUNK)
+        .zip(b.par_chunks_mut(CHUNK))
+        .enumerate()
+        .for_each(|(c, (a, b))| {
+            let k0 = c * CHUNK;
+            match walls {
+                Some(WallTerm {
+                    field,
+                    coefficients,
+                }) => {
+                    let (w, lap_w) = (&field.w()[k0..], &field.laplacian()[k0..]);
+                    for (k, (a, b)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
+                        *a = wall_derivative(coefficients, 1.0, w[k], 0.0);
+                        *b = wall_derivative(coefficients, 0.0, w[k], lap_w[k]);
+                    }
+                }
+                None => {
+                    a.fill(0.0);
+                    b.fill(0.0);
+                }
+            }
+            if c_adh != 0.0 {
+                for (b, &lap) in b.iter_mut().zip(&lap_s1[k0..]) {
+                    *b += adhesion_derivative(c_adh, lap, 0.0);
+                }
+            }
+        });
+}
+
+/// The node terms' derivative at a node, `a φ + b + c_adh ∇²φ` ([`NodeTerms`]).
+#[inline(always)]
+fn node_derivative(a: f64, b: f64, c_adh: f64, phi: f64, laplacian: f64) -> f64 {
+    a * phi + b + adhesion_derivative(c_adh, 0.0, laplacian)
 }

@@ -126,8 +126,9 @@ impl<T: Real> Tissue<T> {
         let dt = step_params.dt;
         // The predictor and the last corrector pass are fused into the evaluations before
         // them (`Post`): two sweeps over every field and two parallel loops fewer per step.
-        // Adhesion adds to the right-hand side in a sweep of its own, after the force pass, so
-        // its steps are the separate sweeps (tested to be the fused step to the bit).
+        // Adhesion and walls add their derivative inside the force pass too; `fuses` is the
+        // switch for a term that could not (the separate sweeps are tested to be the fused
+        // step to the bit).
         let fused = self.fuses();
         self.start_step(ws, dt, Some(dt), check)?;
         for pass in 0..step_params.npc {
@@ -172,6 +173,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             ..
         } = ws;
@@ -188,6 +190,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             post,
         );
@@ -211,10 +214,10 @@ impl<T: Real> Tissue<T> {
         Ok(())
     }
 
-    /// Whether the Heun update is fused into the force pass: not with adhesion or walls,
-    /// which add to the right-hand side after it.
+    /// Whether the Heun update is fused into the force pass: always, since adhesion and walls
+    /// add their derivative inside it (kept as a switch for a term that cannot).
     fn fuses(&self) -> bool {
-        self.params.omega == 0.0 && self.wall_field().is_none()
+        true
     }
 
     /// The walls in effect, with their coefficients.
@@ -267,6 +270,7 @@ impl<T: Real> Tissue<T> {
             next_centre,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             ..
         } = ws;
@@ -277,6 +281,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             Post::Correct {
                 h,
@@ -315,6 +320,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             ..
         } = ws;
@@ -325,6 +331,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             Post::Nothing,
         );
@@ -368,6 +375,7 @@ impl<T: Real> Tissue<T> {
         cell_state: &mut [CellState],
         cell_force: &mut [[f64; 2]],
         lap_s1: &mut Vec<f64>,
+        node_terms: &mut Vec<f64>,
         kind_constants: &mut Vec<crate::terms::CellConstants>,
         post: Post<'_, T>,
     ) {
@@ -380,6 +388,15 @@ impl<T: Real> Tissue<T> {
         };
         if lap_s1.len() != n {
             lap_s1.resize(n, 0.0);
+        }
+        // The node terms' coefficients, with adhesion or walls (made on first use too).
+        let m = if self.params.omega != 0.0 || self.wall_field().is_some() {
+            2 * self.lattice().len()
+        } else {
+            0
+        };
+        if node_terms.len() != m {
+            node_terms.resize(m, 0.0);
         }
         // The terms' whole-cell forces of the current state, from the per-cell quantities the
         // last evaluation left (see `CellContext::state`).
@@ -399,6 +416,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             (&self.populations, &self.cell_id, self.active),
             kind_constants,
             self.wall_term(),
@@ -421,6 +439,7 @@ impl<T: Real> Tissue<T> {
             com,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             ..
         } = ws;
@@ -432,6 +451,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             cell_force,
             lap_s1,
+            node_terms,
             kind_constants,
             Post::Nothing,
         );

@@ -94,6 +94,9 @@ pub struct Workspace<T: Real = f64> {
     pub(crate) cell_force: Vec<[f64; 2]>,
     /// The lattice Laplacian of `s1`, with adhesion only (empty otherwise).
     pub(crate) lap_s1: Vec<f64>,
+    /// The node terms' two lattice fields of coefficients, with adhesion or walls only
+    /// (empty otherwise).
+    pub(crate) node_terms: Vec<f64>,
     /// Each population's constants in the current evaluation (one entry without populations).
     pub(crate) kind_constants: Vec<crate::terms::CellConstants>,
 }
@@ -112,7 +115,7 @@ impl<T: Real> Workspace<T> {
                 + self.next_centre.capacity()
                 + self.cell_force.capacity())
                 * std::mem::size_of::<[f64; 2]>()
-            + self.lap_s1.capacity() * std::mem::size_of::<f64>()
+            + (self.lap_s1.capacity() + self.node_terms.capacity()) * std::mem::size_of::<f64>()
             + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
             + self.com.heap_bytes()
             + crate::kernels::scratch_bytes()
@@ -135,6 +138,7 @@ impl<T: Real> Workspace<T> {
             com: ComTable::new(lattice),
             cell_force: vec![[0.0; 2]; cells.n_cells()],
             lap_s1: Vec::new(),
+            node_terms: Vec::new(),
             kind_constants: Vec::with_capacity(4),
         }
     }

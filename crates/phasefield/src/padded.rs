@@ -170,6 +170,14 @@ impl<const M: usize> PaddedPatch<M> {
         }
     }
 
+    /// The gathered fields alone (for a scratch that gathers beside another one's patch, in
+    /// the same layout: [`PaddedPatch::prepare`] it with the same shape, then
+    /// [`PaddedPatch::gather`]).
+    pub fn gathered(&self) -> [&[f64]; M] {
+        let n = self.len();
+        std::array::from_fn(|m| &self.fields[m * n..(m + 1) * n])
+    }
+
     /// The run, the mask, the gathered fields and the output buffer, borrowed together.
     pub fn parts(&mut self) -> PaddedParts<'_, M> {
         let (n, p) = (self.len(), self.stride());
