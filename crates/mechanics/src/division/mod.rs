@@ -48,7 +48,8 @@ impl<T: Real> Tissue<T> {
         assert!(norm > 0.0, "a division needs a direction");
         let dir = [direction[0] / norm, direction[1] / norm];
         let mother = self.cell_id[slot];
-        let (a, b) = (self.next_id(), self.next_id() + 1);
+        let a = self.next_id();
+        let b = a + 1;
         let lambda = self.params.energy.lambda;
         let new = self.cells.split(slot, self.centre[slot], dir, lambda);
         self.cell_id[slot] = a;
@@ -350,19 +351,18 @@ pub fn remove_extruded<T: Real>(
     fraction: f64,
     mut lineage: Option<&mut Proliferation>,
 ) -> Vec<usize> {
-    let base = tissue.params.energy.radius;
-    let pops = tissue.populations.clone();
+    // Each cell's target radius by its population's override rules (`Populations::params`).
     let mut small: Vec<usize> = (0..tissue.n_cells())
-        .filter(|&slot| {
-            let id = tissue.cell_ids()[slot];
+        .map(|slot| (slot, tissue.cell_ids()[slot]))
+        .filter(|&(slot, id)| {
+            let pops = &tissue.populations;
             let r = pops
-                .kinds()
-                .get(pops.population(id))
-                .and_then(|k| k.radius)
-                .unwrap_or(base);
+                .params(pops.population(id), &tissue.params)
+                .energy
+                .radius;
             ws.cell(slot).area < fraction * std::f64::consts::PI * r * r
         })
-        .map(|slot| tissue.cell_ids()[slot])
+        .map(|(_, id)| id)
         .collect();
     small.sort_unstable();
     let mut out = Vec::new();

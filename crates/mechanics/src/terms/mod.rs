@@ -260,25 +260,13 @@ impl Terms {
         if self.n == n {
             return;
         }
-        self.n = n;
-        let seed = self.seed;
-        for (t, e) in self.entries.iter_mut().enumerate() {
-            let len = e.len;
-            e.x = vec![0.0; n * len];
-            e.old = vec![0.0; n * len];
-            e.rate1 = vec![0.0; n * len];
-            e.kick = vec![0.0; n * len];
-            for id in 0..n {
-                let key = |k: u64| NoiseKey {
-                    seed,
-                    cell: id as u64,
-                    step: 0,
-                    stage: INITIAL_STAGE + ((t as u64) << 16) + k,
-                };
-                e.term
-                    .initial_state(id, &key, &mut e.x[id * len..(id + 1) * len]);
+        for e in &mut self.entries {
+            for v in [&mut e.x, &mut e.old, &mut e.rate1, &mut e.kick] {
+                v.clear();
             }
         }
+        self.n = 0;
+        self.extend_to(n);
     }
 
     /// Allocates and initialises the state of the identities `n..n_new` (new cells of a
