@@ -10,7 +10,7 @@ use crate::params::StepParams;
 use crate::scatter::LatticeSums;
 use crate::terms::CellsView;
 use crate::tissue::Tissue;
-use crate::workspace::{CellState, Workspace, N_SUMS};
+use crate::workspace::{CellState, TermScratch, Workspace, N_SUMS};
 use crate::StepError;
 
 /// How far outside `[0, 1]` a phase field may go before the step is declared unstable.
@@ -171,10 +171,7 @@ impl<T: Real> Tissue<T> {
             k1,
             sums,
             cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
+            term_scratch,
             ..
         } = ws;
         let fused = self.fuses();
@@ -183,17 +180,7 @@ impl<T: Real> Tissue<T> {
             _ => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
-        self.evaluate_fields(
-            shapes,
-            k1,
-            sums,
-            cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
-            post,
-        );
+        self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -268,10 +255,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             com,
             next_centre,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
+            term_scratch,
             ..
         } = ws;
         self.evaluate_fields(
@@ -279,10 +263,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
+            term_scratch,
             Post::Correct {
                 h,
                 k1,
@@ -318,10 +299,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
+            term_scratch,
             ..
         } = ws;
         self.evaluate_fields(
@@ -329,10 +307,7 @@ impl<T: Real> Tissue<T> {
             k2,
             sums,
             cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
+            term_scratch,
             Post::Nothing,
         );
         if !self.terms.is_empty() {
@@ -373,12 +348,15 @@ impl<T: Real> Tissue<T> {
         out: &mut [T],
         sums: &mut LatticeSums<N_SUMS>,
         cell_state: &mut [CellState],
-        cell_force: &mut [[f64; 2]],
-        lap_s1: &mut Vec<f64>,
-        node_terms: &mut Vec<f64>,
-        kind_constants: &mut Vec<crate::terms::CellConstants>,
+        scratch: &mut TermScratch,
         post: Post<'_, T>,
     ) {
+        let TermScratch {
+            cell_force,
+            lap_s1,
+            node_terms,
+            kind_constants,
+        } = scratch;
         // The lattice buffer of adhesion, made on its first use (the one allocation of a run
         // with adhesion).
         let n = if self.params.omega != 0.0 {
@@ -404,7 +382,7 @@ impl<T: Real> Tissue<T> {
             None
         } else {
             self.terms.forces(&self.terms_view(cell_state), cell_force);
-            Some(&*cell_force)
+            Some(&cell_force[..])
         };
         evaluate(
             &self.params,
@@ -437,24 +415,11 @@ impl<T: Real> Tissue<T> {
             cell_state,
             observed_centre,
             com,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
+            term_scratch,
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
-        self.evaluate_fields(
-            true,
-            k2,
-            sums,
-            cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            kind_constants,
-            Post::Nothing,
-        );
+        self.evaluate_fields(true, k2, sums, cell_state, term_scratch, Post::Nothing);
     }
 }
 

@@ -90,6 +90,14 @@ pub struct Workspace<T: Real = f64> {
     /// The centres of mass of the state a fixed step ends in, computed in its corrector pass.
     pub(crate) next_centre: Vec<[f64; 2]>,
     pub(crate) com: ComTable,
+    /// The buffers of the physics terms in an evaluation.
+    pub(crate) term_scratch: TermScratch,
+}
+
+/// The buffers an evaluation needs for the physics terms (docs/model.md §11), passed to it as
+/// one: a new term's buffer goes here, not into every call of the evaluation.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TermScratch {
     /// The whole-cell forces of the terms for the next evaluation, by slot.
     pub(crate) cell_force: Vec<[f64; 2]>,
     /// The lattice Laplacian of `s1`, with adhesion only (empty otherwise).
@@ -99,6 +107,15 @@ pub struct Workspace<T: Real = f64> {
     pub(crate) node_terms: Vec<f64>,
     /// Each population's constants in the current evaluation (one entry without populations).
     pub(crate) kind_constants: Vec<crate::terms::CellConstants>,
+}
+
+impl TermScratch {
+    /// Bytes of heap memory held.
+    fn heap_bytes(&self) -> usize {
+        self.cell_force.capacity() * std::mem::size_of::<[f64; 2]>()
+            + (self.lap_s1.capacity() + self.node_terms.capacity()) * std::mem::size_of::<f64>()
+            + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
+    }
 }
 
 impl<T: Real> Workspace<T> {
@@ -111,12 +128,9 @@ impl<T: Real> Workspace<T> {
             + self.sums.heap_bytes()
             + self.cell_state.capacity() * std::mem::size_of::<CellState>()
             + self.velocity_field.heap_bytes()
-            + (self.observed_centre.capacity()
-                + self.next_centre.capacity()
-                + self.cell_force.capacity())
+            + (self.observed_centre.capacity() + self.next_centre.capacity())
                 * std::mem::size_of::<[f64; 2]>()
-            + (self.lap_s1.capacity() + self.node_terms.capacity()) * std::mem::size_of::<f64>()
-            + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
+            + self.term_scratch.heap_bytes()
             + self.com.heap_bytes()
             + crate::kernels::scratch_bytes()
     }
@@ -136,10 +150,12 @@ impl<T: Real> Workspace<T> {
             observed_centre: vec![[0.0; 2]; cells.n_cells()],
             next_centre: vec![[0.0; 2]; cells.n_cells()],
             com: ComTable::new(lattice),
-            cell_force: vec![[0.0; 2]; cells.n_cells()],
-            lap_s1: Vec::new(),
-            node_terms: Vec::new(),
-            kind_constants: Vec::with_capacity(4),
+            term_scratch: TermScratch {
+                cell_force: vec![[0.0; 2]; cells.n_cells()],
+                lap_s1: Vec::new(),
+                node_terms: Vec::new(),
+                kind_constants: Vec::with_capacity(4),
+            },
         }
     }
 
@@ -157,7 +173,7 @@ impl<T: Real> Workspace<T> {
         for v in [
             &mut self.observed_centre,
             &mut self.next_centre,
-            &mut self.cell_force,
+            &mut self.term_scratch.cell_force,
         ] {
             v.resize(n, [0.0; 2]);
         }
