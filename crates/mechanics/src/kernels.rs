@@ -330,7 +330,7 @@ pub(crate) fn evaluate<T: Real>(
     // 3. Forces, velocities and the right-hand side.
     let g: &LatticeSums<N_SUMS> = global;
     let map = cells.map();
-    let map_lx = cells.lattice().lx;
+    let ly = cells.lattice().ly;
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
         let CellConstants { coef, xi, .. } = constants(i);
@@ -391,7 +391,6 @@ pub(crate) fn evaluate<T: Real>(
                 Some(NodeTerms { a, b, c_adh }) => NODE_TERMS.with_borrow_mut(|extra| {
                     extra.prepare(shape);
                     extra.gather(xs, g.cell_runs(i), |x| {
-                        let ly = a.len() / map_lx;
                         [&a[x * ly..(x + 1) * ly], &b[x * ly..(x + 1) * ly]]
                     });
                     let [ea, eb] = extra.gathered();

@@ -125,14 +125,12 @@ impl<T: Real> Tissue<T> {
     ) -> Result<(), StepError> {
         let dt = step_params.dt;
         // The predictor and the last corrector pass are fused into the evaluations before
-        // them (`Post`): two sweeps over every field and two parallel loops fewer per step.
-        // Adhesion and walls add their derivative inside the force pass too; `fuses` is the
-        // switch for a term that could not (the separate sweeps are tested to be the fused
-        // step to the bit).
-        let fused = self.fuses();
+        // them (`Post`): two sweeps over every field and two parallel loops fewer per step
+        // (tested to be the separate sweeps to the bit). Adhesion and walls add their
+        // derivative inside the force pass too (`kernels::NodeTerms`).
         self.start_step(ws, dt, Some(dt), check)?;
         for pass in 0..step_params.npc {
-            if pass + 1 < step_params.npc || !fused {
+            if pass + 1 < step_params.npc {
                 self.correct::<false>(ws, dt);
             } else {
                 self.correct_last(ws, dt);
@@ -140,7 +138,7 @@ impl<T: Real> Tissue<T> {
         }
         self.iteration += 1;
         self.time += dt;
-        if step_params.npc > 0 && fused {
+        if step_params.npc > 0 {
             // The last corrector pass measured the new centres (`Post::Correct`).
             self.move_patches_to(&ws.next_centre);
         } else {
@@ -174,10 +172,9 @@ impl<T: Real> Tissue<T> {
             term_scratch,
             ..
         } = ws;
-        let fused = self.fuses();
         let post = match predict {
-            Some(h) if fused => Post::Predict { h, out: phi_old },
-            _ => Post::Nothing,
+            Some(h) => Post::Predict { h, out: phi_old },
+            None => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
         self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post);
@@ -192,19 +189,9 @@ impl<T: Real> Tissue<T> {
             self.with_terms_view(cell_state, |terms, view| terms.begin(view));
         }
         if let Some(h) = predict {
-            if fused {
-                self.terms.predict(h);
-            } else {
-                self.predict(ws, h);
-            }
+            self.terms.predict(h);
         }
         Ok(())
-    }
-
-    /// Whether the Heun update is fused into the force pass: always, since adhesion and walls
-    /// add their derivative inside it (kept as a switch for a term that cannot).
-    fn fuses(&self) -> bool {
-        true
     }
 
     /// The walls in effect, with their coefficients.
