@@ -55,8 +55,8 @@ pub struct Scene {
     pub(crate) file: SceneFile,
     /// The initial centres, computed by the validation (which checks that they fit).
     pub(crate) centres: Vec<[f64; 2]>,
-    /// The wall fields of `[walls]`, during and after the relaxation.
-    pub(crate) walls: Option<(phasefield::WallField, Option<phasefield::WallField>)>,
+    /// The walls of `[walls]`, built once by the validation (their fields are shared).
+    pub(crate) walls: Option<mechanics::walls::Walls>,
 }
 
 /// When the writers of a run directory fire ([`Scene::output_schedules`]).
@@ -318,21 +318,19 @@ impl Scene {
         }
     }
 
-    /// The walls of `[walls]`, if any.
+    /// The walls of `[walls]`, if any (a clone that shares the scene's wall fields).
     pub fn walls(&self) -> Option<mechanics::walls::Walls> {
-        let (during, after) = self.walls.clone()?;
-        let spec = self.file.walls.as_ref()?;
-        let walls = mechanics::walls::Walls::new(during, spec.kappa, spec.omega);
-        Some(if spec.kind == WallKind::Wound {
-            walls.replaced_when_active(after)
-        } else {
-            walls
-        })
+        self.walls.clone()
     }
 
     /// The wall field during the relaxation and after it (none: no walls then), for outputs.
     pub fn wall_fields(&self) -> Option<(&phasefield::WallField, Option<&phasefield::WallField>)> {
-        self.walls.as_ref().map(|(a, b)| (a, b.as_ref()))
+        self.walls.as_ref().map(|w| {
+            let during = w
+                .field(false)
+                .expect("walls have a field during the relaxation");
+            (during, w.field(true))
+        })
     }
 
     /// The populations of `[[population]]` (empty without), cells dealt by `[run] seed`.

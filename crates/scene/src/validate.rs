@@ -635,7 +635,7 @@ impl SceneFile {
             }
         }
         let walls = match &self.walls {
-            Some(spec) => Some(crate::walls::wall_fields(
+            Some(spec) => Some(crate::walls::walls_of(
                 spec,
                 lattice,
                 init::wall_clearance(r0),
@@ -655,7 +655,7 @@ impl SceneFile {
             c.count,
             r0,
             &layout,
-            walls.as_ref().map(|(w, _)| w),
+            walls.as_ref().and_then(|w| w.field(false)),
         ) {
             Ok(centres) => centres,
             Err(e) => {

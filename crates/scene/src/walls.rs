@@ -3,23 +3,24 @@
 
 use std::path::Path;
 
+use mechanics::walls::Walls;
 use phasefield::{Lattice, WallField, WallShape};
 
 use crate::file::{WallKind, WallsSpec};
 use crate::validate::{invalid, SceneError};
 
-/// The wall fields of `[walls]`: during the relaxation, and after it (none once a wound has
-/// opened). `reach` is how far from the solid the distances must be exact (the initial
-/// placement's clearance).
+/// The walls of `[walls]`: their field during the relaxation and after it (none once a wound
+/// has opened), with κ_w and ω_w. `reach` is how far from the solid the distances must be
+/// exact (the initial placement's clearance).
 ///
 /// # Errors
 /// [`SceneError::Invalid`] naming the key, for a bad value, a key of another kind, or a mask
 /// file that cannot be read or does not fit the lattice.
-pub(crate) fn wall_fields(
+pub(crate) fn walls_of(
     spec: &WallsSpec,
     lattice: Lattice,
     reach: f64,
-) -> Result<(WallField, Option<WallField>), SceneError> {
+) -> Result<Walls, SceneError> {
     let (lx, ly) = (lattice.lx as f64, lattice.ly as f64);
     if !(spec.thickness.is_finite() && spec.thickness > 0.0 && spec.thickness <= 10.0) {
         return Err(invalid(
@@ -182,12 +183,15 @@ pub(crate) fn wall_fields(
             },
         ));
     }
-    let field = WallField::new(lattice, &solid, spec.thickness, reach);
-    let after = match spec.kind {
-        WallKind::Wound => None,
-        _ => Some(field.clone()),
-    };
-    Ok((field, after))
+    let walls = Walls::new(
+        WallField::new(lattice, &solid, spec.thickness, reach),
+        spec.kappa,
+        spec.omega,
+    );
+    Ok(match spec.kind {
+        WallKind::Wound => walls.replaced_when_active(None),
+        _ => walls,
+    })
 }
 
 /// The solid nodes of a mask file: a PNG image (bright solid) or a `.npy` array (non-zero
@@ -378,7 +382,8 @@ mod tests {
                 "walls.invert=true".into(),
             ];
             let file = crate::SceneFile::parse(BASE, &set).unwrap();
-            let (f, _) = wall_fields(file.walls.as_ref().unwrap(), l, 0.0).unwrap();
+            let w = walls_of(file.walls.as_ref().unwrap(), l, 0.0).unwrap();
+            let f = w.field(false).unwrap();
             assert!(!f.is_solid(l.index(20, 29)) && f.is_solid(l.index(20, 10)));
         }
         let path = dir.path().join("m.npy");
