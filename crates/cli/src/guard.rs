@@ -159,14 +159,16 @@ pub fn memory_of(scene: &Scene, runs: usize, max_memory: Option<&str>) -> Result
             String::new()
         };
         bail!(
-            "the run needs about {} ({} cell(s) of {}×{} patch nodes on a {}×{} lattice{at_once}), more than {} ({what}); reduce [cells] count, [domain] lx and ly or [integrator] margin{f32_hint}, or give a larger --max-memory",
+            "the run needs about {} ({} cell(s){} of {}×{} patch nodes on a {}×{} lattice{at_once}), more than {} ({what}); reduce {}, [domain] lx and ly or [integrator] margin{f32_hint}, or give a larger --max-memory",
             gib(est),
-            f.cells.count,
+            scene.max_cells(),
+            if f.division.is_some() { " at most, [division] max_cells" } else { "" },
             shape.nx,
             shape.ny,
             f.domain.lx,
             f.domain.ly,
-            gib(limit)
+            gib(limit),
+            if f.division.is_some() { "[division] max_cells" } else { "[cells] count" }
         );
     }
     Ok(())

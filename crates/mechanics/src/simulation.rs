@@ -334,7 +334,6 @@ pub struct Simulation<T: Real = f64> {
     callbacks: Vec<Entry<T>>,
     writers: Vec<Entry<T>>,
     fixes: Vec<(String, Timer, Box<dyn Fix<T>>)>,
-    proliferation: Option<(crate::division::Proliferation, Option<f64>)>,
     sort_scratch: Vec<T>,
     initialized: bool,
 }
@@ -362,7 +361,6 @@ impl<T: Real> Simulation<T> {
             callbacks: Vec::new(),
             writers: Vec::new(),
             fixes: Vec::new(),
-            proliferation: None,
             sort_scratch: Vec::new(),
             initialized: false,
         }
@@ -371,20 +369,24 @@ impl<T: Real> Simulation<T> {
     /// Cells divide by the clock `clock` after every step, and, with `extrusion = Some(f)`,
     /// cells whose area falls below `f πR²` are removed
     /// ([`crate::division::remove_extruded`]); both before the fixes and callbacks of the
-    /// step. The number of cells then changes during the run: the run-directory writers of
-    /// `rundir` do not support that yet.
+    /// step ([`Tissue::proliferate`]). The tissue holds the clock
+    /// ([`Tissue::with_proliferation`], which this calls), so outputs see the lineage.
     pub fn with_proliferation(
         mut self,
         clock: crate::division::Proliferation,
         extrusion: Option<f64>,
     ) -> Self {
-        self.proliferation = Some((clock, extrusion));
+        let clock = match extrusion {
+            Some(f) => clock.with_extrusion(f),
+            None => clock,
+        };
+        self.tissue = self.tissue.with_proliferation(clock);
         self
     }
 
-    /// The division clock and its lineage, with [`Simulation::with_proliferation`].
+    /// The division clock and its lineage ([`Tissue::proliferation`]).
     pub fn proliferation(&self) -> Option<&crate::division::Proliferation> {
-        self.proliferation.as_ref().map(|p| &p.0)
+        self.tissue.proliferation()
     }
 
     /// Stops when the tissue has taken `n` steps in all.
@@ -670,17 +672,7 @@ impl<T: Real> Simulation<T> {
                 }
             }
             self.apply_activity();
-            if let Some((clock, extrusion)) = &mut self.proliferation {
-                clock.divide_due(&mut self.tissue, &mut self.workspace);
-                if let Some(f) = *extrusion {
-                    crate::division::remove_extruded(
-                        &mut self.tissue,
-                        &mut self.workspace,
-                        f,
-                        Some(clock),
-                    );
-                }
-            }
+            self.tissue.proliferate(&mut self.workspace);
             let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
             for (name, timer, fix) in &mut self.fixes {
                 if timer.fires(iteration, time, false) {

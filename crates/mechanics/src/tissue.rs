@@ -4,6 +4,7 @@ use nalgebra::Vector2;
 use phasefield::{Cells, ComTable, Lattice, Real};
 use rayon::prelude::*;
 
+use crate::division::Proliferation;
 use crate::params::ModelParams;
 use crate::terms::{Populations, Terms};
 use crate::walls::Walls;
@@ -39,6 +40,8 @@ pub struct Tissue<T: Real = f64> {
     pub(crate) populations: Populations,
     /// Walls (`crate::walls`), if any.
     pub(crate) walls: Option<Walls>,
+    /// The cell-cycle clock and the lineage (`crate::division`), if cells divide.
+    pub(crate) proliferation: Option<Box<Proliferation>>,
 }
 
 impl<T: Real> Tissue<T> {
@@ -48,6 +51,7 @@ impl<T: Real> Tissue<T> {
         self.cells.heap_bytes()
             + self.terms.heap_bytes()
             + self.walls.as_ref().map_or(0, Walls::heap_bytes)
+            + self.proliferation.as_ref().map_or(0, |p| p.heap_bytes())
             + self.centre.capacity() * std::mem::size_of::<[f64; 2]>()
             + self.cell_id.capacity() * std::mem::size_of::<usize>()
     }
@@ -63,11 +67,12 @@ impl<T: Real> Tissue<T> {
     }
 
     /// A tissue from a saved state: fields (with their patch origins), parameters, clock
-    /// and the identity of each slot (a permutation of `0..n_cells`). The centres are
-    /// computed from the fields; the patches stay where they are.
+    /// and the identity of each slot (distinct; a permutation of `0..n_cells` unless cells
+    /// have divided or been removed). The centres are computed from the fields; the patches
+    /// stay where they are.
     ///
     /// # Panics
-    /// If `cell_id` is not a permutation of `0..cells.n_cells()`.
+    /// If `cell_id` does not hold one distinct identity per cell.
     pub fn from_state(
         cells: Cells<T>,
         params: ModelParams,
@@ -76,13 +81,9 @@ impl<T: Real> Tissue<T> {
         cell_id: Vec<usize>,
     ) -> Self {
         let n = cells.n_cells();
-        let mut seen = vec![false; n];
         assert!(
-            cell_id.len() == n
-                && cell_id
-                    .iter()
-                    .all(|&i| i < n && !std::mem::replace(&mut seen[i], true)),
-            "cell_id must be a permutation of 0..{n}"
+            cell_id.len() == n && distinct(&cell_id),
+            "cell_id must hold {n} distinct identities"
         );
         let mut t = Self {
             centre: vec![[0.0; 2]; n],
@@ -95,6 +96,7 @@ impl<T: Real> Tissue<T> {
             active: true,
             populations: Populations::default(),
             walls: None,
+            proliferation: None,
         };
         let com = ComTable::new(t.cells.lattice());
         let mut centre = std::mem::take(&mut t.centre);
@@ -118,15 +120,9 @@ impl<T: Real> Tissue<T> {
         cell_id: Vec<usize>,
     ) -> Result<Self, String> {
         let n = cells.n_cells();
-        let mut seen = vec![false; n];
-        if centre.len() != n
-            || cell_id.len() != n
-            || !cell_id
-                .iter()
-                .all(|&i| i < n && !std::mem::replace(&mut seen[i], true))
-        {
+        if centre.len() != n || cell_id.len() != n || !distinct(&cell_id) {
             return Err(format!(
-                "{} centres and identities {:?}… for {n} cells: not a permutation of 0..{n}",
+                "{} centres and identities {:?}… for {n} cells: not {n} distinct identities",
                 centre.len(),
                 &cell_id[..cell_id.len().min(4)]
             ));
@@ -145,13 +141,14 @@ impl<T: Real> Tissue<T> {
             active: true,
             populations: Populations::default(),
             walls: None,
+            proliferation: None,
         })
     }
 
     /// This tissue with the physics terms `terms` (`crate::terms`), their per-cell state
     /// initialised from their seed unless it is there already.
     pub fn with_terms(mut self, mut terms: Terms) -> Self {
-        terms.initialise(self.n_cells());
+        terms.initialise(self.next_id());
         self.terms = terms;
         self
     }
@@ -159,13 +156,13 @@ impl<T: Real> Tissue<T> {
     /// This tissue with cells in populations of their own parameters (`crate::terms`).
     ///
     /// # Panics
-    /// If the populations do not assign every cell.
+    /// If the populations do not assign every identity `0..`[`Tissue::next_id`].
     pub fn with_populations(mut self, populations: Populations) -> Self {
         assert!(
-            populations.is_empty() || populations.of_cell().len() == self.n_cells(),
-            "{} cells assigned to populations, {} in the tissue",
+            populations.is_empty() || populations.of_cell().len() == self.next_id(),
+            "{} cells assigned to populations, {} identities in the tissue",
             populations.of_cell().len(),
-            self.n_cells()
+            self.next_id()
         );
         self.populations = populations;
         self
@@ -283,18 +280,19 @@ impl<T: Real> Tissue<T> {
         Vector2::from(self.centre[slot])
     }
 
-    /// The identity of the cell in each slot: its index in the initial state.
+    /// The identity of the cell in each slot: its index in the initial state, or for a
+    /// daughter of a division the next unused number ([`Tissue::next_id`]).
     /// [`Tissue::sort_cells`] reorders the slots; outputs are written in identity order.
     pub fn cell_ids(&self) -> &[usize] {
         &self.cell_id
     }
 
-    /// Slot of every cell identity: `slots()[id]` is where cell `id` is stored.
+    /// The slots in increasing order of their cells' identities: `slots()[k]` is where the
+    /// cell with the `k`-th smallest identity is stored (while no cell has divided or been
+    /// removed, where cell `k` is). Outputs write their rows in this order.
     pub fn slots(&self) -> Vec<usize> {
-        let mut s = vec![0; self.cell_id.len()];
-        for (slot, &id) in self.cell_id.iter().enumerate() {
-            s[id] = slot;
-        }
+        let mut s: Vec<usize> = (0..self.cell_id.len()).collect();
+        s.sort_unstable_by_key(|&slot| self.cell_id[slot]);
         s
     }
 
@@ -354,4 +352,11 @@ impl<T: Real> Tissue<T> {
             self.cells.recentre(i, self.centre[i]);
         }
     }
+}
+
+/// Whether no identity appears twice.
+fn distinct(ids: &[usize]) -> bool {
+    let mut sorted = ids.to_vec();
+    sorted.sort_unstable();
+    sorted.windows(2).all(|w| w[0] != w[1])
 }

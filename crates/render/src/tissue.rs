@@ -47,6 +47,10 @@ pub enum Fill {
     Plain,
     /// Each cell its own colour (no colour bar).
     Id,
+    /// Each cell the colour of its key (no colour bar): cells of one key share a colour, and
+    /// a cell keeps its colour from picture to picture (keys: identities, or each cell's
+    /// founder for a lineage).
+    Keys(Vec<usize>),
     /// One value per cell, on a colour bar.
     Values {
         /// The values, one per cell.
@@ -365,6 +369,7 @@ impl TissuePicture {
         let colours: Vec<[u8; 3]> = match (&self.fill, bar) {
             (Fill::Plain, _) => vec![PLAIN; p.origins.len()],
             (Fill::Id, _) => (0..p.origins.len()).map(id_colour).collect(),
+            (Fill::Keys(keys), _) => keys.iter().map(|&k| id_colour(k)).collect(),
             (Fill::Values { values, signed, .. }, Some((lo, hi))) => values
                 .iter()
                 .map(|&v| self.colour_of((v - lo) / (hi - lo), *signed))

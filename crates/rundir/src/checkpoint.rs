@@ -19,7 +19,9 @@
 //! | `cell_id` | `(N,)` int64 | identity of each slot |
 //! | `scene` | `(bytes,)` uint8 | the resolved scene (TOML) |
 //! | `controller` | `(5,)` | adaptive runs only: [`mechanics::Controller::to_array`] |
-//! | `TERM.VARIABLE` | `(N,)` | each physics term's per-cell state, by identity (e.g. `polarity.theta`; [`mechanics::terms::Terms::variables`]) |
+//! | `TERM.VARIABLE` | `(M,)` | each physics term's per-cell state, by identity `0..M` (e.g. `polarity.theta`; [`mechanics::terms::Terms::variables`]; `M = N` while no cell divided) |
+//! | `population` | `(M,)` int64 | with `[[population]]` and `[division]`: each identity's population |
+//! | `lineage` | `(K, 9)` | with `[division]`: every cell that lived, one row each: id, parent (−1 for a founder), birth, death (NaN while alive), ending (0 alive, 1 division, 2 extrusion, 3 death), generation, cycle, and the centre `x, y` where it ended |
 //!
 //! Each is written under a temporary name, flushed to disk (`fsync`) and renamed, so a kill
 //! at any moment leaves the previous checkpoint intact; the newest [`KEEP`] are kept.
@@ -28,6 +30,7 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
+use mechanics::division::{Ending, LineageRecord, Proliferation};
 use mechanics::{Controller, Tissue};
 use phasefield::{Cells, Real};
 
@@ -128,8 +131,21 @@ pub fn write_checkpoint<T: Real>(
         .map(|(name, a)| (name.to_string(), a))
         .collect();
     for (name, values) in term_arrays(tissue) {
-        let a = npy(&[n], values).map_err(|e| RunDirError::io("encode", &path, e))?;
+        let a =
+            npy(&[values.len() as u64], values).map_err(|e| RunDirError::io("encode", &path, e))?;
         arrays.push((name, a));
+    }
+    if let Some(clock) = tissue.proliferation() {
+        let pops = tissue.populations().of_cell();
+        if !pops.is_empty() {
+            let a = npy(&[pops.len() as u64], pops.iter().map(|&k| i64::from(k)))
+                .map_err(|e| RunDirError::io("encode", &path, e))?;
+            arrays.push(("population".into(), a));
+        }
+        let rows = lineage_rows(clock);
+        let a = npy(&[rows.len() as u64, 9], rows.into_iter().flatten())
+            .map_err(|e| RunDirError::io("encode", &path, e))?;
+        arrays.push(("lineage".into(), a));
     }
     if let Some(c) = controller {
         let a = npy(&[5], c.to_array()).map_err(|e| RunDirError::io("encode", &path, e))?;
@@ -273,9 +289,116 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
     let ids: Vec<usize> = a[10].data.iter().map(|&v| v as usize).collect();
     let tissue = Tissue::restore(cells, scene.model_params(zeta), time, step, centre, ids)
         .map_err(|r| bad("cell_id", r))?
-        .with_terms(scene.terms())
-        .with_populations(scene.populations());
+        .with_terms(scene.terms());
+    let Some(restored) = scene.restored_clock(read_lineage(path)?) else {
+        return read_terms(path, tissue.with_populations(scene.populations()), true);
+    };
+    let clock = restored.map_err(|r| bad("lineage", r))?;
+    let populations = scene.populations();
+    let populations = if populations.is_empty() {
+        populations
+    } else {
+        let of_cell = read_npz(path, &["population"])?.remove(0).data;
+        if of_cell.len() != tissue.next_id()
+            || of_cell
+                .iter()
+                .any(|&k| !(k >= 0.0 && (k as usize) < populations.kinds().len()))
+        {
+            return Err(bad(
+                "population",
+                format!(
+                    "{} entries for {} identities, or an index outside the scene's {} populations",
+                    of_cell.len(),
+                    tissue.next_id(),
+                    populations.kinds().len()
+                ),
+            ));
+        }
+        mechanics::terms::Populations::from_assignment(
+            populations.kinds().to_vec(),
+            of_cell.iter().map(|&k| k as u16).collect(),
+        )
+    };
+    let tissue = tissue
+        .with_populations(populations)
+        .with_proliferation(clock);
     read_terms(path, tissue, true)
+}
+
+/// The lineage of `clock` as the rows of the checkpoint's `lineage` array (and, in words,
+/// of `lineage.csv`).
+pub(crate) fn lineage_rows(clock: &Proliferation) -> Vec<[f64; 9]> {
+    clock
+        .lineage()
+        .map(|r| {
+            let (death, ending) = match r.death {
+                None => (f64::NAN, 0.0),
+                Some((t, Ending::Division)) => (t, 1.0),
+                Some((t, Ending::Extrusion)) => (t, 2.0),
+                Some((t, Ending::Death)) => (t, 3.0),
+            };
+            [
+                r.id as f64,
+                r.parent.map_or(-1.0, |p| p as f64),
+                r.birth,
+                death,
+                ending,
+                f64::from(r.generation),
+                r.cycle,
+                r.place[0],
+                r.place[1],
+            ]
+        })
+        .collect()
+}
+
+/// The lineage of a checkpoint (empty when it has none).
+///
+/// # Errors
+/// A damaged `lineage` array.
+fn read_lineage(path: &Path) -> Result<Vec<LineageRecord>> {
+    let a = match read_npz(path, &["lineage"]) {
+        Err(RunDirError::MissingArray { .. }) => return Ok(Vec::new()),
+        Err(e) => return Err(e),
+        Ok(mut a) => a.remove(0),
+    };
+    let bad = |reason: String| RunDirError::BadArray {
+        path: path.to_path_buf(),
+        name: "lineage".into(),
+        reason,
+    };
+    if a.data.len() % 9 != 0 {
+        return Err(bad(format!("{} values is not rows of 9", a.data.len())));
+    }
+    a.data
+        .chunks_exact(9)
+        .map(|r| {
+            let whole = |v: f64| v >= 0.0 && v.fract() == 0.0;
+            let ending = match r[4] {
+                0.0 => None,
+                1.0 => Some(Ending::Division),
+                2.0 => Some(Ending::Extrusion),
+                3.0 => Some(Ending::Death),
+                _ => None,
+            };
+            if !(whole(r[0]) && (r[1] == -1.0 || whole(r[1])) && whole(r[5]))
+                || !r[2].is_finite()
+                || !r[6].is_finite()
+                || (r[4] != 0.0 && ending.is_none())
+            {
+                return Err(bad(format!("the row {r:?} is not a cell's lineage")));
+            }
+            Ok(LineageRecord {
+                id: r[0] as usize,
+                parent: (r[1] >= 0.0).then_some(r[1] as usize),
+                birth: r[2],
+                death: ending.map(|e| (r[3], e)),
+                place: [r[7], r[8]],
+                generation: r[5] as u32,
+                cycle: r[6],
+            })
+        })
+        .collect()
 }
 
 /// The name of the array that holds a term's state variable (`polarity/theta` →

@@ -8,6 +8,7 @@
 //! | `format` | `()` int64 | [`FRAME_FORMAT`], the version of this layout |
 //! | `step`, `time`, `zeta` | `()` | clock and activity |
 //! | `lattice` | `(2,)` int64 | `[lx, ly]` |
+//! | `id` | `(N,)` int64 | each row's cell identity, increasing (`0..N` unless cells divided or were removed; then the ids of `lineage.csv`) |
 //! | `centre` | `(N, 2)` | centre of mass `[x, y]` |
 //! | `velocity` | `(N, 2)` | `v_i` |
 //! | `force` | `(N, 2)` | `F_i` |
@@ -16,9 +17,11 @@
 //! | `origin` | `(N, 2)` int64 | lattice node of each patch's element `[0, 0]` |
 //! | `phi` | `(N, nx, ny)`, float32 or float64: the run's storage precision (`[integrator] precision`) | `phi[i, u, v]` is `φ_i` at node `((origin_x+u) % lx, (origin_y+v) % ly)` |
 //!
-//! Arrays without a type in the table are float64. Cells are in identity order (`phi[i]` is
-//! cell `i` of the scene), whatever their order in memory. `format` 1 (before issue 12) is
-//! the same layout with `phi` always float64; [`read_npz`] reads both.
+//! Arrays without a type in the table are float64. Rows are in increasing identity (`phi[i]`
+//! is the cell `id[i]`: cell `i` of the scene while the number of cells has not changed),
+//! whatever their order in memory. `format` 2 is the same layout without `id` (cell `i` is
+//! row `i`), and `format` 1 (before issue 12) has `phi` always float64; [`read_npz`] reads
+//! them all.
 
 use std::fs::File;
 use std::io::{BufReader, Read, Write};
@@ -31,8 +34,9 @@ use npyz::WriterBuilder;
 use phasefield::Real;
 
 /// Version of the frame layout; `monolayer analyze` refuses frames of another version.
-/// Format 2 stores `phi` in the run's precision; format 1 stored it as float64.
-pub const FRAME_FORMAT: i64 = 2;
+/// Format 3 adds `id`, the identity of each row; format 2 stores `phi` in the run's
+/// precision; format 1 stored it as float64.
+pub const FRAME_FORMAT: i64 = 3;
 
 /// The frame formats this version reads.
 pub const FRAME_FORMATS_READ: std::ops::RangeInclusive<i64> = 1..=FRAME_FORMAT;
@@ -66,8 +70,9 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
     let (nx, ny) = (shape.nx, shape.ny);
     let cs = ws.cell_states();
     let lattice = tissue.lattice();
-    // Cells are written in identity order, whatever their storage order.
+    // Cells are written in increasing identity, whatever their storage order.
     let slots = tissue.slots();
+    let ids: Vec<usize> = slots.iter().map(|&s| tissue.cell_ids()[s]).collect();
     let cs: Vec<_> = slots.iter().map(|&s| cs[s]).collect();
     let centre: Vec<[f64; 2]> = slots.iter().map(|&s| ws.centres()[s]).collect();
     let origin = &tissue.cells().map().origin;
@@ -86,6 +91,7 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
                 "lattice",
                 npy(&[2], [lattice.lx as i64, lattice.ly as i64])?,
             ),
+            ("id", npy(&[n64], ids.iter().map(|&i| i as i64))?),
             ("centre", npy(&[n64, 2], centre.iter().flatten().copied())?),
             (
                 "velocity",
@@ -142,17 +148,21 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
     if let Some((_, theta)) = terms.iter().find(|(name, _)| name == "polarity.theta") {
         extra.push((
             "polarity".to_string(),
-            npy(&[n64, 2], theta.iter().flat_map(|t| [t.cos(), t.sin()])),
+            npy(
+                &[n64, 2],
+                ids.iter().flat_map(|&i| [theta[i].cos(), theta[i].sin()]),
+            ),
         ));
     }
+    // The terms' state and the populations are by identity: one row per living cell.
     for (name, values) in terms {
-        extra.push((name, npy(&[n64], values)));
+        extra.push((name, npy(&[n64], ids.iter().map(|&i| values[i]))));
     }
     let pops = tissue.populations();
     if !pops.is_empty() {
         extra.push((
             "population".to_string(),
-            npy(&[n64], pops.of_cell().iter().map(|&k| i64::from(k))),
+            npy(&[n64], ids.iter().map(|&i| i64::from(pops.of_cell()[i]))),
         ));
     }
     for (name, a) in extra {

@@ -8,6 +8,7 @@
 //! | `series.csv` | [`SeriesWriter`], one row every `series_every` steps ([`SERIES_HEADER`]) |
 //! | `frames/frame_STEP.npz` | [`write_frame`], NumPy archives `numpy.load` reads as they are |
 //! | `checkpoints/checkpoint_STEP.npz` | [`add_checkpoints`]: the complete state, for `monolayer run --resume` ([`checkpoint`]) |
+//! | `lineage.csv` | with `[division]`: every cell that lived, with its parent, birth, death and why ([`lineage`]), with every frame |
 //! | `run.json` | [`write_scene`]: version, precision, axes, the unit of every column |
 //! | `vtk/*.vti`, `*.vtp`, `*.pvd` | [`vtk`]: ParaView files (by `monolayer export vtk`) |
 //!
@@ -18,6 +19,7 @@
 
 pub mod checkpoint;
 mod frame;
+pub mod lineage;
 pub mod run;
 mod series;
 mod sidecar;
@@ -31,6 +33,7 @@ pub use checkpoint::read_terms;
 pub use frame::{
     last_frame, npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ,
 };
+pub use lineage::{read_lineage, write_lineage, LINEAGE_HEADER};
 pub use run::{lock_dir, DirLock, Interrupt, Outcome, RunDir, RunError, LOCK};
 pub use series::{SeriesWriter, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
@@ -102,7 +105,7 @@ impl RunDirError {
 pub type Result<T> = std::result::Result<T, RunDirError>;
 
 /// Makes `dir` ready for a new run: creates it, and makes sure it holds no earlier run. With
-/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml`, `frames/`,
+/// `overwrite`, removes an earlier run's `series.csv`, `scene.toml`, `lineage.csv`, `frames/`,
 /// `checkpoints/` and `analysis/` (which described the old run); without,
 /// refuses.
 ///
@@ -119,6 +122,7 @@ pub fn prepare(dir: &Path, overwrite: bool) -> Result<()> {
         std::fs::remove_file(&series).map_err(|e| RunDirError::io("remove", &series, e))?;
         let _ = std::fs::remove_file(dir.join("scene.toml"));
         let _ = std::fs::remove_file(dir.join("run.json"));
+        let _ = std::fs::remove_file(dir.join("lineage.csv"));
         for sub in ["frames", "checkpoints", "analysis"] {
             let d = dir.join(sub);
             if d.exists() {

@@ -11,7 +11,7 @@ use crate::{Result, RunDirError};
 
 /// The header of `series.csv`.
 pub const SERIES_HEADER: &str =
-    "step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max,cell_speed_rms,phi_min,phi_max";
+    "step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max,cell_speed_rms,phi_min,phi_max,cells";
 
 /// Writes `series.csv` row by row, each row in one write, so that a run that stops keeps
 /// them; a row that fails (a full disk) is cut off again, so the file always ends with a
@@ -83,7 +83,7 @@ impl SeriesWriter {
     /// When the row cannot be written.
     pub fn row<T: Real>(&mut self, tissue: &Tissue<T>, o: &Observables) -> Result<()> {
         self.append(&format!(
-            "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{}\n",
+            "{},{:.6},{},{:e},{:e},{},{},{},{:e},{},{},{}\n",
             tissue.iteration(),
             tissue.time(),
             tissue.params().zeta,
@@ -94,7 +94,8 @@ impl SeriesWriter {
             o.area_max,
             o.cell_speed_rms,
             o.phi_min,
-            o.phi_max
+            o.phi_max,
+            tissue.n_cells()
         ))
     }
 

@@ -43,6 +43,7 @@ fn unit(column: &str) -> &'static str {
         "x" | "y" | "r" | "length" => "nodes",
         "angle" => "radians",
         "defect_density" => "defects per node",
+        "cells" | "divisions" | "extrusions" | "deaths" => "cells",
         "creation_rate" => "pair creations per node per TU",
         _ => "dimensionless",
     }

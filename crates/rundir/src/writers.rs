@@ -87,7 +87,24 @@ fn add_with<T: Real>(
             written: written.frames.clone(),
         }),
     );
+    sim.add_output_writer(
+        "lineage.csv",
+        schedules.frames,
+        FinalToo::new(Lineage(dir.to_path_buf())),
+    );
     written
+}
+
+/// `lineage.csv`, rewritten with every frame, when cells divide.
+struct Lineage(PathBuf);
+
+impl<T: Real> Callback<T> for Lineage {
+    fn call(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
+        if let Some(clock) = obs.tissue().proliferation() {
+            crate::lineage::write_lineage(&self.0, clock)?;
+        }
+        Ok(())
+    }
 }
 
 /// A writer that also writes the final state, unless its schedule just did.

@@ -307,6 +307,51 @@ fn default_wall_kappa() -> f64 {
     1.0
 }
 
+/// `[division] axis`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DivisionAxis {
+    /// Across the long axis of the cell's shape tensor (the daughters lie along it).
+    #[default]
+    Long,
+    /// Along a uniformly random direction.
+    Random,
+}
+
+/// `[division]`: cells divide by a cell-cycle clock, and are extruded or die (docs/model.md
+/// §11.5); absent: the number of cells is fixed.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DivisionSpec {
+    /// The mean cell-cycle time `T₀ + 1/k` in time units: a cell divides when its age
+    /// reaches its cycle `T₀ + Exp(1/k)`, drawn at its birth.
+    pub cycle_time: f64,
+    /// The mean `1/k` of the cycle's exponential part (default a quarter of `cycle_time`;
+    /// `cycle_time` itself gives a memoryless clock).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle_spread: Option<f64>,
+    /// The axis of the split (default `"long"`).
+    #[serde(default)]
+    pub axis: DivisionAxis,
+    /// At most this many cells: a cell due to divide waits while the tissue has them
+    /// (default twice the cells that fill the lattice, `2 lx ly/(πR²)`). The memory guard
+    /// sizes the run for this many.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_cells: Option<usize>,
+    /// A cell whose area `Σφ_i²` falls below this fraction of `πR²` is extruded (removed);
+    /// absent or 0: no extrusion. The spec's example: 0.2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extrusion: Option<f64>,
+    /// A death rate `k_d` per time unit (default 0): each cell is removed at an age drawn at
+    /// its birth, exponential of mean `1/k_d`.
+    #[serde(default)]
+    pub death_rate: f64,
+    /// Contact inhibition of proliferation: a cell due to divide waits while its pressure
+    /// `p_i = Σφ_i P/Σφ_i` is above this; absent: never waits.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pressure_gate: Option<f64>,
+}
+
 /// `[[population]]`: a population of cells with parameters of their own (docs/model.md
 /// §11.3); absent: every cell has `[model]`'s. The counts must add up to `[cells] count`;
 /// cells are dealt to populations by a shuffle drawn from `[run] seed`.
@@ -439,6 +484,9 @@ pub struct SceneFile {
     /// `[walls]`, when the cells are confined.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub walls: Option<WallsSpec>,
+    /// `[division]`, when cells divide.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub division: Option<DivisionSpec>,
 }
 
 impl SceneFile {
@@ -452,9 +500,13 @@ impl SceneFile {
         for o in overrides {
             apply_override(&mut table, o)?;
         }
-        table
+        let mut file: Self = table
             .try_into()
-            .map_err(|e: toml::de::Error| SceneError::Parse(e.to_string()))
+            .map_err(|e: toml::de::Error| SceneError::Parse(e.to_string()))?;
+        if let Some(d) = &mut file.division {
+            d.cycle_spread.get_or_insert(0.25 * d.cycle_time);
+        }
+        Ok(file)
     }
 
     /// The scene as TOML, with every default filled in.

@@ -33,13 +33,14 @@
 //! ```
 #![deny(missing_docs)]
 
+mod division;
 mod file;
 mod validate;
 mod walls;
 
 pub use file::{
-    AdhesionSpec, CellsSpec, Domain, InitKind, Integrator, Model, PolaritySpec, PopulationSpec,
-    Run, SceneFile, WallKind, WallsSpec,
+    AdhesionSpec, CellsSpec, DivisionAxis, DivisionSpec, Domain, InitKind, Integrator, Model,
+    PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
 };
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
@@ -126,7 +127,8 @@ impl Scene {
     }
 
     /// An estimate of the memory a run of this scene needs at its peak, in bytes, computed
-    /// from the scene alone (nothing is allocated): with `N` cells of `p` patch nodes, `b`
+    /// from the scene alone (nothing is allocated): with `N` cells (with `[division]`, its
+    /// `max_cells`, [`Scene::max_cells`]) of `p` patch nodes, `b`
     /// bytes per stored value (4 in f32, 8 in f64), `L` lattice nodes and `t` the threads this
     /// machine can run at once,
     ///
@@ -141,7 +143,7 @@ impl Scene {
     /// `Tissue::heap_bytes` + `Workspace::heap_bytes` from above (tested), so a scene it refuses
     /// could not have run.
     pub fn memory_estimate(&self) -> f64 {
-        let n = self.file.cells.count as f64;
+        let n = self.max_cells() as f64;
         let shape = self.patch_shape();
         let p = (shape.nx * shape.ny) as f64;
         let b = match self.precision() {
@@ -307,14 +309,49 @@ impl Scene {
         )))
     }
 
-    /// `tissue` with the scene's terms, populations and walls.
+    /// `tissue` with the scene's terms, populations, walls and cell-cycle clock.
     fn dressed<T: Real>(&self, tissue: Tissue<T>) -> Tissue<T> {
         let tissue = tissue
             .with_terms(self.file.terms())
             .with_populations(self.file.populations());
-        match self.walls() {
+        let tissue = match self.walls() {
             Some(walls) => tissue.with_walls(walls),
             None => tissue,
+        };
+        match &self.file.division {
+            Some(spec) => {
+                let clock = division::clock(spec, &self.file, &tissue);
+                tissue.with_proliferation(clock)
+            }
+            None => tissue,
+        }
+    }
+
+    /// The clock of `[division]` restored from a lineage (a checkpoint's), or `None` when
+    /// the scene has no `[division]`.
+    ///
+    /// # Errors
+    /// A message when the lineage holds a cell twice.
+    pub fn restored_clock(
+        &self,
+        lineage: Vec<mechanics::division::LineageRecord>,
+    ) -> Option<Result<mechanics::division::Proliferation, String>> {
+        let spec = self.file.division.as_ref()?;
+        let (t0, rate) = spec.cycle();
+        Some(
+            mechanics::division::Proliferation::restore(t0, rate, self.file.run.seed, lineage)
+                .map(|c| division::configure(c, spec, &self.file)),
+        )
+    }
+
+    /// The most cells the run can hold: `[division] max_cells` (or its default) with
+    /// `[division]`, else `[cells] count`.
+    pub fn max_cells(&self) -> usize {
+        match &self.file.division {
+            Some(d) => d
+                .max_cells
+                .unwrap_or_else(|| division::default_max_cells(&self.file)),
+            None => self.file.cells.count,
         }
     }
 

@@ -634,6 +634,9 @@ impl SceneFile {
                 }
             }
         }
+        if let Some(spec) = &self.division {
+            crate::division::check(spec, &self)?;
+        }
         let walls = match &self.walls {
             Some(spec) => Some(crate::walls::walls_of(
                 spec,

@@ -285,6 +285,9 @@ pub(crate) struct LoadedFrame {
     pub centres: Vec<[f64; 2]>,
     pub velocities: Vec<[f64; 2]>,
     pub areas: Vec<f64>,
+    /// The identity of each row (the frame's `id`; `0..N` in frames before format 3). The
+    /// tissue numbers its cells by row, `0..N`.
+    pub ids: Vec<usize>,
 }
 
 fn pairs(a: &Array) -> Vec<[f64; 2]> {
@@ -346,14 +349,66 @@ pub(crate) fn load_frame(
             ),
         ));
     }
-    let n = scene.file().cells.count;
+    // With `[division]` the number of cells changes: each frame has its own.
+    let n = if scene.file().division.is_some() {
+        phi.shape.first().map_or(0, |&n| n as usize)
+    } else {
+        scene.file().cells.count
+    };
     let want = vec![n as u64, shape.nx as u64, shape.ny as u64];
-    if phi.shape != want {
+    if phi.shape != want || n == 0 || n > scene.max_cells() {
         return Err(input(
             path,
-            format!("phi has shape {:?}, the scene implies {want:?}", phi.shape),
+            format!(
+                "phi has shape {:?}, the scene implies {want:?} (at most {} cells)",
+                phi.shape,
+                scene.max_cells()
+            ),
         ));
     }
+    let ids: Vec<usize> = match read_npz(path, &["id"]) {
+        Ok(mut a) => {
+            let ids = a.remove(0).data;
+            let increasing = ids.windows(2).all(|w| w[0] < w[1]);
+            if ids.len() != n || !increasing || ids.iter().any(|&v| !(v >= 0.0 && v.fract() == 0.0))
+            {
+                return Err(input(
+                    path,
+                    format!(
+                        "array 'id' must hold {n} increasing cell identities, one per row of phi"
+                    ),
+                ));
+            }
+            ids.iter().map(|&v| v as usize).collect()
+        }
+        Err(rundir::RunDirError::MissingArray { .. }) => (0..n).collect(),
+        Err(e) => return Err(input(path, e.to_string())),
+    };
+    // The populations by row: the frame's own when cells divide (daughters inherit), else
+    // the scene's deal.
+    let populations = scene.populations();
+    let populations = if populations.is_empty() || scene.file().division.is_none() {
+        populations
+    } else {
+        let rows = read_npz(path, &["population"])
+            .map_err(|e| input(path, e.to_string()))?
+            .remove(0)
+            .data;
+        if rows.len() != n
+            || rows
+                .iter()
+                .any(|&k| !(k >= 0.0 && (k as usize) < populations.kinds().len()))
+        {
+            return Err(input(
+                path,
+                format!("array 'population' must hold {n} indices of the scene's populations"),
+            ));
+        }
+        mechanics::terms::Populations::from_assignment(
+            populations.kinds().to_vec(),
+            rows.iter().map(|&k| k as u16).collect(),
+        )
+    };
     for (name, a, len) in [
         ("origin", &origin, 2 * n),
         ("shape_tensor", &shape_tensor, 2 * n),
@@ -411,7 +466,7 @@ pub(crate) fn load_frame(
         step,
         (0..n).collect(),
     )
-    .with_populations(scene.populations())
+    .with_populations(populations)
     .with_terms(scene.terms());
     if let Some(walls) = scene.walls() {
         tissue = tissue.with_walls(walls);
@@ -444,6 +499,7 @@ pub(crate) fn load_frame(
         centres,
         velocities: pairs(&velocity),
         areas: area.data,
+        ids,
     })
 }
 
@@ -627,6 +683,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             ..
         } = frame;
         let ws = ws.get_or_insert_with(|| Workspace::new(tissue.cells()));
+        // A run whose cells divide has its own number of cells in each frame.
+        ws.fit(tissue.cells());
         let f = tissue.fields(ws);
         let smooth = |v: &[f64]| box_smooth(lattice, v, box_side).expect("checked above");
         let (svx, svy) = (smooth(&f.vx), smooth(&f.vy));

@@ -17,6 +17,7 @@ use std::str::FromStr;
 
 use analysis::defects::detect;
 use analysis::smooth::box_smooth;
+use mechanics::division::LineageRecord;
 use mechanics::{TissueFields, Workspace};
 use render::{
     CellArrows, CellAxes, Fill, LatticeVectors, Movie, Patches, RenderError, TissuePicture,
@@ -102,6 +103,10 @@ pub enum Colour {
     Id,
     /// Each cell by its population (`[[population]]`).
     Population,
+    /// Each cell by its generation in `lineage.csv` (`[division]`): 0 for a founder.
+    Generation,
+    /// Each cell the colour of its founder (`[division]`): the clones of one cell share it.
+    Lineage,
 }
 
 impl FromStr for Colour {
@@ -115,9 +120,11 @@ impl FromStr for Colour {
             "deformation" => Self::Deformation,
             "id" => Self::Id,
             "population" => Self::Population,
+            "generation" => Self::Generation,
+            "lineage" => Self::Lineage,
             _ => {
                 return Err(format!(
-                "--colour {s}: use none, velocity, pressure, area, deformation, id or population"
+                "--colour {s}: use none, velocity, pressure, area, deformation, id, population, generation or lineage"
             ))
             }
         })
@@ -189,6 +196,8 @@ pub struct ViewInfo {
 /// A run directory opened for pictures or export: its scene and the selected frames.
 struct Run {
     scene: Scene,
+    /// `lineage.csv`, by identity, when cells divide.
+    lineage: Option<Vec<LineageRecord>>,
     frames: Vec<PathBuf>,
     /// Every frame of the run, with its step (the tracks are drawn through all of them).
     all: Vec<(u64, PathBuf)>,
@@ -220,8 +229,15 @@ impl Run {
                 picked
             }
         };
+        let lineage = rundir::read_lineage(run_dir).map_err(|e| {
+            ViewError::Run(crate::analyze::input(
+                &run_dir.join("lineage.csv"),
+                e.to_string(),
+            ))
+        })?;
         Ok(Self {
             scene,
+            lineage,
             frames,
             all: every,
             notes,
@@ -230,24 +246,29 @@ impl Run {
 
     /// Each cell's centre in every frame of the run up to step `last`, in order (the cells'
     /// tracks).
+    /// A track follows a cell's identity (the frames' `id`), so a daughter's starts at its
+    /// birth and a mother's ends at her division.
     fn tracks(&self, last: u64) -> Result<Vec<Vec<[f64; 2]>>> {
-        let mut tracks: Vec<Vec<[f64; 2]>> = Vec::new();
+        let mut tracks: std::collections::BTreeMap<usize, Vec<[f64; 2]>> = Default::default();
         for (step, path) in self.all.iter().filter(|(s, _)| *s <= last) {
-            let a = rundir::read_npz(path, &["centre"]).map_err(|e| {
+            let err = |e: rundir::RunDirError| {
                 ViewError::Run(crate::analyze::input(
                     path,
                     format!("{e} (frame at step {step})"),
                 ))
-            })?;
+            };
+            let a = rundir::read_npz(path, &["centre"]).map_err(err)?;
             let centres: Vec<[f64; 2]> = a[0].data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-            if tracks.is_empty() {
-                tracks = vec![Vec::new(); centres.len()];
-            }
-            for (t, c) in tracks.iter_mut().zip(centres) {
-                t.push(c);
+            let ids: Vec<usize> = match rundir::read_npz(path, &["id"]) {
+                Ok(a) => a[0].data.iter().map(|&v| v as usize).collect(),
+                Err(rundir::RunDirError::MissingArray { .. }) => (0..centres.len()).collect(),
+                Err(e) => return Err(err(e)),
+            };
+            for (id, c) in ids.into_iter().zip(centres) {
+                tracks.entry(id).or_default().push(c);
             }
         }
-        Ok(tracks)
+        Ok(tracks.into_values().collect())
     }
 
     fn load(&self, path: &Path) -> Result<LoadedFrame> {
@@ -336,6 +357,29 @@ pub fn in_tissue(
     Ok((tissue, defects))
 }
 
+/// The lineage record of the cell `id`, if the run has one.
+fn lineage_of(run: &Run, id: usize) -> Option<&LineageRecord> {
+    record(run.lineage.as_deref()?, id)
+}
+
+/// The record of `id` in a lineage in increasing identity (as `lineage.csv` has it).
+fn record(lineage: &[LineageRecord], id: usize) -> Option<&LineageRecord> {
+    lineage
+        .binary_search_by_key(&id, |r| r.id)
+        .ok()
+        .map(|k| &lineage[k])
+}
+
+/// The founder (generation 0) the cell `id` descends from, following `parent` up the lineage
+/// (`id` itself when the lineage does not know it).
+fn founder(lineage: &[LineageRecord], id: usize) -> usize {
+    let mut id = id;
+    while let Some(p) = record(lineage, id).and_then(|r| r.parent) {
+        id = p;
+    }
+    id
+}
+
 fn picture(
     run: &Run,
     frame: &LoadedFrame,
@@ -361,7 +405,15 @@ fn picture(
     let f: Option<TissueFields> = need_fields.then(|| frame.tissue.fields(ws));
     let signed = opts.colour == Colour::Pressure;
     let values: Option<(Vec<f64>, &str)> = match opts.colour {
-        Colour::None | Colour::Id => None,
+        Colour::None | Colour::Id | Colour::Lineage => None,
+        Colour::Generation => Some((
+            frame
+                .ids
+                .iter()
+                .map(|&id| lineage_of(run, id).map_or(0.0, |r| f64::from(r.generation)))
+                .collect(),
+            "generation",
+        )),
         Colour::Velocity => Some((
             frame.velocities.iter().map(|v| v[0].hypot(v[1])).collect(),
             "|v|",
@@ -388,7 +440,14 @@ fn picture(
         )),
     };
     p.fill = match (opts.colour, values) {
-        (Colour::Id, _) => Fill::Id,
+        (Colour::Id, _) => Fill::Keys(frame.ids.clone()),
+        (Colour::Lineage, _) => Fill::Keys(
+            frame
+                .ids
+                .iter()
+                .map(|&id| founder(run.lineage.as_deref().unwrap_or_default(), id))
+                .collect(),
+        ),
         (_, Some((values, label))) => Fill::Values {
             values,
             label: label.into(),
@@ -515,6 +574,13 @@ pub fn render_run(
         render::MovieKind::of(m).map_err(ViewError::Options)?;
     }
     let run = Run::open(run_dir, &opts.frames)?;
+    if matches!(opts.colour, Colour::Generation | Colour::Lineage) && run.lineage.is_none() {
+        return Err(ViewError::Options(format!(
+            "--colour {}: {} has no lineage.csv (its scene has no [division], so no cell divided); use --colour id",
+            if opts.colour == Colour::Generation { "generation" } else { "lineage" },
+            run_dir.display()
+        )));
+    }
     create_dir(out)?;
     let total = run.frames.len();
     progress(0, total);
@@ -524,6 +590,8 @@ pub fn render_run(
     for (k, path) in run.frames.iter().enumerate() {
         let frame = run.load(path)?;
         let ws = ws.get_or_insert_with(|| Workspace::new(frame.tissue.cells()));
+        // A run whose cells divide has its own number of cells in each frame.
+        ws.fit(frame.tissue.cells());
         let pic = picture(&run, &frame, ws, opts)?.draw()?;
         if let Some(m) = &opts.movie {
             if movie.is_none() {
@@ -608,6 +676,17 @@ fn field_arrays(frame: &LoadedFrame, f: &TissueFields, nx: usize, ny: usize) -> 
             (s * th.cos(), s * th.sin())
         })
         .unzip();
+    // The owner's identity (the frames' `id`), −1 where no cell is.
+    let owner = owner
+        .into_iter()
+        .map(|o| {
+            if o < 0 {
+                o
+            } else {
+                frame.ids[o as usize] as i32
+            }
+        })
+        .collect();
     let mut arrays = vec![
         VtkArray::new("phi_sum", 1, VtkValues::F32(phi_sum)),
         VtkArray::new("cell_id", 1, VtkValues::I32(owner)),
@@ -638,7 +717,11 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
         })
         .collect();
     let arrays = vec![
-        VtkArray::new("cell_id", 1, VtkValues::I32((0..n as i32).collect())),
+        VtkArray::new(
+            "cell_id",
+            1,
+            VtkValues::I32(frame.ids.iter().map(|&i| i as i32).collect()),
+        ),
         VtkArray::new(
             "velocity",
             3,
@@ -705,6 +788,8 @@ pub fn export_vtk(
     for (k, path) in run.frames.iter().enumerate() {
         let frame = run.load(path)?;
         let ws = ws.get_or_insert_with(|| Workspace::new(frame.tissue.cells()));
+        // A run whose cells divide has its own number of cells in each frame.
+        ws.fit(frame.tissue.cells());
         let f = frame.tissue.fields(ws);
         let time = frame.tissue.time();
         let vti = format!("fields_{:08}.vti", frame.step);

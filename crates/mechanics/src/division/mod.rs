@@ -10,8 +10,9 @@
 //! about half of it under the area term. The number of cells changes: call
 //! [`crate::Workspace::fit`] before the next step.
 //!
-//! Not yet wired to scenes and outputs: frames, checkpoints, `analyze` and `render` assume a
-//! fixed number of cells (issue 28 says what is left).
+//! A tissue holds its clock ([`Tissue::with_proliferation`]), so that the outputs and
+//! checkpoints that see the tissue see the lineage too; [`Tissue::proliferate`] applies it
+//! after a step, and [`crate::Simulation`] calls it after every step.
 
 use phasefield::{ComTable, Real};
 
@@ -101,8 +102,28 @@ pub enum SplitAxis {
 pub enum Ending {
     /// It divided.
     Division,
-    /// It was removed (extruded).
-    Removal,
+    /// It was extruded: its area fell below the extrusion threshold.
+    Extrusion,
+    /// It died at the death rate (apoptosis).
+    Death,
+}
+
+impl Ending {
+    /// The word for outputs: `"division"`, `"extrusion"` or `"death"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Ending::Division => "division",
+            Ending::Extrusion => "extrusion",
+            Ending::Death => "death",
+        }
+    }
+
+    /// The inverse of [`Ending::name`].
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Ending::Division, Ending::Extrusion, Ending::Death]
+            .into_iter()
+            .find(|e| e.name() == name)
+    }
 }
 
 /// One cell's line in the lineage.
@@ -116,6 +137,8 @@ pub struct LineageRecord {
     pub birth: f64,
     /// When its life ended, and how (`None` while it lives).
     pub death: Option<(f64, Ending)>,
+    /// Its centre of mass when its life ended (NaN while it lives).
+    pub place: [f64; 2],
     /// Its generation: 0 for a founder, the mother's plus one for a daughter.
     pub generation: u32,
     /// Its cycle time: it divides at `birth + cycle`.
@@ -139,6 +162,12 @@ pub struct Proliferation {
     /// Contact inhibition of proliferation: a cell due to divide waits while its pressure
     /// ([`cell_pressure`]) is above this (none: never waits).
     pub pressure_gate: Option<f64>,
+    /// The extrusion rule: a cell whose area falls below this fraction of its target area
+    /// is removed ([`remove_extruded`]; none: no extrusion).
+    pub extrusion: Option<f64>,
+    /// The death rate `k_d` per time unit (0: none): each cell's lifespan is drawn at its
+    /// birth, exponential of mean `1/k_d`, and it is removed when its age passes it.
+    pub death_rate: f64,
     seed: u64,
     lineage: Vec<LineageRecord>,
 }
@@ -147,6 +176,7 @@ pub struct Proliferation {
 const CYCLE_STAGE: u64 = 1 << 61;
 const PHASE_STAGE: u64 = CYCLE_STAGE + 1;
 const AXIS_STAGE: u64 = CYCLE_STAGE + 2;
+const DEATH_STAGE: u64 = CYCLE_STAGE + 3;
 
 impl Proliferation {
     /// A clock of cycle `T₀ + Exp(1/k)` for the cells of `tissue` (its founders), with the
@@ -158,6 +188,8 @@ impl Proliferation {
             axis: SplitAxis::Long,
             max_cells: usize::MAX,
             pressure_gate: None,
+            extrusion: None,
+            death_rate: 0.0,
             seed,
             lineage: Vec::new(),
         };
@@ -177,11 +209,77 @@ impl Proliferation {
                 parent: None,
                 birth: tissue.time() - phase * cycle,
                 death: None,
+                place: [f64::NAN; 2],
                 generation: 0,
                 cycle,
             });
         }
         p
+    }
+
+    /// A clock restored from its lineage (a checkpoint's), with the parameters and seed it
+    /// was made with (`axis`, the gate and the rest as set by the `with_*` methods after).
+    ///
+    /// # Errors
+    /// Two records of one identity.
+    pub fn restore(
+        t0: f64,
+        rate: f64,
+        seed: u64,
+        records: impl IntoIterator<Item = LineageRecord>,
+    ) -> Result<Self, String> {
+        let mut p = Self {
+            t0,
+            rate,
+            axis: SplitAxis::Long,
+            max_cells: usize::MAX,
+            pressure_gate: None,
+            extrusion: None,
+            death_rate: 0.0,
+            seed,
+            lineage: Vec::new(),
+        };
+        for r in records {
+            if p.lineage.get(r.id).is_some_and(|o| o.id == r.id) {
+                return Err(format!("cell {} appears twice in the lineage", r.id));
+            }
+            p.record(r);
+        }
+        Ok(p)
+    }
+
+    /// The same clock with the extrusion rule: cells whose area falls below `fraction` of
+    /// their target area are removed.
+    pub fn with_extrusion(mut self, fraction: f64) -> Self {
+        self.extrusion = Some(fraction);
+        self
+    }
+
+    /// The same clock with the death rate `k_d` per time unit.
+    pub fn with_death_rate(mut self, k_d: f64) -> Self {
+        self.death_rate = k_d;
+        self
+    }
+
+    /// Bytes of heap memory held by the lineage.
+    pub fn heap_bytes(&self) -> usize {
+        self.lineage.capacity() * std::mem::size_of::<LineageRecord>()
+    }
+
+    /// The age at which the cell `id` dies at the death rate (infinite without one), drawn
+    /// from its noise.
+    fn lifespan(&self, id: usize) -> f64 {
+        if self.death_rate <= 0.0 {
+            return f64::INFINITY;
+        }
+        let u = NoiseKey {
+            seed: self.seed,
+            cell: id as u64,
+            step: 0,
+            stage: DEATH_STAGE,
+        }
+        .uniform();
+        -u.ln() / self.death_rate
     }
 
     /// The same clock with the split along `axis`.
@@ -224,6 +322,7 @@ impl Proliferation {
                     parent: None,
                     birth: f64::NAN,
                     death: None,
+                    place: [f64::NAN; 2],
                     generation: 0,
                     cycle: f64::NAN,
                 },
@@ -247,6 +346,17 @@ impl Proliferation {
         tissue: &mut Tissue<T>,
         ws: &mut Workspace<T>,
     ) -> Vec<Division> {
+        self.divide_due_except(tissue, ws, &[])
+    }
+
+    /// [`Proliferation::divide_due`], leaving out the cells `skip` (sorted; those about to be
+    /// removed).
+    fn divide_due_except<T: Real>(
+        &mut self,
+        tissue: &mut Tissue<T>,
+        ws: &mut Workspace<T>,
+        skip: &[usize],
+    ) -> Vec<Division> {
         let now = tissue.time();
         let mut due: Vec<(usize, usize)> = (0..tissue.n_cells())
             .map(|slot| (tissue.cell_ids()[slot], slot))
@@ -254,6 +364,7 @@ impl Proliferation {
                 self.lineage
                     .get(id)
                     .is_some_and(|r| r.id == id && now - r.birth >= r.cycle)
+                    && skip.binary_search(&id).is_err()
             })
             .collect();
         if let Some(p_max) = self.pressure_gate {
@@ -267,7 +378,9 @@ impl Proliferation {
             }
             let direction = match self.axis {
                 SplitAxis::Long => {
-                    let (_, axis) = ws.cell(slot).shape.axis();
+                    // The step computes S_i only when something needs it (activity, or a
+                    // term): the mother's own, from her field.
+                    let (_, axis) = shape_tensor(tissue, slot).axis();
                     if axis.norm() > 0.0 {
                         [axis.x, axis.y]
                     } else {
@@ -287,9 +400,11 @@ impl Proliferation {
                     [theta.cos(), theta.sin()]
                 }
             };
+            let place = tissue.centres()[slot];
             let d = tissue.divide(slot, direction);
             let generation = self.lineage[id].generation + 1;
             self.lineage[id].death = Some((now, Ending::Division));
+            self.lineage[id].place = place;
             for child in d.daughters {
                 let cycle = self.cycle(child);
                 self.record(LineageRecord {
@@ -297,6 +412,7 @@ impl Proliferation {
                     parent: Some(id),
                     birth: now,
                     death: None,
+                    place: [f64::NAN; 2],
                     generation,
                     cycle,
                 });
@@ -309,13 +425,129 @@ impl Proliferation {
         out
     }
 
-    /// Records the removal of the cell `id` at the tissue's time (call it with the identity
-    /// [`Tissue::remove`] returns).
-    pub fn removed(&mut self, id: usize, time: f64) {
+    /// Records the end of the cell `id` at `time`, at `place`, for `why` (call it with the
+    /// identity [`Tissue::remove`] returns).
+    pub fn removed(&mut self, id: usize, time: f64, place: [f64; 2], why: Ending) {
         if let Some(r) = self.lineage.get_mut(id).filter(|r| r.id == id) {
-            r.death = Some((time, Ending::Removal));
+            r.death = Some((time, why));
+            r.place = place;
         }
     }
+
+    /// The cells of `tissue` whose age has passed their lifespan at the death rate, in the
+    /// order of their identities.
+    fn dead<T: Real>(&self, tissue: &Tissue<T>) -> Vec<usize> {
+        if self.death_rate <= 0.0 {
+            return Vec::new();
+        }
+        let now = tissue.time();
+        let mut dead: Vec<usize> = tissue
+            .cell_ids()
+            .iter()
+            .copied()
+            .filter(|&id| {
+                self.lineage
+                    .get(id)
+                    .is_some_and(|r| r.id == id && now - r.birth >= self.lifespan(id))
+            })
+            .collect();
+        dead.sort_unstable();
+        dead
+    }
+}
+
+/// The slot of the cell `id`, which must be in `tissue`.
+fn slot_of<T: Real>(tissue: &Tissue<T>, id: usize) -> usize {
+    tissue
+        .cell_ids()
+        .iter()
+        .position(|&i| i == id)
+        .expect("a listed cell is there")
+}
+
+/// What [`Tissue::proliferate`] did after one step.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CellEvents {
+    /// The divisions, in the order of the mothers' identities.
+    pub divisions: Vec<Division>,
+    /// The identities of the cells removed, with why.
+    pub removals: Vec<(usize, Ending)>,
+}
+
+impl<T: Real> Tissue<T> {
+    /// The same tissue with a cell-cycle clock (and its extrusion rule and death rate), which
+    /// [`Tissue::proliferate`] applies.
+    pub fn with_proliferation(mut self, clock: Proliferation) -> Self {
+        self.proliferation = Some(Box::new(clock));
+        self
+    }
+
+    /// The clock and the lineage, if cells divide.
+    pub fn proliferation(&self) -> Option<&Proliferation> {
+        self.proliferation.as_deref()
+    }
+
+    /// Applies the clock after a step: the divisions that are due, then deaths at the death
+    /// rate, then the extrusion rule, each in the order of identities, and fits `ws` to the
+    /// new number of cells. `ws` must hold the evaluation of the current state (as
+    /// [`Tissue::step`] leaves it). Does nothing without a clock.
+    ///
+    /// Every decision is taken on the state the step left, before any event (the evaluation
+    /// in `ws` is by slot, and a removal moves a slot): the cells to extrude, then the cells
+    /// that die (not already extruded), then the divisions due among the rest; the removals
+    /// happen after the divisions. A tissue keeps at least one cell.
+    pub fn proliferate(&mut self, ws: &mut Workspace<T>) -> CellEvents {
+        let Some(mut clock) = self.proliferation.take() else {
+            return CellEvents::default();
+        };
+        let mut removals: Vec<(usize, Ending)> = clock
+            .extrusion
+            .map(|f| extruded(self, ws, f))
+            .unwrap_or_default()
+            .into_iter()
+            .map(|id| (id, Ending::Extrusion))
+            .collect();
+        for id in clock.dead(self) {
+            if !removals.iter().any(|&(r, _)| r == id) {
+                removals.push((id, Ending::Death));
+            }
+        }
+        let mut skip: Vec<usize> = removals.iter().map(|&(id, _)| id).collect();
+        skip.sort_unstable();
+        let divisions = clock.divide_due_except(self, ws, &skip);
+        let now = self.time();
+        removals.retain(|&(id, why)| {
+            if self.n_cells() == 1 {
+                return false;
+            }
+            let slot = slot_of(self, id);
+            let place = self.centres()[slot];
+            self.remove(slot);
+            clock.removed(id, now, place, why);
+            true
+        });
+        if !removals.is_empty() {
+            ws.fit(self.cells());
+        }
+        self.proliferation = Some(clock);
+        CellEvents {
+            divisions,
+            removals,
+        }
+    }
+}
+
+/// The deformation tensor `S_i` of the cell in slot `slot`, from its field
+/// (`equations::shape_tensor_density` summed over the patch, as the step's first pass does).
+fn shape_tensor<T: Real>(tissue: &Tissue<T>, slot: usize) -> crate::TracelessTensor {
+    let cells = tissue.cells();
+    let mut acc = [0.0; 2];
+    phasefield::for_each_stencil(cells.cell_phi(slot), cells.shape(), |_, s| {
+        let [xx, xy] = crate::equations::shape_tensor_density([s.diff_x(), s.diff_y()]);
+        acc[0] += 0.25 * xx;
+        acc[1] += 0.25 * xy;
+    });
+    crate::TracelessTensor::from(acc)
 }
 
 /// The pressure of the cell in slot `slot`, `p_i = Σ_x φ_i P / Σ_x φ_i`, the tissue pressure
@@ -351,6 +583,29 @@ pub fn remove_extruded<T: Real>(
     fraction: f64,
     mut lineage: Option<&mut Proliferation>,
 ) -> Vec<usize> {
+    let small = extruded(tissue, ws, fraction);
+    let mut out = Vec::new();
+    for id in small {
+        if tissue.n_cells() == 1 {
+            break;
+        }
+        let slot = slot_of(tissue, id);
+        let place = tissue.centres()[slot];
+        tissue.remove(slot);
+        if let Some(l) = lineage.as_deref_mut() {
+            l.removed(id, tissue.time(), place, Ending::Extrusion);
+        }
+        out.push(id);
+    }
+    if !out.is_empty() {
+        ws.fit(tissue.cells());
+    }
+    out
+}
+
+/// The cells whose area in the evaluation `ws` is below `fraction` of their target area, in
+/// the order of their identities.
+fn extruded<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, fraction: f64) -> Vec<usize> {
     // Each cell's target radius by its population's override rules (`Populations::params`).
     let mut small: Vec<usize> = (0..tissue.n_cells())
         .map(|slot| (slot, tissue.cell_ids()[slot]))
@@ -365,26 +620,7 @@ pub fn remove_extruded<T: Real>(
         .map(|(_, id)| id)
         .collect();
     small.sort_unstable();
-    let mut out = Vec::new();
-    for id in small {
-        if tissue.n_cells() == 1 {
-            break;
-        }
-        let slot = tissue
-            .cell_ids()
-            .iter()
-            .position(|&i| i == id)
-            .expect("a listed cell is there");
-        tissue.remove(slot);
-        if let Some(l) = lineage.as_deref_mut() {
-            l.removed(id, tissue.time());
-        }
-        out.push(id);
-    }
-    if !out.is_empty() {
-        ws.fit(tissue.cells());
-    }
-    out
+    small
 }
 
 #[cfg(test)]

@@ -241,7 +241,7 @@ fn cells_below_the_area_fraction_are_removed() {
     assert_eq!(removed, vec![1]);
     assert_eq!(t.cell_ids(), &[0, 2]);
     let r = clock.lineage().find(|r| r.id == 1).unwrap();
-    assert_eq!(r.death, Some((0.0, Ending::Removal)));
+    assert_eq!(r.death, Some((0.0, Ending::Extrusion)));
     for _ in 0..10 {
         t.step(&mut ws, &StepParams::default()).unwrap();
     }

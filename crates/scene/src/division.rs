@@ -1,0 +1,143 @@
+//! `[division]` into a cell-cycle clock (`mechanics::division::Proliferation`), checked key
+//! by key.
+
+use mechanics::division::{Proliferation, SplitAxis};
+use mechanics::Tissue;
+use phasefield::Real;
+
+use crate::file::{DivisionAxis, DivisionSpec, SceneFile};
+use crate::validate::{invalid, sig3, SceneError};
+
+/// The most cells `[division] max_cells` may allow without being asked: twice as many as fill
+/// the lattice at the target area, `2 lx ly / (πR²)`.
+pub(crate) fn default_max_cells(file: &SceneFile) -> usize {
+    let r = file.cells.radius;
+    let area = (file.domain.lx * file.domain.ly) as f64;
+    (2.0 * area / (std::f64::consts::PI * r * r)).ceil() as usize
+}
+
+impl DivisionSpec {
+    /// The fixed part `T₀ = cycle_time − cycle_spread` and the rate `k = 1/cycle_spread` of
+    /// the cycle `T₀ + Exp(1/k)`.
+    pub fn cycle(&self) -> (f64, f64) {
+        let spread = self.spread();
+        (self.cycle_time - spread, 1.0 / spread)
+    }
+
+    /// `cycle_spread`, or its default, a quarter of `cycle_time`.
+    pub fn spread(&self) -> f64 {
+        self.cycle_spread.unwrap_or(0.25 * self.cycle_time)
+    }
+}
+
+/// Checks `[division]` against the rest of the scene.
+///
+/// # Errors
+/// [`SceneError::Invalid`] naming the first bad key.
+pub(crate) fn check(spec: &DivisionSpec, file: &SceneFile) -> Result<(), SceneError> {
+    let s = "division";
+    if !(spec.cycle_time.is_finite() && spec.cycle_time > 0.0) {
+        return Err(invalid(
+            s,
+            "cycle_time",
+            spec.cycle_time,
+            "the mean cell-cycle time must be positive",
+            "give it in model time units (e.g. 300, a few hundred steps of dt 0.5 per cell size moved)",
+        ));
+    }
+    let spread = spec.spread();
+    if !(spread.is_finite() && spread > 0.0 && spread <= spec.cycle_time) {
+        return Err(invalid(
+            s,
+            "cycle_spread",
+            spread,
+            format!(
+                "the mean of the cycle's exponential part must be positive and at most cycle_time = {}",
+                spec.cycle_time
+            ),
+            format!(
+                "use e.g. {} (a quarter of cycle_time; cycle_spread = cycle_time is a memoryless clock)",
+                sig3(spec.cycle_time / 4.0)
+            ),
+        ));
+    }
+    let n = file.cells.count;
+    let max = spec.max_cells.unwrap_or_else(|| default_max_cells(file));
+    if max < n {
+        return Err(invalid(
+            s,
+            "max_cells",
+            max,
+            format!("the cap is below the {n} cells the scene starts with"),
+            format!("use at least {n}"),
+        ));
+    }
+    if let Some(f) = spec.extrusion {
+        if !(f.is_finite() && (0.0..1.0).contains(&f)) {
+            return Err(invalid(
+                s,
+                "extrusion",
+                f,
+                "the extrusion threshold is a fraction of the target area in [0, 1)",
+                "use 0.2 (a cell is extruded when its area falls below a fifth of πR²), or leave it out for no extrusion",
+            ));
+        }
+    }
+    if !(spec.death_rate.is_finite() && spec.death_rate >= 0.0) {
+        return Err(invalid(
+            s,
+            "death_rate",
+            spec.death_rate,
+            "the death rate must be zero or positive",
+            "give it per time unit (e.g. 1e-3), or 0 for none",
+        ));
+    }
+    if let Some(p) = spec.pressure_gate {
+        if !p.is_finite() {
+            return Err(invalid(
+                s,
+                "pressure_gate",
+                p,
+                "the pressure gate must be a finite pressure",
+                "use a value of the cells' pressure p_i = Σφ_i P/Σφ_i (about 0.001–0.01 at confluence), or leave it out",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The clock of `[division]` for the founders of `tissue`, with the noise of `seed`.
+pub(crate) fn clock<T: Real>(
+    spec: &DivisionSpec,
+    file: &SceneFile,
+    tissue: &Tissue<T>,
+) -> Proliferation {
+    let (t0, rate) = spec.cycle();
+    configure(
+        Proliferation::new(t0, rate, file.run.seed, tissue),
+        spec,
+        file,
+    )
+}
+
+/// `clock` with the options of `[division]` besides the cycle.
+pub(crate) fn configure(
+    clock: Proliferation,
+    spec: &DivisionSpec,
+    file: &SceneFile,
+) -> Proliferation {
+    let mut clock = clock
+        .with_axis(match spec.axis {
+            DivisionAxis::Long => SplitAxis::Long,
+            DivisionAxis::Random => SplitAxis::Random,
+        })
+        .with_max_cells(spec.max_cells.unwrap_or_else(|| default_max_cells(file)))
+        .with_death_rate(spec.death_rate);
+    if let Some(f) = spec.extrusion.filter(|&f| f > 0.0) {
+        clock = clock.with_extrusion(f);
+    }
+    if let Some(p) = spec.pressure_gate {
+        clock = clock.with_pressure_gate(p);
+    }
+    clock
+}
