@@ -3,6 +3,7 @@
 mod adaptive;
 mod cli;
 mod common;
+mod division;
 mod docs;
 mod from_state;
 mod signals;

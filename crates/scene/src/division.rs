@@ -141,3 +141,79 @@ pub(crate) fn configure(
     }
     clock
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::{Scene, SceneError};
+
+    const BASE: &str = "[domain]\nlx = 40\nly = 30\n[cells]\ncount = 2\nradius = 6.0\n[integrator]\nmargin = 12\n[run]\ntime = 1\n[division]\ncycle_time = 100.0\n";
+
+    fn parse(set: &[&str]) -> Result<Scene, SceneError> {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        Scene::parse(BASE, &set)
+    }
+
+    /// Defaults: the spread a quarter of the cycle, the cap twice the cells that fill the
+    /// lattice (40·30·2/(36π) = 21.2 → 22), which the memory estimate is sized for; the
+    /// resolved scene writes the spread out, and parses back to the same scene.
+    #[test]
+    fn defaults_and_the_memory_cap() {
+        let s = parse(&[]).unwrap();
+        let d = s.file().division.clone().unwrap();
+        assert_eq!(d.cycle_spread, Some(25.0));
+        assert_eq!(d.cycle(), (75.0, 0.04));
+        assert_eq!(s.max_cells(), 22);
+        let fixed = Scene::parse(
+            BASE.replace("[division]\ncycle_time = 100.0\n", "")
+                .as_str(),
+            &[],
+        )
+        .unwrap();
+        assert_eq!(fixed.max_cells(), 2);
+        let per_cell = (s.memory_estimate() - fixed.memory_estimate()) / 20.0;
+        let p = (25 * 25) as f64;
+        assert!(per_cell >= p * (4.0 * 4.0 + 16.0), "{per_cell}");
+        let again = Scene::parse(&s.to_toml(), &[]).unwrap();
+        assert_eq!(again.to_toml(), s.to_toml());
+        let big = parse(&["division.max_cells=1000"]).unwrap();
+        let grown = (big.memory_estimate() - s.memory_estimate()) / 978.0;
+        assert!((grown / per_cell - 1.0).abs() < 1e-9, "{grown} {per_cell}");
+    }
+
+    /// Each bad `[division]` value names its key and a fix.
+    #[test]
+    fn bad_division_values_name_their_key() {
+        let cases: &[(&[&str], &[&str])] = &[
+            (
+                &["division.cycle_time=0"],
+                &["[division] cycle_time", "positive"],
+            ),
+            (
+                &["division.cycle_spread=150"],
+                &["[division] cycle_spread", "at most cycle_time = 100"],
+            ),
+            (&["division.cycle_spread=-1"], &["[division] cycle_spread"]),
+            (
+                &["division.max_cells=1"],
+                &["[division] max_cells", "at least 2"],
+            ),
+            (
+                &["division.extrusion=1.5"],
+                &["[division] extrusion", "[0, 1)"],
+            ),
+            (&["division.death_rate=-0.1"], &["[division] death_rate"]),
+            (
+                &["division.pressure_gate=nan"],
+                &["[division] pressure_gate"],
+            ),
+            (&["division.axis=\"short\""], &["axis", "long"]),
+            (&["division.cycle=3"], &["cycle"]),
+        ];
+        for (set, want) in cases {
+            let e = parse(set).unwrap_err().to_string();
+            for w in *want {
+                assert!(e.contains(w), "{set:?}: {e:?} lacks {w:?}");
+            }
+        }
+    }
+}

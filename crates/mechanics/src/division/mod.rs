@@ -197,13 +197,7 @@ impl Proliferation {
         ids.sort_unstable();
         for id in ids {
             let cycle = p.cycle(id);
-            let phase = NoiseKey {
-                seed,
-                cell: id as u64,
-                step: 0,
-                stage: PHASE_STAGE,
-            }
-            .uniform();
+            let phase = p.phase(id);
             p.record(LineageRecord {
                 id,
                 parent: None,
@@ -266,8 +260,32 @@ impl Proliferation {
         self.lineage.capacity() * std::mem::size_of::<LineageRecord>()
     }
 
-    /// The age at which the cell `id` dies at the death rate (infinite without one), drawn
-    /// from its noise.
+    /// The age at which the cell of `r` dies at the death rate (infinite without one): its
+    /// lifespan counted from its birth, or for a founder from the clock's start (the death
+    /// rate is a constant hazard, so a founder alive at the start has a lifespan of the same
+    /// law ahead of it; its age then is `phase · cycle`, from its noise).
+    fn death_age(&self, r: &LineageRecord) -> f64 {
+        let at_start = if r.parent.is_none() {
+            self.phase(r.id) * r.cycle
+        } else {
+            0.0
+        };
+        at_start + self.lifespan(r.id)
+    }
+
+    /// A founder's age at the start as a fraction of its cycle, from its noise.
+    fn phase(&self, id: usize) -> f64 {
+        NoiseKey {
+            seed: self.seed,
+            cell: id as u64,
+            step: 0,
+            stage: PHASE_STAGE,
+        }
+        .uniform()
+    }
+
+    /// The lifespan of the cell `id` at the death rate (infinite without one), drawn from its
+    /// noise: exponential of mean `1/k_d`.
     fn lifespan(&self, id: usize) -> f64 {
         if self.death_rate <= 0.0 {
             return f64::INFINITY;
@@ -448,7 +466,7 @@ impl Proliferation {
             .filter(|&id| {
                 self.lineage
                     .get(id)
-                    .is_some_and(|r| r.id == id && now - r.birth >= self.lifespan(id))
+                    .is_some_and(|r| r.id == id && now - r.birth >= self.death_age(r))
             })
             .collect();
         dead.sort_unstable();

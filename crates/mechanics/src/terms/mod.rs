@@ -336,6 +336,10 @@ impl Terms {
                 continue;
             }
             e.old.copy_from_slice(&e.x);
+            // Identities that are no longer in the tissue (divided or removed) keep their last
+            // state: no rate, no kick (a resumed run, which does not keep these, agrees).
+            e.rate1.fill(0.0);
+            e.kick.fill(0.0);
             for slot in 0..view.cells.len() {
                 let cell = view.context(slot);
                 let r = cell.id * len..(cell.id + 1) * len;

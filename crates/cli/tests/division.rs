@@ -1,0 +1,203 @@
+//! Scenes whose cells divide (`[division]`) end to end: a colony from one cell on two threads
+//! equals one thread and a resumed run to the byte (clocks and lineage in the checkpoint);
+//! `lineage.csv`, the frames' `id`, the `cells` column of `series.csv` agree; `analyze`,
+//! `render --colour generation` and `export vtk` follow the changing number of cells.
+
+use std::path::Path;
+
+use crate::common::{bin, run_files, scene_path, stderr};
+
+/// The colony scene shrunk to 96² with a 60 TU cycle and self-propulsion (a term with
+/// per-cell state, which daughters get fresh), checkpoints every 20 TU.
+fn colony(out: &Path, time: &str, threads: &str) -> std::process::Output {
+    bin()
+        .arg("run")
+        .arg(scene_path("colony.toml"))
+        .arg("--out")
+        .arg(out)
+        .args(["--quiet", "--threads", threads])
+        .args([
+            "--set",
+            "domain.lx=96",
+            "--set",
+            "domain.ly=96",
+            "--set",
+            "cells.positions=[[48.0,48.0]]",
+            "--set",
+            "division.cycle_time=60",
+            "--set",
+            "division.cycle_spread=15",
+            "--set",
+            "polarity.alpha=0.01",
+            "--set",
+            "polarity.rotational_diffusion=0.01",
+            "--set",
+            "run.output_every=20",
+            "--set",
+            "run.checkpoint_every=20",
+            "--set",
+            &format!("run.time={time}"),
+        ])
+        .output()
+        .unwrap()
+}
+
+/// One row of `lineage.csv`, as strings.
+fn lineage(dir: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(dir.join("lineage.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(rundir::LINEAGE_HEADER));
+    lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}
+
+#[test]
+fn a_colony_grows_resumes_bit_for_bit_and_is_drawn() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = dir.path().join("full");
+    let o = colony(&full, "300", "2");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mut want = run_files(&full);
+    want.push((
+        "lineage.csv".into(),
+        std::fs::read(full.join("lineage.csv")).unwrap(),
+    ));
+    let files = |d: &Path| {
+        let mut v = run_files(d);
+        v.push((
+            "lineage.csv".into(),
+            std::fs::read(d.join("lineage.csv")).unwrap(),
+        ));
+        v
+    };
+    let one = dir.path().join("one");
+    assert!(colony(&one, "300", "1").status.success());
+    assert!(files(&one) == want, "one thread differs from two");
+    // Stopped at 130 TU (cells born and divided before it, others due after), resumed.
+    let short = dir.path().join("short");
+    assert!(colony(&short, "130", "1").status.success());
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&short)
+        .args(["--quiet", "--set", "run.time=300"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(files(&short) == want, "the resumed run differs");
+
+    // The lineage: every non-founder's parent ended by division at its birth, one
+    // generation before; each mother has two daughters.
+    let rows = lineage(&full);
+    let f = |r: &Vec<String>, k: usize| r[k].parse::<f64>().unwrap();
+    let by_id = |id: &str| {
+        rows.iter()
+            .find(|r| r[0] == id)
+            .expect("the parent is listed")
+    };
+    let mut children = std::collections::BTreeMap::<String, usize>::new();
+    for r in rows.iter().filter(|r| !r[1].is_empty()) {
+        let p = by_id(&r[1]);
+        assert_eq!(
+            (p[3].as_str(), p[4].as_str()),
+            (r[2].as_str(), "division"),
+            "{r:?}"
+        );
+        assert_eq!(f(p, 5) + 1.0, f(r, 5), "{r:?}");
+        *children.entry(r[1].clone()).or_default() += 1;
+    }
+    assert!(children.values().all(|&c| c == 2), "{children:?}");
+    let divisions = rows.iter().filter(|r| r[4] == "division").count();
+    assert!(divisions >= 15, "only {divisions} divisions in 300 TU");
+    // The last frame's ids are the living cells of the lineage, and series.csv counts them.
+    let living: Vec<f64> = rows
+        .iter()
+        .filter(|r| r[3].is_empty())
+        .map(|r| f(r, 0))
+        .collect();
+    let step = rundir::last_frame(&full).unwrap();
+    let ids = rundir::read_npz(&full.join(format!("frames/frame_{step:08}.npz")), &["id"])
+        .unwrap()
+        .remove(0)
+        .data;
+    assert_eq!(ids, living);
+    let series = std::fs::read_to_string(full.join("series.csv")).unwrap();
+    let last = series.lines().last().unwrap();
+    assert_eq!(
+        last.split(',').last().unwrap(),
+        living.len().to_string(),
+        "{last}"
+    );
+
+    // analyze, render by generation and VTK read every frame, whatever its N.
+    let o = bin().arg("analyze").arg(&full).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = dir.path().join("png");
+    let o = bin()
+        .arg("render")
+        .arg(&full)
+        .arg("--out")
+        .arg(&png)
+        .args(["--colour", "generation", "--tracks"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_dir(&png).unwrap().count(), 16);
+    let vtk = dir.path().join("vtk");
+    let o = bin()
+        .args(["export", "vtk"])
+        .arg(&full)
+        .arg("--out")
+        .arg(&vtk)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The owner map of the last frame names cells by identity: every living cell owns
+    // nodes, and no other identity does.
+    let vti = rundir::vtk::read_vti(&vtk.join(format!("fields_{step:08}.vti"))).unwrap();
+    let (_, _, owner) = vti
+        .arrays
+        .iter()
+        .find(|a| a.0 == "cell_id")
+        .expect("a cell_id array");
+    let mut owners: Vec<f64> = owner.iter().copied().filter(|&o| o >= 0.0).collect();
+    owners.sort_by(f64::total_cmp);
+    owners.dedup();
+    assert_eq!(owners, living);
+}
+
+/// `--colour generation` on a run without `[division]` is refused with the reason.
+#[test]
+fn colour_by_generation_needs_a_lineage() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = bin()
+        .arg("run")
+        .arg(scene_path("single.toml"))
+        .arg("--out")
+        .arg(&out)
+        .args([
+            "--quiet",
+            "--set",
+            "run.time=2",
+            "--set",
+            "run.relax_time=0",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = bin()
+        .arg("render")
+        .arg(&out)
+        .arg("--out")
+        .arg(dir.path().join("png"))
+        .args(["--colour", "generation"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("no lineage.csv") && e.contains("[division]"),
+        "{e}"
+    );
+}
