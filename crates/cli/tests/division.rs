@@ -124,7 +124,7 @@ fn a_colony_grows_resumes_bit_for_bit_and_is_drawn() {
     let series = std::fs::read_to_string(full.join("series.csv")).unwrap();
     let last = series.lines().last().unwrap();
     assert_eq!(
-        last.split(',').last().unwrap(),
+        last.split(',').next_back().unwrap(),
         living.len().to_string(),
         "{last}"
     );
