@@ -11,7 +11,8 @@
 //! - [`correlation`]: normalised autocorrelations by FFT, radial averages, first minima;
 //! - [`defects`]: ±½ defects by winding, orientation by Vromans & Giomi;
 //! - [`tracking`]: links between frames, creation and annihilation in pairs;
-//! - [`crop`]: fields averaged in the frame of each defect.
+//! - [`crop`]: fields averaged in the frame of each defect;
+//! - [`proximity`]: how near events come to defects, against random points in the tissue.
 //!
 //! Axis convention: x first index, y second, right-handed; angles counterclockwise from +x.
 //!
@@ -43,6 +44,7 @@ pub mod crop;
 pub mod defects;
 pub mod fields;
 pub mod mixing;
+pub mod proximity;
 pub mod smooth;
 pub mod tracking;
 

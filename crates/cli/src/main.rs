@@ -171,6 +171,10 @@ enum Command {
         /// Each cell's track: its centre through every frame of the run up to the one drawn.
         #[arg(long)]
         tracks: bool,
+        /// The divisions (rings), extrusions (black ×) and deaths (grey ×) since the frame
+        /// before, from lineage.csv (scenes with [division]).
+        #[arg(long)]
+        events: bool,
         /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
         #[arg(long)]
         size: Option<u32>,
@@ -497,6 +501,7 @@ fn real_main() -> Result<ExitCode> {
             axes,
             polarity,
             tracks,
+            events,
             size,
             range,
             movie,
@@ -525,6 +530,7 @@ fn real_main() -> Result<ExitCode> {
                 axes,
                 polarity,
                 tracks,
+                events,
                 size,
                 range,
                 movie,
@@ -592,6 +598,12 @@ fn real_main() -> Result<ExitCode> {
             let opts = analysis.options();
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
             note_skipped(&info.notes, &run_dir);
+            if info.cell_events > 0 {
+                say!(
+                    "{} divisions, extrusions and deaths, with their distances to the defects, in cell_events.csv",
+                    info.cell_events
+                );
+            }
             say!(
                 "analysed {} frames: {} defects, {} creation/annihilation events; results in {}",
                 info.frames,

@@ -205,12 +205,12 @@ pub(crate) fn evaluate<T: Real>(
     cell_force: Option<&[[f64; 2]]>,
     lap_s1: &mut [f64],
     node_buf: &mut [f64],
-    cells_of: (&Populations, &[usize], bool),
+    cells_of: (&Populations, &[usize], bool, &[f64]),
     kind_constants: &mut Vec<CellConstants>,
     walls: Option<WallTerm<'_>>,
     post: Post<'_, T>,
 ) {
-    let (pops, ids, active) = cells_of;
+    let (pops, ids, active, growth) = cells_of;
     let shape = cells.shape();
     let plen = shape.len();
     let energy = params.energy;
@@ -222,7 +222,15 @@ pub(crate) fn evaluate<T: Real>(
     // cell's once per patch column).
     pops.fill_constants(params, active, mixed, kind_constants);
     let kind_constants: &[CellConstants] = kind_constants;
-    let constants = |i: usize| kind_constants[pops.population(ids[i])];
+    // A growing cell (division's growth phase) has its target area scaled by `growth[id]`.
+    let constants = |i: usize| {
+        let mut k = kind_constants[pops.population(ids[i])];
+        if let Some(&g) = growth.get(ids[i]) {
+            k.coef.area /= g;
+            k.coef.inv_target_area /= g;
+        }
+        k
+    };
 
     // 1. Per cell: area, deformation tensor, range.
     cell_state

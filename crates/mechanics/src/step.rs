@@ -382,7 +382,12 @@ impl<T: Real> Tissue<T> {
             cell_force,
             lap_s1,
             node_terms,
-            (&self.populations, &self.cell_id, self.active),
+            (
+                &self.populations,
+                &self.cell_id,
+                self.active,
+                &self.target_scale,
+            ),
             kind_constants,
             self.wall_term(),
             post,

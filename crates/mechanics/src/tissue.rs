@@ -42,6 +42,9 @@ pub struct Tissue<T: Real = f64> {
     pub(crate) walls: Option<Walls>,
     /// The cell-cycle clock and the lineage (`crate::division`), if cells divide.
     pub(crate) proliferation: Option<Box<Proliferation>>,
+    /// Each identity's target area as a multiple of `πR²` (the growth before a division;
+    /// empty: 1 for every cell), set by the clock after each step.
+    pub(crate) target_scale: Vec<f64>,
 }
 
 impl<T: Real> Tissue<T> {
@@ -52,6 +55,7 @@ impl<T: Real> Tissue<T> {
             + self.terms.heap_bytes()
             + self.walls.as_ref().map_or(0, Walls::heap_bytes)
             + self.proliferation.as_ref().map_or(0, |p| p.heap_bytes())
+            + self.target_scale.capacity() * std::mem::size_of::<f64>()
             + self.centre.capacity() * std::mem::size_of::<[f64; 2]>()
             + self.cell_id.capacity() * std::mem::size_of::<usize>()
     }
@@ -97,6 +101,7 @@ impl<T: Real> Tissue<T> {
             populations: Populations::default(),
             walls: None,
             proliferation: None,
+            target_scale: Vec::new(),
         };
         let com = ComTable::new(t.cells.lattice());
         let mut centre = std::mem::take(&mut t.centre);
@@ -142,6 +147,7 @@ impl<T: Real> Tissue<T> {
             populations: Populations::default(),
             walls: None,
             proliferation: None,
+            target_scale: Vec::new(),
         })
     }
 

@@ -70,7 +70,10 @@ pub use heatmap::{save_heatmaps, Heatmap};
 pub use movie::{Movie, MovieKind};
 pub use plot::{LegendAt, Plot, Series};
 pub use raster::Picture;
-pub use tissue::{CellArrows, CellAxes, Fill, LatticeVectors, Patches, TissuePicture, MINUS, PLUS};
+pub use tissue::{
+    CellArrows, CellAxes, EventKind, EventMark, Fill, LatticeVectors, Patches, TissuePicture,
+    MINUS, PLUS,
+};
 
 /// What stops a picture from being drawn, naming the file.
 #[derive(Debug, thiserror::Error)]

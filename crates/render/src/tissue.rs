@@ -63,6 +63,29 @@ pub enum Fill {
     },
 }
 
+/// A cell event drawn on a picture: a division (a green ring), an extrusion (a black ×) or a
+/// death (a grey ×), at the centre where the cell was.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EventMark {
+    /// Position along x.
+    pub x: f64,
+    /// Position along y.
+    pub y: f64,
+    /// What happened.
+    pub kind: EventKind,
+}
+
+/// What an [`EventMark`] marks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventKind {
+    /// A cell divided.
+    Division,
+    /// A cell was extruded.
+    Extrusion,
+    /// A cell died.
+    Death,
+}
+
 /// A vector or director field on the lattice, drawn every `every` nodes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LatticeVectors {
@@ -116,6 +139,8 @@ pub struct TissuePicture {
     /// `∇·Q`, so the head is the dot's side opposite the tail), a three-armed mark for −½
     /// (arms at `ψ + 2πk/3`), a ring for any other charge.
     pub defects: Vec<Defect>,
+    /// Cell events to mark (divisions, extrusions, deaths), at the cells' centres.
+    pub events: Vec<EventMark>,
     /// Principal deformation axes, one per cell.
     pub axes: Option<CellAxes>,
     /// Polarities, one arrow per cell.
@@ -148,6 +173,7 @@ const AXIS: [u8; 3] = [200, 20, 20];
 const POLARITY: [u8; 3] = [10, 110, 40];
 const TRACK: [u8; 3] = [60, 60, 160];
 const WALL: [u8; 3] = [140, 140, 140];
+const DIVISION: [u8; 3] = [20, 150, 60];
 
 const TITLE_PX: u32 = 36;
 const BAR_PX: u32 = 110;
@@ -165,6 +191,7 @@ impl TissuePicture {
             director: None,
             flow: None,
             defects: Vec::new(),
+            events: Vec::new(),
             axes: None,
             polarity: None,
             tracks: None,
@@ -311,6 +338,7 @@ impl TissuePicture {
             clip,
         };
         self.draw_overlays(&mut canvas);
+        self.draw_events(&mut canvas);
         if let Some(range) = bar {
             self.draw_bar_colours(&mut pic, range);
         }
@@ -555,6 +583,36 @@ impl TissuePicture {
                         let a = 2.0 * PI * k as f64 / 24.0;
                         c.disc(px + r * a.cos(), py + r * a.sin(), 0.4 * w, CONTOUR);
                     }
+                }
+            });
+        }
+    }
+
+    /// The cell events: rings for divisions, crosses for extrusions and deaths.
+    fn draw_events(&self, c: &mut Canvas<'_>) {
+        let s = self.scale();
+        let r = (0.45 * self.mark * s).max(5.0);
+        let w = (0.12 * self.mark * s).clamp(2.0, 5.0);
+        for e in &self.events {
+            if !(e.x.is_finite() && e.y.is_finite()) {
+                continue;
+            }
+            self.periodic(c, e.x, e.y, self.mark, |c, (px, py), _| match e.kind {
+                EventKind::Division => {
+                    for k in 0..32 {
+                        let a = 2.0 * PI * k as f64 / 32.0;
+                        c.disc(px + r * a.cos(), py + r * a.sin(), 0.5 * w, DIVISION);
+                    }
+                }
+                EventKind::Extrusion | EventKind::Death => {
+                    let col = if e.kind == EventKind::Extrusion {
+                        [0, 0, 0]
+                    } else {
+                        [110, 110, 110]
+                    };
+                    let d = 0.75 * r;
+                    c.line((px - d, py - d), (px + d, py + d), w, col);
+                    c.line((px - d, py + d), (px + d, py - d), w, col);
                 }
             });
         }

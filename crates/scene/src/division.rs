@@ -83,6 +83,18 @@ pub(crate) fn check(spec: &DivisionSpec, file: &SceneFile) -> Result<(), SceneEr
             ));
         }
     }
+    if !(spec.growth_time.is_finite() && spec.growth_time >= 0.0) {
+        return Err(invalid(
+            s,
+            "growth_time",
+            spec.growth_time,
+            "the growth time must be zero or positive",
+            format!(
+                "give it in time units (e.g. {}, a third of cycle_time), or 0 for daughters that regrow from half the area",
+                sig3(spec.cycle_time / 3.0)
+            ),
+        ));
+    }
     if !(spec.death_rate.is_finite() && spec.death_rate >= 0.0) {
         return Err(invalid(
             s,
@@ -113,8 +125,10 @@ pub(crate) fn clock<T: Real>(
     tissue: &Tissue<T>,
 ) -> Proliferation {
     let (t0, rate) = spec.cycle();
+    // The clocks start when the relaxation ends, when the tissue starts to proliferate.
+    let start = tissue.time().max(file.run.relax_time);
     configure(
-        Proliferation::new(t0, rate, file.run.seed, tissue),
+        Proliferation::starting_at(t0, rate, file.run.seed, tissue, start),
         spec,
         file,
     )
@@ -132,7 +146,8 @@ pub(crate) fn configure(
             DivisionAxis::Random => SplitAxis::Random,
         })
         .with_max_cells(spec.max_cells.unwrap_or_else(|| default_max_cells(file)))
-        .with_death_rate(spec.death_rate);
+        .with_death_rate(spec.death_rate)
+        .with_growth_time(spec.growth_time);
     if let Some(f) = spec.extrusion.filter(|&f| f > 0.0) {
         clock = clock.with_extrusion(f);
     }
@@ -202,6 +217,10 @@ mod tests {
                 &["[division] extrusion", "[0, 1)"],
             ),
             (&["division.death_rate=-0.1"], &["[division] death_rate"]),
+            (
+                &["division.growth_time=-5"],
+                &["[division] growth_time", "e.g. 33.3"],
+            ),
             (
                 &["division.pressure_gate=nan"],
                 &["[division] pressure_gate"],

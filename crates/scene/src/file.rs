@@ -330,6 +330,11 @@ pub struct DivisionSpec {
     /// `cycle_time` itself gives a memoryless clock).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle_spread: Option<f64>,
+    /// The growth time `T_g` (default 0): once a cell's age reaches its cycle, its target
+    /// area ramps from `πR²` to `2πR²` over `T_g`, and it divides at the end; the mean time
+    /// between divisions is then `cycle_time + growth_time`.
+    #[serde(default)]
+    pub growth_time: f64,
     /// The axis of the split (default `"long"`).
     #[serde(default)]
     pub axis: DivisionAxis,

@@ -19,6 +19,7 @@ use analysis::tracking::{TrackParams, Tracker};
 use mechanics::{Tissue, TissueFields, Workspace};
 use phasefield::{Cells, Lattice, PatchShape};
 
+use analysis::proximity::{mean_nearest_over, nearest};
 use rundir::{npy, read_npz, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
 use scene::{Scene, SceneFile};
 
@@ -109,6 +110,8 @@ pub struct AnalyzeInfo {
     pub defects: usize,
     /// Creation and annihilation events.
     pub events: usize,
+    /// Divisions, extrusions and deaths in the analysed time (`[division]`; 0 without).
+    pub cell_events: usize,
     /// What reading the frames noticed.
     pub notes: FrameNotes,
 }
@@ -656,8 +659,14 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         frames: 0,
         defects: 0,
         events: 0,
+        cell_events: 0,
         notes,
     };
+    // With `[division]`: each frame's ±½ defects and the random baseline, for the distances
+    // of the divisions and extrusions to the defects (`cell_events.csv`).
+    let lineage = rundir::read_lineage(run_dir)
+        .map_err(|e| input(&run_dir.join("lineage.csv"), e.to_string()))?;
+    let mut near: Vec<FrameDefects> = Vec::new();
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
     // A wound's band: the solid of the walls during the relaxation, when they open after it.
@@ -675,6 +684,10 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
             let s1: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
             analysis::confinement::uncovered_fraction(&s1, band)
+        });
+        let covered: Option<Vec<bool>> = lineage.as_ref().map(|_| {
+            let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
+            phi_sum.iter().map(|&v| v >= 0.5).collect()
         });
         let LoadedFrame {
             tissue,
@@ -720,6 +733,26 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
                 e.y
             );
         }
+        if let Some(mask) = &covered {
+            let at = |q: f64| -> Vec<[f64; 2]> {
+                found
+                    .iter()
+                    .filter(|d| d.charge == q)
+                    .map(|d| [d.x, d.y])
+                    .collect()
+            };
+            let (plus, minus) = (at(0.5), at(-0.5));
+            let stride = (radius / 2.0).max(1.0) as usize;
+            near.push(FrameDefects {
+                time,
+                random: [
+                    mean_nearest_over(lattice, mask, &plus, stride),
+                    mean_nearest_over(lattice, mask, &minus, stride),
+                ],
+                plus,
+                minus,
+            });
+        }
         avg.add(lattice, &crop_fields(&f), &found);
         let n_plus = found.iter().filter(|d| d.charge == 0.5).count();
         let n_minus = found.iter().filter(|d| d.charge == -0.5).count();
@@ -752,6 +785,9 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     write_file(&out.join("observables.csv"), obs.as_bytes())?;
     write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
     write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
+    if let Some(lineage) = &lineage {
+        info.cell_events = write_cell_events(&out, lattice, lineage, &near)?;
+    }
 
     let radial: Vec<Vec<f64>> = corr.iter().map(|c| c.radial()).collect();
     let mut c = String::new();
@@ -774,6 +810,109 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     write_file(&out.join("lengths.csv"), l.as_bytes())?;
     write_averages(&out.join("defect_averages.npz"), &avg)?;
     Ok(info)
+}
+
+/// One analysed frame's ±½ defects, and the mean distance of a random point of its tissue
+/// to the nearest of each.
+struct FrameDefects {
+    time: f64,
+    plus: Vec<[f64; 2]>,
+    minus: Vec<[f64; 2]>,
+    random: [f64; 2],
+}
+
+/// Writes `cell_events.csv` (every division, extrusion and death of `lineage.csv` within the
+/// analysed frames, at the frame nearest in time: the distance from where the cell ended to
+/// the nearest +½ and −½ defect, and the same for a random point of the tissue) and
+/// `cell_events_summary.csv` (their means by kind). Returns the number of events.
+fn write_cell_events(
+    out: &Path,
+    lattice: Lattice,
+    lineage: &[mechanics::division::LineageRecord],
+    frames: &[FrameDefects],
+) -> Result<usize> {
+    let mut csv = String::new();
+    row!(
+        csv,
+        "time,kind,id,x,y,frame_time,d_plus,d_minus,d_plus_random,d_minus_random"
+    );
+    let (Some(first), Some(last)) = (frames.first(), frames.last()) else {
+        return Ok(0);
+    };
+    let half = if frames.len() > 1 {
+        0.5 * (last.time - first.time) / (frames.len() - 1) as f64
+    } else {
+        0.0
+    };
+    // kind → (count, Σ d_plus, Σ d_plus_random, Σ d_minus, Σ d_minus_random), finite only.
+    let mut sums: std::collections::BTreeMap<&str, [f64; 5]> = Default::default();
+    let mut n = 0;
+    for r in lineage {
+        let Some((t, why)) = r.death else { continue };
+        if t < first.time - half || t > last.time + half {
+            continue;
+        }
+        let f = frames
+            .iter()
+            .min_by(|a, b| (a.time - t).abs().total_cmp(&(b.time - t).abs()))
+            .expect("frames are not empty");
+        let d = [
+            nearest(lattice, r.place, &f.plus),
+            nearest(lattice, r.place, &f.minus),
+        ];
+        let shown = |v: f64| {
+            if v.is_finite() {
+                format!("{v:e}")
+            } else {
+                "nan".into()
+            }
+        };
+        row!(
+            csv,
+            "{t},{},{},{},{},{},{},{},{},{}",
+            why.name(),
+            r.id,
+            r.place[0],
+            r.place[1],
+            f.time,
+            shown(d[0]),
+            shown(d[1]),
+            shown(f.random[0]),
+            shown(f.random[1])
+        );
+        let e = sums.entry(why.name()).or_default();
+        if [d[0], d[1], f.random[0], f.random[1]]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            e[0] += 1.0;
+            e[1] += d[0];
+            e[2] += f.random[0];
+            e[3] += d[1];
+            e[4] += f.random[1];
+        }
+        n += 1;
+    }
+    write_file(&out.join("cell_events.csv"), csv.as_bytes())?;
+    let mut summary = String::new();
+    row!(
+        summary,
+        "kind,events,mean_d_plus,mean_d_plus_random,mean_d_minus,mean_d_minus_random"
+    );
+    for (kind, e) in &sums {
+        let m = |v: f64| if e[0] > 0.0 { v / e[0] } else { f64::NAN };
+        row!(
+            summary,
+            "{kind},{},{:e},{:e},{:e},{:e}",
+            e[0],
+            m(e[1]),
+            m(e[2]),
+            m(e[3]),
+            m(e[4])
+        );
+    }
+    write_file(&out.join("cell_events_summary.csv"), summary.as_bytes())?;
+    Ok(n)
 }
 
 /// The demixing parameter of the frame's populations over the cells that touch

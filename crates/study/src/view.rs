@@ -17,10 +17,11 @@ use std::str::FromStr;
 
 use analysis::defects::detect;
 use analysis::smooth::box_smooth;
-use mechanics::division::LineageRecord;
+use mechanics::division::{Ending, LineageRecord};
 use mechanics::{TissueFields, Workspace};
 use render::{
-    CellArrows, CellAxes, Fill, LatticeVectors, Movie, Patches, RenderError, TissuePicture,
+    CellArrows, CellAxes, EventKind, EventMark, Fill, LatticeVectors, Movie, Patches, RenderError,
+    TissuePicture,
 };
 use rundir::vtk::{write_pvd, write_vti, write_vtp, VtkArray, VtkValues};
 use rundir::RunDirError;
@@ -150,6 +151,9 @@ pub struct RenderOptions {
     pub polarity: bool,
     /// Each cell's track: its centre through every frame up to the one drawn.
     pub tracks: bool,
+    /// The divisions, extrusions and deaths of `lineage.csv` since the frame before (runs
+    /// with `[division]`): a ring, a black ×, a grey ×.
+    pub events: bool,
     /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
     pub size: Option<u32>,
     /// The colour bar's range (default: each frame's own).
@@ -173,6 +177,7 @@ impl Default for RenderOptions {
             axes: false,
             polarity: false,
             tracks: false,
+            events: false,
             size: None,
             range: None,
             movie: None,
@@ -503,6 +508,27 @@ fn picture(
     if opts.tracks {
         p.tracks = Some(run.tracks(frame.step)?);
     }
+    if opts.events {
+        let now = frame.tissue.time();
+        let since = now - run.scene.file().run.output_every;
+        p.events = run
+            .lineage
+            .iter()
+            .flatten()
+            .filter_map(|r| {
+                let (t, why) = r.death?;
+                (t > since + 1e-9 && t <= now + 1e-9).then_some(EventMark {
+                    x: r.place[0],
+                    y: r.place[1],
+                    kind: match why {
+                        Ending::Division => EventKind::Division,
+                        Ending::Extrusion => EventKind::Extrusion,
+                        Ending::Death => EventKind::Death,
+                    },
+                })
+            })
+            .collect();
+    }
     if opts.polarity {
         if let Some(theta) = frame.tissue.terms().state("polarity") {
             p.polarity = Some(CellArrows {
@@ -578,6 +604,12 @@ pub fn render_run(
         return Err(ViewError::Options(format!(
             "--colour {}: {} has no lineage.csv (its scene has no [division], so no cell divided); use --colour id",
             if opts.colour == Colour::Generation { "generation" } else { "lineage" },
+            run_dir.display()
+        )));
+    }
+    if opts.events && run.lineage.is_none() {
+        return Err(ViewError::Options(format!(
+            "--events: {} has no lineage.csv (its scene has no [division], so no cell divided or was extruded); leave --events out",
             run_dir.display()
         )));
     }

@@ -168,6 +168,10 @@ pub struct Proliferation {
     /// The death rate `k_d` per time unit (0: none): each cell's lifespan is drawn at its
     /// birth, exponential of mean `1/k_d`, and it is removed when its age passes it.
     pub death_rate: f64,
+    /// The growth time `T_g` (0: none): once a cell's age reaches its cycle it grows, its
+    /// target area ramping linearly from `πR²` to `2πR²` over `T_g`, and divides at
+    /// `cycle + T_g`, so the mean time between divisions is `T₀ + 1/k + T_g`.
+    pub growth_time: f64,
     seed: u64,
     lineage: Vec<LineageRecord>,
 }
@@ -182,6 +186,19 @@ impl Proliferation {
     /// A clock of cycle `T₀ + Exp(1/k)` for the cells of `tissue` (its founders), with the
     /// noise of `seed`.
     pub fn new<T: Real>(t0: f64, rate: f64, seed: u64, tissue: &Tissue<T>) -> Self {
+        Self::starting_at(t0, rate, seed, tissue, tissue.time())
+    }
+
+    /// [`Proliferation::new`] with the founders' clocks starting at `start` (the end of a
+    /// relaxation, when [`Tissue::proliferate`] starts to act) rather than at the tissue's
+    /// time.
+    pub fn starting_at<T: Real>(
+        t0: f64,
+        rate: f64,
+        seed: u64,
+        tissue: &Tissue<T>,
+        start: f64,
+    ) -> Self {
         let mut p = Self {
             t0,
             rate,
@@ -190,6 +207,7 @@ impl Proliferation {
             pressure_gate: None,
             extrusion: None,
             death_rate: 0.0,
+            growth_time: 0.0,
             seed,
             lineage: Vec::new(),
         };
@@ -201,7 +219,7 @@ impl Proliferation {
             p.record(LineageRecord {
                 id,
                 parent: None,
-                birth: tissue.time() - phase * cycle,
+                birth: start - phase * cycle,
                 death: None,
                 place: [f64::NAN; 2],
                 generation: 0,
@@ -230,6 +248,7 @@ impl Proliferation {
             pressure_gate: None,
             extrusion: None,
             death_rate: 0.0,
+            growth_time: 0.0,
             seed,
             lineage: Vec::new(),
         };
@@ -247,6 +266,39 @@ impl Proliferation {
     pub fn with_extrusion(mut self, fraction: f64) -> Self {
         self.extrusion = Some(fraction);
         self
+    }
+
+    /// The same clock with a growth phase of `t_g` before each division.
+    pub fn with_growth_time(mut self, t_g: f64) -> Self {
+        self.growth_time = t_g;
+        self
+    }
+
+    /// The target area of the cell of `r` at `now` as a multiple of `πR²`: 1, rising
+    /// linearly to 2 over the growth time once its age passes its cycle.
+    pub fn target_scale(&self, r: &LineageRecord, now: f64) -> f64 {
+        if self.growth_time <= 0.0 {
+            return 1.0;
+        }
+        1.0 + ((now - r.birth - r.cycle) / self.growth_time).clamp(0.0, 1.0)
+    }
+
+    /// Fills `out` (by identity) with the target-area scale of every cell of `tissue` at its
+    /// time; empty without a growth phase. Grows `out` only when identities are added.
+    fn fill_target_scale<T: Real>(&self, tissue: &Tissue<T>, out: &mut Vec<f64>) {
+        if self.growth_time <= 0.0 {
+            out.clear();
+            return;
+        }
+        out.resize(tissue.next_id(), 1.0);
+        let now = tissue.time();
+        for &id in tissue.cell_ids() {
+            out[id] = self
+                .lineage
+                .get(id)
+                .filter(|r| r.id == id)
+                .map_or(1.0, |r| self.target_scale(r, now));
+        }
     }
 
     /// The same clock with the death rate `k_d` per time unit.
@@ -381,7 +433,7 @@ impl Proliferation {
             .filter(|&(id, _)| {
                 self.lineage
                     .get(id)
-                    .is_some_and(|r| r.id == id && now - r.birth >= r.cycle)
+                    .is_some_and(|r| r.id == id && now - r.birth >= r.cycle + self.growth_time)
                     && skip.binary_search(&id).is_err()
             })
             .collect();
@@ -496,6 +548,9 @@ impl<T: Real> Tissue<T> {
     /// The same tissue with a cell-cycle clock (and its extrusion rule and death rate), which
     /// [`Tissue::proliferate`] applies.
     pub fn with_proliferation(mut self, clock: Proliferation) -> Self {
+        let mut scale = std::mem::take(&mut self.target_scale);
+        clock.fill_target_scale(&self, &mut scale);
+        self.target_scale = scale;
         self.proliferation = Some(Box::new(clock));
         self
     }
@@ -507,7 +562,8 @@ impl<T: Real> Tissue<T> {
 
     /// Applies the clock after a step: the divisions that are due, then deaths at the death
     /// rate, then the extrusion rule, each in the order of identities, and fits `ws` to the
-    /// new number of cells. `ws` must hold the evaluation of the current state (as
+    /// new number of cells. Nothing happens while the tissue is inactive (the relaxation of
+    /// a scene, whose initial discs are smaller than the cells and would be extruded). `ws` must hold the evaluation of the current state (as
     /// [`Tissue::step`] leaves it). Does nothing without a clock.
     ///
     /// Every decision is taken on the state the step left, before any event (the evaluation
@@ -515,6 +571,9 @@ impl<T: Real> Tissue<T> {
     /// that die (not already extruded), then the divisions due among the rest; the removals
     /// happen after the divisions. A tissue keeps at least one cell.
     pub fn proliferate(&mut self, ws: &mut Workspace<T>) -> CellEvents {
+        if !self.active {
+            return CellEvents::default();
+        }
         let Some(mut clock) = self.proliferation.take() else {
             return CellEvents::default();
         };
@@ -547,6 +606,9 @@ impl<T: Real> Tissue<T> {
         if !removals.is_empty() {
             ws.fit(self.cells());
         }
+        let mut scale = std::mem::take(&mut self.target_scale);
+        clock.fill_target_scale(self, &mut scale);
+        self.target_scale = scale;
         self.proliferation = Some(clock);
         CellEvents {
             divisions,
@@ -633,7 +695,8 @@ fn extruded<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, fraction: f64) -> Ve
                 .params(pops.population(id), &tissue.params)
                 .energy
                 .radius;
-            ws.cell(slot).area < fraction * std::f64::consts::PI * r * r
+            let scale = tissue.target_scale.get(id).copied().unwrap_or(1.0);
+            ws.cell(slot).area < fraction * scale * std::f64::consts::PI * r * r
         })
         .map(|(_, id)| id)
         .collect();
