@@ -185,7 +185,7 @@ fn colony_growth(t_g: f64) {
             let lattice = Lattice::new(200, 200);
             let shape = PatchShape::new(lattice, 16).unwrap();
             let cells = init::discs(lattice, shape, &[[100.0, 100.0]], 8.0, 2.5);
-            let mut t = Tissue::new(cells, ModelParams::paper(0.0));
+            let t = Tissue::new(cells, ModelParams::paper(0.0));
             let mut ws = Workspace::new(t.cells());
             // The founder starts its cycle at birth, as every later cell does.
             let mut clock = Proliferation::new(t0, k, seed, &t)
