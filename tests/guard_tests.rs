@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 45] = [
+const KEYS: [&str; 53] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -164,8 +164,16 @@ const KEYS: [&str; 45] = [
     "walls.omega",
     "walls.width",
     "walls.radius",
+    "division.cycle_time",
+    "division.cycle_spread",
+    "division.growth_time",
+    "division.axis",
+    "division.max_cells",
+    "division.extrusion",
+    "division.death_rate",
+    "division.pressure_gate",
 ];
-const VALUES: [&str; 40] = [
+const VALUES: [&str; 42] = [
     "0",
     "-1",
     "1",
@@ -206,6 +214,8 @@ const VALUES: [&str; 40] = [
     "\"disc\"",
     "\"wound\"",
     "\"box\"",
+    "\"long\"",
+    "0.3",
 ];
 
 /// Stands for the path of a real frame of the base scene (`frame_path`) among [`VALUES`].
@@ -271,7 +281,9 @@ fn fuzz_one(overrides: &[String], tally: &mut Tally) -> Result<(), String> {
         let mut ws = Workspace::new(t.cells());
         let p = s.step_params();
         Ok::<_, String>((0..2).try_for_each(|_| match s.adaptive() {
-            None => t.step(&mut ws, &p),
+            None => t.step(&mut ws, &p).map(|_| {
+                t.proliferate(&mut ws);
+            }),
             Some(a) => {
                 let mut c = mechanics::Controller::new(p.dt);
                 let check = &mut mechanics::StateCheck::default();
@@ -316,13 +328,15 @@ fn fuzzed_scenes_end_in_a_clean_error_or_a_valid_run() {
     let rng = TestRng::deterministic_rng(config.rng_algorithm);
     let mut runner = TestRunner::new_with_rng(config, rng);
     // A third of the cases start from a saved frame of the base scene, so that overrides meet
-    // `init = "frame"` too; half have a channel, so that the wall keys meet walls.
+    // `init = "frame"` too; half have a channel, so that the wall keys meet walls; half divide
+    // (a cycle of 0.5 TU: the cells divide within the two steps).
     let overrides = (
         prop::collection::vec((0..KEYS.len(), 0..VALUES.len()), 1..=3),
         0..3,
         proptest::bool::ANY,
+        proptest::bool::ANY,
     )
-        .prop_map(|(v, base, walls)| {
+        .prop_map(|(v, base, walls, divide)| {
             let from_frame = (base == 0).then(|| {
                 [
                     "cells.init=\"frame\"".to_string(),
@@ -330,10 +344,12 @@ fn fuzzed_scenes_end_in_a_clean_error_or_a_valid_run() {
                 ]
             });
             let channel = walls.then(|| "walls.kind=\"channel\"".to_string());
+            let division = divide.then(|| "division.cycle_time=0.5".to_string());
             from_frame
                 .into_iter()
                 .flatten()
                 .chain(channel)
+                .chain(division)
                 .chain(v.into_iter().map(|(k, x)| match VALUES[x] {
                     FRAME => format!("{}={}", KEYS[k], frame_path()),
                     v => format!("{}={v}", KEYS[k]),

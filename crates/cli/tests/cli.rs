@@ -56,7 +56,7 @@ fn a_run_writes_scene_series_and_frames() {
             .unwrap();
     assert_eq!(json["precision"], "f32");
     assert_eq!(json["lattice"], serde_json::json!([100, 100]));
-    assert_eq!(json["frame_format"], 2);
+    assert_eq!(json["frame_format"], 3);
     assert_eq!(json["columns"]["series.csv"]["v_rms"], "nodes/TU");
     let header = series.lines().next().unwrap();
     for column in header.split(',') {
@@ -1321,7 +1321,7 @@ fn a_full_disk_stops_the_run_cleanly_and_it_resumes_bit_for_bit() {
     let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
     assert!(series.ends_with('\n'), "a cut row ends series.csv");
     assert!(
-        series.lines().all(|l| l.split(',').count() == 11),
+        series.lines().all(|l| l.split(',').count() == 12),
         "{series}"
     );
     // More room, and the run goes on where its checkpoint left it.

@@ -7,8 +7,9 @@ use std::path::Path;
 
 use crate::common::{bin, run_files, scene_path, stderr};
 
-/// The colony scene shrunk to 96² with a 60 TU cycle and self-propulsion (a term with
-/// per-cell state, which daughters get fresh), checkpoints every 20 TU.
+/// The colony scene shrunk to 96² with a 40 TU cycle and 20 TU of growth, and
+/// self-propulsion (a term with per-cell state, which daughters get fresh), checkpoints every
+/// 20 TU.
 fn colony(out: &Path, time: &str, threads: &str) -> std::process::Output {
     bin()
         .arg("run")
@@ -24,9 +25,11 @@ fn colony(out: &Path, time: &str, threads: &str) -> std::process::Output {
             "--set",
             "cells.positions=[[48.0,48.0]]",
             "--set",
-            "division.cycle_time=60",
+            "division.cycle_time=40",
             "--set",
-            "division.cycle_spread=15",
+            "division.cycle_spread=10",
+            "--set",
+            "division.growth_time=20",
             "--set",
             "polarity.alpha=0.01",
             "--set",
