@@ -2,12 +2,17 @@
 //! ζ = 0.005) of `large.toml` (960 cells, 400², margin 12, f32 storage) without terms, with
 //! self-propulsion (`[polarity]` α = 0.04, D_r = 4.5e-4, aligning to the velocity), with
 //! adhesion (ω = 0.005), with two populations of different γ and ζ (±0.005), and in a channel
-//! (`[walls] kind = "channel"`, κ_w = 1, ℓ_w = 1), on one and two threads. Throughput is in node updates (cells × patch nodes per step).
+//! (`[walls] kind = "channel"`, κ_w = 1, ℓ_w = 1), and with a cell-cycle clock (`[division]`
+//! with every cell in its growth phase and none due: the step, the clock's checks after it and
+//! each cell's own target area in the kernels), on one and two threads. Throughput is in node
+//! updates (cells × patch nodes per step). `division/event` is one division of a cell of the
+//! relaxed tissue with the workspace fitted after it (the cost of an event, not per step).
 //!
 //! Run with `cargo bench -p monolayer-benches --bench terms`.
 
 use criterion::{criterion_main, BenchmarkId, Criterion, Throughput};
 use mechanics::terms::{Population, Populations};
+use mechanics::Workspace;
 use monolayer_benches::{pool, relaxed_scene};
 
 fn bench_terms(c: &mut Criterion) {
@@ -20,7 +25,7 @@ fn bench_terms(c: &mut Criterion) {
             .chain(extra.iter().map(|s| s.to_string()))
             .collect()
     };
-    let cases: [(&str, Vec<String>, bool); 5] = [
+    let cases: [(&str, Vec<String>, bool); 6] = [
         ("none", with(&[]), false),
         (
             "polarity",
@@ -35,6 +40,16 @@ fn bench_terms(c: &mut Criterion) {
         ("adhesion", with(&["adhesion.omega=0.005"]), false),
         ("populations", with(&[]), true),
         ("walls", with(&["walls.kind=\"channel\""]), false),
+        (
+            "division",
+            with(&[
+                "division.cycle_time=1",
+                "division.cycle_spread=1",
+                "division.growth_time=1e9",
+                "division.max_cells=2000",
+            ]),
+            false,
+        ),
     ];
     for (name, overrides, populations) in cases {
         let (t, mut ws, s) =
@@ -55,7 +70,26 @@ fn bench_terms(c: &mut Criterion) {
             let pool = pool(threads);
             let id = BenchmarkId::new(name, format!("threads={threads}"));
             g.bench_function(id, |b| {
-                pool.install(|| b.iter(|| t.step(&mut ws, &sp).unwrap()));
+                pool.install(|| {
+                    b.iter(|| {
+                        t.step(&mut ws, &sp).unwrap();
+                        t.proliferate(&mut ws)
+                    })
+                });
+            });
+        }
+        if name == "division" {
+            let id = BenchmarkId::new("division", "event");
+            g.bench_function(id, |b| {
+                b.iter_batched(
+                    || (t.clone(), Workspace::new(t.cells())),
+                    |(mut t, mut ws)| {
+                        t.divide(n / 2, [1.0, 0.0]);
+                        ws.fit(t.cells());
+                        (t, ws)
+                    },
+                    criterion::BatchSize::LargeInput,
+                )
             });
         }
     }
