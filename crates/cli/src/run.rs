@@ -209,6 +209,11 @@ impl<T: Real> Callback<T> for Progress {
     fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
         let (step, time, v_rms) = (obs.iteration(), obs.time(), obs.observables().v_rms);
         let end = self.end;
+        // With `[division]` the number of cells changes: say it.
+        let cells = match obs.tissue().proliferation() {
+            Some(_) => format!("  cells = {}", obs.tissue().n_cells()),
+            None => String::new(),
+        };
         if let Some(b) = &self.bar {
             let done = if end > 0.0 {
                 (time / end).min(1.0)
@@ -216,9 +221,11 @@ impl<T: Real> Callback<T> for Progress {
                 1.0
             };
             b.set_position((done * PROGRESS_TICKS as f64) as u64);
-            b.set_message(format!("step {step}  t = {time:.1}  v_rms = {v_rms:.3e}"));
+            b.set_message(format!(
+                "step {step}  t = {time:.1}  v_rms = {v_rms:.3e}{cells}"
+            ));
         } else if !self.quiet && self.lines.due(time, end) {
-            crate::say!("step {step}  t = {time:.1}/{end}  v_rms = {v_rms:.3e}");
+            crate::say!("step {step}  t = {time:.1}/{end}  v_rms = {v_rms:.3e}{cells}");
         }
         Ok(())
     }

@@ -204,3 +204,98 @@ fn colour_by_generation_needs_a_lineage() {
         "{e}"
     );
 }
+
+/// Populations and division: the mixture scene (two populations of different γ) shrunk to
+/// 64² with 16 cells and a fast clock after 20 TU of relaxation, stopped at 60 TU and resumed
+/// to 120 TU, equals the run
+/// straight through to the byte (the daughters' populations, which the scene's deal does not
+/// know, are in the checkpoint), and every frame's `population` has a row per cell.
+#[test]
+fn a_dividing_mixture_resumes_with_its_populations() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |out: &Path, time: &str| {
+        bin()
+            .arg("run")
+            .arg(scene_path("mixture.toml"))
+            .arg("--out")
+            .arg(out)
+            .args(["--quiet", "--threads", "2"])
+            .args([
+                "--set",
+                "domain.lx=64",
+                "--set",
+                "domain.ly=64",
+                "--set",
+                "cells.count=16",
+                "--set",
+                "population.0.count=8",
+                "--set",
+                "population.1.count=8",
+                "--set",
+                "division.cycle_time=30",
+                "--set",
+                "division.extrusion=0.2",
+                "--set",
+                "run.relax_time=20",
+                "--set",
+                "run.output_every=20",
+                "--set",
+                "run.checkpoint_every=20",
+                "--set",
+                &format!("run.time={time}"),
+            ])
+            .output()
+            .unwrap()
+    };
+    let full = dir.path().join("full");
+    let o = run(&full, "120");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let short = dir.path().join("short");
+    assert!(run(&short, "60").status.success());
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&short)
+        .args(["--quiet", "--set", "run.time=120"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        run_files(&short) == run_files(&full),
+        "the resumed run differs"
+    );
+    let step = rundir::last_frame(&full).unwrap();
+    let a = rundir::read_npz(
+        &full.join(format!("frames/frame_{step:08}.npz")),
+        &["id", "population"],
+    )
+    .unwrap();
+    assert_eq!(a[0].data.len(), a[1].data.len());
+    assert!(a[0].data.len() > 16, "no cell divided: {}", a[0].data.len());
+    assert!(a[1].data.iter().all(|&k| k == 0.0 || k == 1.0));
+    let o = bin().arg("analyze").arg(&full).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// The memory guard sizes a dividing run for its cap: a cap of 10⁸ cells is refused, naming
+/// `[division] max_cells`, where the same scene with its default cap runs.
+#[test]
+fn the_memory_guard_counts_the_cap() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bin()
+        .arg("run")
+        .arg(scene_path("colony.toml"))
+        .arg("--out")
+        .arg(dir.path().join("big"))
+        .args(["--quiet", "--set", "division.max_cells=100000000"])
+        .args(["--max-memory", "4G"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("100000000 cell(s) at most, [division] max_cells")
+            && e.contains("reduce [division] max_cells"),
+        "{e}"
+    );
+    assert!(!dir.path().join("big/series.csv").exists());
+}

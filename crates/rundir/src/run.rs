@@ -483,11 +483,21 @@ fn initial_state(source: Box<dyn std::error::Error + Send + Sync>) -> RunError {
 fn scene_diff(own: &str, other: &str) -> String {
     let entries = |s: &str| -> Vec<(String, String)> {
         let mut section = String::new();
+        // The K-th table of an array of tables (`[[population]]`) is `population.K`, as in
+        // `--set`, so that each is compared with its own.
+        let mut counts = std::collections::HashMap::<String, usize>::new();
         s.lines()
             .filter_map(|l| {
                 let l = l.trim();
                 if l.starts_with('[') {
-                    section = l.trim_matches(|c| c == '[' || c == ']').to_string();
+                    let name = l.trim_matches(|c| c == '[' || c == ']').to_string();
+                    section = if l.starts_with("[[") {
+                        let k = counts.entry(name.clone()).or_default();
+                        *k += 1;
+                        format!("{name}.{}", *k - 1)
+                    } else {
+                        name
+                    };
                     return None;
                 }
                 let (k, v) = l.split_once('=')?;
@@ -607,5 +617,25 @@ impl<T: Real> Callback<T> for StopOnSignal {
             obs.request_stop();
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::scene_diff;
+
+    /// Each table of an array of tables is compared with its own: two `[[population]]`
+    /// tables that agree give no difference (the first version compared every
+    /// `population.*` key with the first table's, and refused to resume any run with two
+    /// populations), and a change in the second is named with its index.
+    #[test]
+    fn arrays_of_tables_compare_table_by_table() {
+        let a = "[run]\ntime = 5.0\n\n[[population]]\nname = \"stiff\"\ngamma = 0.05\n\n[[population]]\nname = \"soft\"\ngamma = 0.005\n";
+        assert_eq!(scene_diff(a, &a.replace("time = 5.0", "time = 9.0")), "");
+        let b = a.replace("gamma = 0.005", "gamma = 0.006");
+        assert_eq!(
+            scene_diff(a, &b),
+            "population.1.gamma is 0.006 there, 0.005 here"
+        );
     }
 }

@@ -5,7 +5,7 @@ use mechanics::division::{Proliferation, SplitAxis};
 use mechanics::Tissue;
 use phasefield::Real;
 
-use crate::file::{DivisionAxis, DivisionSpec, SceneFile};
+use crate::file::{DivisionAxis, DivisionSpec, InitKind, SceneFile};
 use crate::validate::{invalid, sig3, SceneError};
 
 /// The most cells `[division] max_cells` may allow without being asked: twice as many as fill
@@ -80,6 +80,25 @@ pub(crate) fn check(spec: &DivisionSpec, file: &SceneFile) -> Result<(), SceneEr
                 f,
                 "the extrusion threshold is a fraction of the target area in [0, 1)",
                 "use 0.2 (a cell is extruded when its area falls below a fifth of πR²), or leave it out for no extrusion",
+            ));
+        }
+    }
+    if let Some(f) = spec.extrusion.filter(|&f| f > 0.0) {
+        // Without a relaxation the clock acts from the first step, on the initial discs.
+        let (r0, r) = (file.init_radius(), file.cells.radius);
+        if file.run.relax_time == 0.0 && file.cells.init != InitKind::Frame && r0 * r0 < f * r * r {
+            return Err(invalid(
+                s,
+                "extrusion",
+                f,
+                format!(
+                    "the initial discs (init_radius {r0}) have about {} of the target area πR² (R = {r}), below the threshold, and with relax_time = 0 they would all be extruded at the first step",
+                    sig3(r0 * r0 / (r * r))
+                ),
+                format!(
+                    "give [run] relax_time > 0 (the clock starts after it; e.g. 100), [cells] init_radius ≥ {}, or a lower extrusion",
+                    sig3(r * f.sqrt() * 1.05)
+                ),
             ));
         }
     }
