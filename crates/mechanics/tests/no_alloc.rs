@@ -77,4 +77,33 @@ fn check_steps() {
             after - before
         );
     }
+    // With a cell-cycle clock (every cell growing, extrusion and deaths checked, no event
+    // due): the clock's work after each step allocates nothing either; only events do.
+    let shape = PatchShape::new(lattice, 12).unwrap();
+    let cells = init::discs(lattice, shape, &centres, 4.0, 2.5);
+    let t = Tissue::new(cells, ModelParams::paper(0.01));
+    let clock = mechanics::division::Proliferation::new(0.0, 1.0, 3, &t)
+        .with_growth_time(1e12)
+        .with_extrusion(0.01)
+        .with_death_rate(1e-12);
+    let mut t = t.with_proliferation(clock);
+    let mut ws = Workspace::new(t.cells());
+    let sp = StepParams::new(0.2, 2);
+    for _ in 0..3 {
+        t.step(&mut ws, &sp).unwrap();
+        t.proliferate(&mut ws);
+    }
+    let before = ALLOCS.load(Ordering::SeqCst);
+    for _ in 0..60 {
+        t.step(&mut ws, &sp).unwrap();
+        let events = t.proliferate(&mut ws);
+        assert!(events.divisions.is_empty() && events.removals.is_empty());
+    }
+    let after = ALLOCS.load(Ordering::SeqCst);
+    assert_eq!(
+        after - before,
+        0,
+        "with a clock: {} allocations in 60 steps",
+        after - before
+    );
 }
