@@ -169,9 +169,12 @@ fn a_colony_grows_resumes_bit_for_bit_and_is_drawn() {
     assert_eq!(owners, living);
 }
 
-/// `--colour generation` on a run without `[division]` is refused with the reason.
+/// A lone cell (`single.toml`, 64²): `analyze` finds no defect in the empty space around it,
+/// where `Q ≈ 0` and its angle is noise (938 were reported there before defects were kept to
+/// the tissue, as `render` draws them), and `--colour generation` on this run without
+/// `[division]` is refused with the reason.
 #[test]
-fn colour_by_generation_needs_a_lineage() {
+fn a_lone_cell_has_no_defects_and_no_lineage() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let o = bin()
@@ -189,6 +192,15 @@ fn colour_by_generation_needs_a_lineage() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
+    let o = bin()
+        .arg("analyze")
+        .arg(&out)
+        .args(["--from", "0"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let defects = std::fs::read_to_string(out.join("analysis/defects.csv")).unwrap();
+    assert_eq!(defects.lines().count(), 1, "{defects}");
     let o = bin()
         .arg("render")
         .arg(&out)

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use analysis::correlation::{first_minimum, Correlator};
 use analysis::crop::CropFields;
 use analysis::crop::{DefectAverage, COMPONENTS};
-use analysis::defects::{detect, net_charge};
+use analysis::defects::net_charge;
 use analysis::fields::{rms, s_rms, vorticity};
 use analysis::smooth::{box_smooth, paper_box_side};
 use analysis::tracking::{TrackParams, Tracker};
@@ -685,10 +685,11 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             let s1: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
             analysis::confinement::uncovered_fraction(&s1, band)
         });
-        let covered: Option<Vec<bool>> = lineage.as_ref().map(|_| {
-            let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
-            phi_sum.iter().map(|&v| v >= 0.5).collect()
-        });
+        let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
+        let phi_sum: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
+        let covered: Option<Vec<bool>> = lineage
+            .as_ref()
+            .map(|_| phi_sum.iter().map(|&v| v >= 0.5).collect());
         let LoadedFrame {
             tissue,
             shapes,
@@ -706,7 +707,10 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         corr[0].add(&[&svx, &svy]);
         corr[1].add(&[&w]);
         corr[2].add(&[&sqxx, &sqxy]);
-        let found = detect(lattice, &sqxx, &sqxy);
+        // Only defects in tissue, as `render` draws them (`view::in_tissue`): in the empty
+        // space of a colony, a wound or a channel's wall `Q ≈ 0` and its angle is noise.
+        let (_, found) = crate::view::in_tissue(lattice, box_side, &phi_sum, &sqxx, &sqxy)
+            .map_err(|e| AnalyzeError::Options(e.to_string()))?;
         let tracks = tracker.push(&found);
         let time = tissue.time();
         for (d, t) in found.iter().zip(&tracks.track) {
