@@ -299,25 +299,9 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
         populations
     } else {
         let of_cell = read_npz(path, &["population"])?.remove(0).data;
-        if of_cell.len() != tissue.next_id()
-            || of_cell
-                .iter()
-                .any(|&k| !(k >= 0.0 && (k as usize) < populations.kinds().len()))
-        {
-            return Err(bad(
-                "population",
-                format!(
-                    "{} entries for {} identities, or an index outside the scene's {} populations",
-                    of_cell.len(),
-                    tissue.next_id(),
-                    populations.kinds().len()
-                ),
-            ));
-        }
-        mechanics::terms::Populations::from_assignment(
-            populations.kinds().to_vec(),
-            of_cell.iter().map(|&k| k as u16).collect(),
-        )
+        populations
+            .reassigned(&of_cell, tissue.next_id())
+            .map_err(|r| bad("population", r))?
     };
     let tissue = tissue
         .with_populations(populations)
@@ -325,17 +309,24 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
     read_terms(path, tissue, true)
 }
 
-/// The lineage of `clock` as the rows of the checkpoint's `lineage` array (and, in words,
-/// of `lineage.csv`).
-pub(crate) fn lineage_rows(clock: &Proliferation) -> Vec<[f64; 9]> {
+/// How the `lineage` array codes why a cell's life ended (0: it lives).
+const ENDING_CODES: [(Ending, f64); 3] = [
+    (Ending::Division, 1.0),
+    (Ending::Extrusion, 2.0),
+    (Ending::Death, 3.0),
+];
+
+/// The lineage of `clock` as the rows of the checkpoint's `lineage` array.
+fn lineage_rows(clock: &Proliferation) -> Vec<[f64; 9]> {
     clock
         .lineage()
         .map(|r| {
             let (death, ending) = match r.death {
                 None => (f64::NAN, 0.0),
-                Some((t, Ending::Division)) => (t, 1.0),
-                Some((t, Ending::Extrusion)) => (t, 2.0),
-                Some((t, Ending::Death)) => (t, 3.0),
+                Some((t, why)) => {
+                    let code = ENDING_CODES.iter().find(|(e, _)| *e == why);
+                    (t, code.expect("every ending has a code").1)
+                }
             };
             [
                 r.id as f64,
@@ -374,13 +365,10 @@ fn read_lineage(path: &Path) -> Result<Vec<LineageRecord>> {
         .chunks_exact(9)
         .map(|r| {
             let whole = |v: f64| v >= 0.0 && v.fract() == 0.0;
-            let ending = match r[4] {
-                0.0 => None,
-                1.0 => Some(Ending::Division),
-                2.0 => Some(Ending::Extrusion),
-                3.0 => Some(Ending::Death),
-                _ => None,
-            };
+            let ending = ENDING_CODES
+                .iter()
+                .find(|(_, code)| *code == r[4])
+                .map(|(e, _)| *e);
             if !(whole(r[0]) && (r[1] == -1.0 || whole(r[1])) && whole(r[5]))
                 || !r[2].is_finite()
                 || !r[6].is_finite()

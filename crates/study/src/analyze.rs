@@ -297,6 +297,29 @@ fn pairs(a: &Array) -> Vec<[f64; 2]> {
     a.data.chunks_exact(2).map(|s| [s[0], s[1]]).collect()
 }
 
+/// The identity of each of the `n` rows of the frame at `path` (its `id`, checked: `n`
+/// increasing whole numbers), or `0..n` for a frame from before format 3.
+pub(crate) fn frame_ids(path: &Path, n: usize) -> Result<Vec<usize>> {
+    match read_npz(path, &["id"]) {
+        Ok(mut a) => {
+            let ids = a.remove(0).data;
+            let increasing = ids.windows(2).all(|w| w[0] < w[1]);
+            if ids.len() != n || !increasing || ids.iter().any(|&v| !(v >= 0.0 && v.fract() == 0.0))
+            {
+                return Err(input(
+                    path,
+                    format!(
+                        "array 'id' must hold {n} increasing cell identities, one per row of phi"
+                    ),
+                ));
+            }
+            Ok(ids.iter().map(|&v| v as usize).collect())
+        }
+        Err(rundir::RunDirError::MissingArray { .. }) => Ok((0..n).collect()),
+        Err(e) => Err(input(path, e.to_string())),
+    }
+}
+
 /// One frame's state, rebuilt as a tissue.
 pub(crate) fn load_frame(
     path: &Path,
@@ -369,24 +392,7 @@ pub(crate) fn load_frame(
             ),
         ));
     }
-    let ids: Vec<usize> = match read_npz(path, &["id"]) {
-        Ok(mut a) => {
-            let ids = a.remove(0).data;
-            let increasing = ids.windows(2).all(|w| w[0] < w[1]);
-            if ids.len() != n || !increasing || ids.iter().any(|&v| !(v >= 0.0 && v.fract() == 0.0))
-            {
-                return Err(input(
-                    path,
-                    format!(
-                        "array 'id' must hold {n} increasing cell identities, one per row of phi"
-                    ),
-                ));
-            }
-            ids.iter().map(|&v| v as usize).collect()
-        }
-        Err(rundir::RunDirError::MissingArray { .. }) => (0..n).collect(),
-        Err(e) => return Err(input(path, e.to_string())),
-    };
+    let ids = frame_ids(path, n)?;
     // The populations by row: the frame's own when cells divide (daughters inherit), else
     // the scene's deal.
     let populations = scene.populations();
@@ -397,20 +403,9 @@ pub(crate) fn load_frame(
             .map_err(|e| input(path, e.to_string()))?
             .remove(0)
             .data;
-        if rows.len() != n
-            || rows
-                .iter()
-                .any(|&k| !(k >= 0.0 && (k as usize) < populations.kinds().len()))
-        {
-            return Err(input(
-                path,
-                format!("array 'population' must hold {n} indices of the scene's populations"),
-            ));
-        }
-        mechanics::terms::Populations::from_assignment(
-            populations.kinds().to_vec(),
-            rows.iter().map(|&k| k as u16).collect(),
-        )
+        populations
+            .reassigned(&rows, n)
+            .map_err(|r| input(path, format!("array 'population': {r}")))?
     };
     for (name, a, len) in [
         ("origin", &origin, 2 * n),
@@ -680,13 +675,13 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     for path in &selected {
         let frame = load_frame(path, &scene, &shape, lattice)?;
         let (demix, polar) = mixing_and_order(&frame, &shape);
-        let gap = wound.as_ref().map_or(f64::NAN, |band| {
-            let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
-            let s1: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
-            analysis::confinement::uncovered_fraction(&s1, band)
-        });
+        // s1 = Σφ_i on the lattice: the tissue mask of the defects, a wound's gap and the
+        // cover of the random points of `cell_events.csv`.
         let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
         let phi_sum: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
+        let gap = wound.as_ref().map_or(f64::NAN, |band| {
+            analysis::confinement::uncovered_fraction(&phi_sum, band)
+        });
         let covered: Option<Vec<bool>> = lineage
             .as_ref()
             .map(|_| phi_sum.iter().map(|&v| v >= 0.5).collect());

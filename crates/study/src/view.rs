@@ -264,11 +264,7 @@ impl Run {
             };
             let a = rundir::read_npz(path, &["centre"]).map_err(err)?;
             let centres: Vec<[f64; 2]> = a[0].data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-            let ids: Vec<usize> = match rundir::read_npz(path, &["id"]) {
-                Ok(a) => a[0].data.iter().map(|&v| v as usize).collect(),
-                Err(rundir::RunDirError::MissingArray { .. }) => (0..centres.len()).collect(),
-                Err(e) => return Err(err(e)),
-            };
+            let ids = crate::analyze::frame_ids(path, centres.len())?;
             for (id, c) in ids.into_iter().zip(centres) {
                 tracks.entry(id).or_default().push(c);
             }

@@ -199,18 +199,7 @@ impl Proliferation {
         tissue: &Tissue<T>,
         start: f64,
     ) -> Self {
-        let mut p = Self {
-            t0,
-            rate,
-            axis: SplitAxis::Long,
-            max_cells: usize::MAX,
-            pressure_gate: None,
-            extrusion: None,
-            death_rate: 0.0,
-            growth_time: 0.0,
-            seed,
-            lineage: Vec::new(),
-        };
+        let mut p = Self::empty(t0, rate, seed);
         let mut ids: Vec<usize> = tissue.cell_ids().to_vec();
         ids.sort_unstable();
         for id in ids {
@@ -240,7 +229,20 @@ impl Proliferation {
         seed: u64,
         records: impl IntoIterator<Item = LineageRecord>,
     ) -> Result<Self, String> {
-        let mut p = Self {
+        let mut p = Self::empty(t0, rate, seed);
+        for r in records {
+            if p.record_of(r.id).is_some() {
+                return Err(format!("cell {} appears twice in the lineage", r.id));
+            }
+            p.record(r);
+        }
+        Ok(p)
+    }
+
+    /// A clock of cycle `T₀ + Exp(1/k)` with the default options and no cell in its
+    /// lineage: what [`Proliferation::starting_at`] and [`Proliferation::restore`] fill.
+    fn empty(t0: f64, rate: f64, seed: u64) -> Self {
+        Self {
             t0,
             rate,
             axis: SplitAxis::Long,
@@ -251,14 +253,7 @@ impl Proliferation {
             growth_time: 0.0,
             seed,
             lineage: Vec::new(),
-        };
-        for r in records {
-            if p.lineage.get(r.id).is_some_and(|o| o.id == r.id) {
-                return Err(format!("cell {} appears twice in the lineage", r.id));
-            }
-            p.record(r);
         }
-        Ok(p)
     }
 
     /// The same clock with the extrusion rule: cells whose area falls below `fraction` of
@@ -294,9 +289,7 @@ impl Proliferation {
         let now = tissue.time();
         for &id in tissue.cell_ids() {
             out[id] = self
-                .lineage
-                .get(id)
-                .filter(|r| r.id == id)
+                .record_of(id)
                 .map_or(1.0, |r| self.target_scale(r, now));
         }
     }
@@ -401,6 +394,12 @@ impl Proliferation {
         self.lineage[r.id] = r;
     }
 
+    /// The lineage record of the cell `id`, if it has one (the lineage is indexed by
+    /// identity, with holes for identities it never saw).
+    fn record_of(&self, id: usize) -> Option<&LineageRecord> {
+        self.lineage.get(id).filter(|r| r.id == id)
+    }
+
     /// Every cell that has lived, by identity.
     pub fn lineage(&self) -> impl Iterator<Item = &LineageRecord> {
         self.lineage.iter().filter(|r| r.id != usize::MAX)
@@ -431,9 +430,8 @@ impl Proliferation {
         let mut due: Vec<(usize, usize)> = (0..tissue.n_cells())
             .map(|slot| (tissue.cell_ids()[slot], slot))
             .filter(|&(id, _)| {
-                self.lineage
-                    .get(id)
-                    .is_some_and(|r| r.id == id && now - r.birth >= r.cycle + self.growth_time)
+                self.record_of(id)
+                    .is_some_and(|r| now - r.birth >= r.cycle + self.growth_time)
                     && skip.binary_search(&id).is_err()
             })
             .collect();
@@ -516,9 +514,8 @@ impl Proliferation {
             .iter()
             .copied()
             .filter(|&id| {
-                self.lineage
-                    .get(id)
-                    .is_some_and(|r| r.id == id && now - r.birth >= self.death_age(r))
+                self.record_of(id)
+                    .is_some_and(|r| now - r.birth >= self.death_age(r))
             })
             .collect();
         dead.sort_unstable();
@@ -548,11 +545,17 @@ impl<T: Real> Tissue<T> {
     /// The same tissue with a cell-cycle clock (and its extrusion rule and death rate), which
     /// [`Tissue::proliferate`] applies.
     pub fn with_proliferation(mut self, clock: Proliferation) -> Self {
-        let mut scale = std::mem::take(&mut self.target_scale);
-        clock.fill_target_scale(&self, &mut scale);
-        self.target_scale = scale;
+        self.set_target_scale(&clock);
         self.proliferation = Some(Box::new(clock));
         self
+    }
+
+    /// Sets each identity's target-area factor from `clock` (the growth phase) at the
+    /// tissue's time.
+    fn set_target_scale(&mut self, clock: &Proliferation) {
+        let mut scale = std::mem::take(&mut self.target_scale);
+        clock.fill_target_scale(self, &mut scale);
+        self.target_scale = scale;
     }
 
     /// The clock and the lineage, if cells divide.
@@ -592,23 +595,8 @@ impl<T: Real> Tissue<T> {
         let mut skip: Vec<usize> = removals.iter().map(|&(id, _)| id).collect();
         skip.sort_unstable();
         let divisions = clock.divide_due_except(self, ws, &skip);
-        let now = self.time();
-        removals.retain(|&(id, why)| {
-            if self.n_cells() == 1 {
-                return false;
-            }
-            let slot = slot_of(self, id);
-            let place = self.centres()[slot];
-            self.remove(slot);
-            clock.removed(id, now, place, why);
-            true
-        });
-        if !removals.is_empty() {
-            ws.fit(self.cells());
-        }
-        let mut scale = std::mem::take(&mut self.target_scale);
-        clock.fill_target_scale(self, &mut scale);
-        self.target_scale = scale;
+        let removals = remove_cells(self, ws, removals, Some(&mut clock));
+        self.set_target_scale(&clock);
         self.proliferation = Some(clock);
         CellEvents {
             divisions,
@@ -661,26 +649,44 @@ pub fn remove_extruded<T: Real>(
     tissue: &mut Tissue<T>,
     ws: &mut Workspace<T>,
     fraction: f64,
-    mut lineage: Option<&mut Proliferation>,
+    lineage: Option<&mut Proliferation>,
 ) -> Vec<usize> {
-    let small = extruded(tissue, ws, fraction);
-    let mut out = Vec::new();
-    for id in small {
+    let small = extruded(tissue, ws, fraction)
+        .into_iter()
+        .map(|id| (id, Ending::Extrusion))
+        .collect();
+    remove_cells(tissue, ws, small, lineage)
+        .into_iter()
+        .map(|(id, _)| id)
+        .collect()
+}
+
+/// Removes the cells `ids` in their order, each recorded in `lineage` (when given) as ending
+/// for its reason at the tissue's time and its centre, while more than one cell is left;
+/// fits `ws` when any went. Returns those removed.
+fn remove_cells<T: Real>(
+    tissue: &mut Tissue<T>,
+    ws: &mut Workspace<T>,
+    mut ids: Vec<(usize, Ending)>,
+    mut lineage: Option<&mut Proliferation>,
+) -> Vec<(usize, Ending)> {
+    let now = tissue.time();
+    ids.retain(|&(id, why)| {
         if tissue.n_cells() == 1 {
-            break;
+            return false;
         }
         let slot = slot_of(tissue, id);
         let place = tissue.centres()[slot];
         tissue.remove(slot);
         if let Some(l) = lineage.as_deref_mut() {
-            l.removed(id, tissue.time(), place, Ending::Extrusion);
+            l.removed(id, now, place, why);
         }
-        out.push(id);
-    }
-    if !out.is_empty() {
+        true
+    });
+    if !ids.is_empty() {
         ws.fit(tissue.cells());
     }
-    out
+    ids
 }
 
 /// The cells whose area in the evaluation `ws` is below `fraction` of their target area, in

@@ -239,11 +239,9 @@ fn colony_growth(t_g: f64) {
     }
 }
 
-/// The extrusion rule removes exactly the cells below the area fraction, records their end
-/// in the lineage, and the tissue steps on with the others: three cells, one of them scaled
+/// Three paper cells (R = 8) in a row on 96 × 64, margin 14, the middle one (cell 1) scaled
 /// to a third of its field (an area of a ninth).
-#[test]
-fn cells_below_the_area_fraction_are_removed() {
+fn squeezed_trio() -> Tissue {
     let lattice = Lattice::new(96, 64);
     let shape = PatchShape::new(lattice, 14).unwrap();
     let cells = init::discs(
@@ -258,6 +256,15 @@ fn cells_below_the_area_fraction_are_removed() {
     for v in &mut t.phi_mut()[plen..2 * plen] {
         *v /= 3.0;
     }
+    t
+}
+
+/// The extrusion rule removes exactly the cells below the area fraction, records their end
+/// in the lineage, and the tissue steps on with the others: three cells, one of them scaled
+/// to a third of its field (an area of a ninth).
+#[test]
+fn cells_below_the_area_fraction_are_removed() {
+    let mut t = squeezed_trio();
     let mut ws = Workspace::new(t.cells());
     let mut clock = Proliferation::new(1e9, 1.0, 1, &t);
     t.refresh(&mut ws);
@@ -376,20 +383,7 @@ fn a_simulation_grows_the_colony_of_the_hand_loop() {
 /// ended.
 #[test]
 fn proliferation_decides_before_it_acts() {
-    let lattice = Lattice::new(96, 64);
-    let shape = PatchShape::new(lattice, 14).unwrap();
-    let cells = init::discs(
-        lattice,
-        shape,
-        &[[20.0, 32.0], [48.0, 32.0], [76.0, 32.0]],
-        8.0,
-        2.5,
-    );
-    let mut t = Tissue::new(cells, ModelParams::paper(0.0));
-    let plen = t.cells().patch_len();
-    for v in &mut t.phi_mut()[plen..2 * plen] {
-        *v /= 3.0;
-    }
+    let t = squeezed_trio();
     let record = |id: usize, cycle: f64| LineageRecord {
         id,
         parent: None,

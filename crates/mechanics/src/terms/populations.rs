@@ -133,6 +133,30 @@ impl Populations {
         Self { kinds, of_cell }
     }
 
+    /// The same populations with the assignment `of_cell` as a saved file holds it (one
+    /// population index per cell, as numbers), checked: `n` entries, each a whole index of a
+    /// population that is there.
+    ///
+    /// # Errors
+    /// A message with the count and the number of populations when they do not fit.
+    pub fn reassigned(&self, of_cell: &[f64], n: usize) -> Result<Self, String> {
+        let k = self.kinds.len();
+        if of_cell.len() != n
+            || of_cell
+                .iter()
+                .any(|&v| !(v >= 0.0 && v.fract() == 0.0 && (v as usize) < k))
+        {
+            return Err(format!(
+                "{} entries for {n} cells, or one that is not the index of one of the {k} populations",
+                of_cell.len()
+            ));
+        }
+        Ok(Self::from_assignment(
+            self.kinds.clone(),
+            of_cell.iter().map(|&v| v as u16).collect(),
+        ))
+    }
+
     /// Whether there are none (every cell has the tissue's parameters).
     pub fn is_empty(&self) -> bool {
         self.kinds.is_empty()
