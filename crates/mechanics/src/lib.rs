@@ -54,6 +54,7 @@
 #![deny(missing_docs)]
 
 pub mod adaptive;
+pub mod backend;
 pub mod division;
 pub mod equations;
 mod fields;
@@ -132,5 +133,13 @@ pub enum StepError {
         dt: f64,
         /// The tolerance.
         tolerance: f64,
+    },
+    /// The device of a [`backend::Backend`] failed or cannot run what was asked.
+    #[error("the {backend} backend: {message}")]
+    Backend {
+        /// The backend's name.
+        backend: String,
+        /// What went wrong, with what to do.
+        message: String,
     },
 }

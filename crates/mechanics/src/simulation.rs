@@ -29,6 +29,7 @@ use std::time::{Duration, Instant};
 use phasefield::Real;
 
 use crate::adaptive::{AdaptiveParams, Controller};
+use crate::backend::Backend;
 use crate::fields::TissueFields;
 use crate::observables::Observables;
 use crate::params::StepParams;
@@ -81,6 +82,16 @@ impl Timer {
             schedule,
             next_time: f64::NEG_INFINITY,
             last_wall: Instant::now(),
+        }
+    }
+
+    /// Whether [`Timer::fires`] would fire now (not at the starting state), without
+    /// changing the timer.
+    fn due(&self, iteration: u64, time: f64) -> bool {
+        match self.schedule {
+            Schedule::IterationInterval(n) => iteration.is_multiple_of(n.max(1)),
+            Schedule::TimeInterval(dt) => time >= self.next_time - 1e-9 * dt,
+            Schedule::WallTimeInterval(d) => self.last_wall.elapsed() >= d,
         }
     }
 
@@ -336,6 +347,7 @@ pub struct Simulation<T: Real = f64> {
     fixes: Vec<(String, Timer, Box<dyn Fix<T>>)>,
     sort_scratch: Vec<T>,
     initialized: bool,
+    backend: Option<Box<dyn Backend<T>>>,
 }
 
 impl<T: Real> Simulation<T> {
@@ -363,6 +375,7 @@ impl<T: Real> Simulation<T> {
             fixes: Vec::new(),
             sort_scratch: Vec::new(),
             initialized: false,
+            backend: None,
         }
     }
 
@@ -521,6 +534,21 @@ impl<T: Real> Simulation<T> {
         (self.tissue, self.workspace)
     }
 
+    /// Runs the steps on `backend` (a device, such as the `gpu` crate's) instead of the host.
+    /// The tissue's fields are brought up to date from the device whenever a callback, a
+    /// writer or a fix fires, and at the end of [`Simulation::run`]. The backend steps with
+    /// the fixed step of the simulation's [`StepParams`]; [`Simulation::run`] refuses an
+    /// adaptive simulation. Cells are not re-sorted (the device does not need it).
+    pub fn with_backend(mut self, backend: Box<dyn Backend<T>>) -> Self {
+        self.backend = Some(backend);
+        self
+    }
+
+    /// The backend's name, when the steps run on one.
+    pub fn backend_name(&self) -> Option<&str> {
+        self.backend.as_deref().map(|b| b.name())
+    }
+
     /// The iteration the run stops at, when a stop iteration is set.
     pub fn stop_at_iteration(&self) -> Option<u64> {
         self.stop_iteration
@@ -627,13 +655,69 @@ impl<T: Real> Simulation<T> {
         let start = Instant::now();
         let first = self.tissue.iteration();
         let mut stop = false;
-        let result = self.run_loop(start, &mut stop);
+        if let Some(b) = &mut self.backend {
+            if self.adaptive.is_some() {
+                return Err(StepError::Backend {
+                    backend: b.name().to_string(),
+                    message: "the adaptive step runs on the host only; set [integrator] adaptive = false or backend = \"cpu\"".into(),
+                }
+                .into());
+            }
+            b.upload(&self.tissue)?;
+        }
+        let mut result = self.run_loop(start, &mut stop);
+        if let Some(b) = &mut self.backend {
+            let synced = b.sync(&mut self.tissue);
+            if result.is_ok() {
+                result = synced.map_err(SimulationError::from);
+            }
+        }
         let fin = self.fire(start, Hook::Finalize, &mut stop);
         result.and(fin)?;
         Ok(RunInfo {
             iterations: self.tissue.iteration() - first,
             wall_time: start.elapsed(),
         })
+    }
+
+    /// The fixes, callbacks and writers after a step on a backend: the host's copy of the
+    /// state is brought up to date first when any of them fires, and a fix's change is taken
+    /// back to the device.
+    fn after_device_step(
+        &mut self,
+        start: Instant,
+        stop: &mut bool,
+    ) -> Result<(), SimulationError> {
+        let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
+        let fix_due = self.fixes.iter().any(|(_, t, _)| t.due(iteration, time));
+        let call_due = self
+            .callbacks
+            .iter()
+            .chain(&self.writers)
+            .any(|e| e.timer.due(iteration, time));
+        let Some(backend) = self.backend.as_mut() else {
+            return Ok(());
+        };
+        if fix_due || call_due {
+            backend.sync(&mut self.tissue)?;
+        }
+        if fix_due {
+            for (name, timer, fix) in &mut self.fixes {
+                if timer.fires(iteration, time, false) {
+                    fix.apply(&mut self.tissue)
+                        .map_err(|source| SimulationError::Callback {
+                            name: name.clone(),
+                            iteration,
+                            source,
+                        })?;
+                }
+            }
+            backend.upload(&self.tissue)?;
+        }
+        if call_due {
+            self.fire(start, Hook::Call, stop)?;
+        }
+        Ok(())
     }
 
     fn run_loop(&mut self, start: Instant, stop: &mut bool) -> Result<(), SimulationError> {
@@ -652,6 +736,14 @@ impl<T: Real> Simulation<T> {
         let mut none = ();
         while !*stop && !self.done(start) {
             let it = self.tissue.iteration();
+            if let Some(backend) = &mut self.backend {
+                backend.step(&self.tissue, &self.step_params)?;
+                self.tissue.iteration += 1;
+                self.tissue.time += self.step_params.dt;
+                self.apply_activity();
+                self.after_device_step(start, stop)?;
+                continue;
+            }
             if self.sort_every.is_some_and(|k| it.is_multiple_of(k)) {
                 self.tissue.sort_cells(&mut self.sort_scratch);
             }

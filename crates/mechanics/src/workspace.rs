@@ -179,7 +179,13 @@ impl<T: Real> Workspace<T> {
         }
     }
 
-    /// The per-cell quantities of the last evaluation, by slot.
+    /// The right-hand side `R(φ)` of the last [`crate::Tissue::refresh`] or observation, in
+    /// storage order (every cell's patch, stride `patch_len`).
+    pub fn rhs(&self) -> &[T] {
+        &self.k2
+    }
+
+    /// Per-cell quantities of the last evaluation, by slot.
     pub fn cell_states(&self) -> &[CellState] {
         &self.cell_state
     }

@@ -371,6 +371,25 @@ impl<T: Real> Cells<T> {
         d
     }
 
+    /// Sets every patch's origin, with its values taken to be in logical order (storage
+    /// offset `[0, 0]`): for a state computed elsewhere, whose values the caller then writes
+    /// through [`Cells::phi_mut`].
+    ///
+    /// # Panics
+    /// If `origins` has not one origin per cell on the lattice.
+    pub fn set_logical_origins(&mut self, origins: &[[usize; 2]]) {
+        assert_eq!(origins.len(), self.n_cells, "one origin per cell");
+        for (i, &o) in origins.iter().enumerate() {
+            assert!(
+                o[0] < self.lattice.lx && o[1] < self.lattice.ly,
+                "origin {o:?} off the lattice"
+            );
+            self.map.origin[i] = o;
+            self.map.offset[i] = [0, 0];
+            self.map.refresh_tables(self.lattice, &self.shape, i);
+        }
+    }
+
     /// Rotates the values of cell `cell_idx`'s patch in place so that storage column `a` and
     /// row `b` are the logical ones (storage offset `[0, 0]`), and refreshes its tables. Every
     /// value stays on its lattice node; only where it sits in storage changes. Allocates

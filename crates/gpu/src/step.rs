@@ -1,0 +1,759 @@
+//! The buffers of the GPU step, its pipelines, and the recording of steps.
+
+use std::sync::mpsc;
+
+use bytemuck::{Pod, Zeroable};
+use mechanics::backend::Backend;
+use mechanics::{PressureKind, StepError, StepParams, Tissue};
+use phasefield::{Lattice, PatchShape, Real};
+use wgpu::util::DeviceExt;
+
+use crate::device::{Device, GpuError};
+
+/// Invocations per workgroup (the shader's `WG`).
+const WG: u32 = 256;
+/// Workgroups along one dimension of a dispatch (Vulkan's guaranteed minimum).
+const MAX_GROUPS: u32 = 65_535;
+/// Floats per cell in the cell buffer (the shader's `CELL_STRIDE`).
+const CELL_STRIDE: usize = 12;
+/// Steps recorded before they are submitted.
+const BATCH: usize = 16;
+
+const SOURCE: &str = include_str!("step.wgsl");
+
+/// The WGSL source of the step for patches of `shape` and the pressure form `kind`, with
+/// `cap` cells per bin: the file `step.wgsl` after its constants.
+pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String {
+    let (nx, ny) = (shape.nx as u32, shape.ny as u32);
+    let plen = nx * ny;
+    let margin = shape.margin.unwrap_or(0) as u32;
+    format!(
+        "const NX: u32 = {nx}u;\nconst NY: u32 = {ny}u;\nconst PLEN: u32 = {plen}u;\n\
+         const NPT: u32 = {npt}u;\nconst MARGIN: u32 = {margin}u;\nconst CAP: u32 = {cap}u;\n\
+         const PAPER: u32 = {paper}u;\n{SOURCE}",
+        npt = plen.div_ceil(WG),
+        paper = u32::from(kind == PressureKind::Paper),
+    )
+}
+
+/// One evaluation on the device ([`GpuBackend::evaluate`]).
+#[derive(Debug, Clone)]
+pub struct Evaluation {
+    /// `R(φ)` of every cell, in logical patch order.
+    pub rhs: Vec<f32>,
+    /// Per lattice node (`x * ly + y`): `P`, `s2`, `Q_xx`, `Q_xy`.
+    pub lattice: Vec<[f32; 4]>,
+    /// Per cell, 12 floats: area, `S_xx`, `S_xy`, `φ_min`, `φ_max`, `F_x`, `F_y`, `v_x`,
+    /// `v_y`, and the centre of the last step.
+    pub cells: Vec<f32>,
+}
+
+/// The uniform parameters of the kernels (the shader's `Params`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+struct Params {
+    double_well: f32,
+    gradient: f32,
+    area: f32,
+    inv_target_area: f32,
+    repulsion: f32,
+    zeta: f32,
+    xi: f32,
+    dt: f32,
+    lx: u32,
+    ly: u32,
+    nbx: u32,
+    nby: u32,
+    n_cells: u32,
+    grid_x: u32,
+    bound: f32,
+    pad: u32,
+}
+
+/// What the device holds, in bytes, for a state: for the memory estimate and its refusal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpuMemory {
+    /// One φ array (all cells' patches in f32): the largest binding.
+    pub phi_array: u64,
+    /// Every buffer together.
+    pub total: u64,
+}
+
+impl GpuMemory {
+    /// The device memory of `n_cells` cells on patches of `shape` on `lattice`, stepped with
+    /// `npc` corrector passes.
+    pub fn estimate(lattice: Lattice, shape: &PatchShape, n_cells: usize, npc: usize) -> Self {
+        let n = n_cells as u64;
+        let phi_array = n * shape.len() as u64 * 4;
+        let n_phi = if npc >= 2 { 4 } else { 3 };
+        let (nb, cap) = bins(lattice, shape, n_cells);
+        let total = n_phi * phi_array
+            + n * (CELL_STRIDE as u64 * 4 + 8)
+            + lattice.len() as u64 * 16
+            + u64::from(nb) * (4 + 4 * u64::from(cap))
+            + (lattice.lx + lattice.ly) as u64 * 8;
+        Self { phi_array, total }
+    }
+}
+
+/// The bins of patch origins for the gather: `(number of bins, cells per bin)`. A bin is at
+/// least a patch wide, so the patches over a node have their origins in the node's bin or the
+/// one before it, in each direction.
+fn bins(lattice: Lattice, shape: &PatchShape, n_cells: usize) -> (u32, u32) {
+    let (nbx, nby) = bin_grid(lattice, shape);
+    let nb = nbx * nby;
+    let per_bin = n_cells.div_ceil(nb as usize) as u32;
+    let cap = (8 * per_bin).max(32).min(n_cells.max(1) as u32);
+    (nb, cap)
+}
+
+fn bin_grid(lattice: Lattice, shape: &PatchShape) -> (u32, u32) {
+    (
+        (lattice.lx / shape.nx).max(1) as u32,
+        (lattice.ly / shape.ny).max(1) as u32,
+    )
+}
+
+/// A grid of workgroups for `n` of them: `(x, y)` with `x ≤ 65535`.
+fn grid(n: u32) -> (u32, u32) {
+    let x = n.clamp(1, MAX_GROUPS);
+    (x, n.div_ceil(x).max(1))
+}
+
+struct Pipelines {
+    cell_check: wgpu::ComputePipeline,
+    cell: wgpu::ComputePipeline,
+    bin_clear: wgpu::ComputePipeline,
+    bin_fill: wgpu::ComputePipeline,
+    bin_sort: wgpu::ComputePipeline,
+    lattice: wgpu::ComputePipeline,
+    predict: wgpu::ComputePipeline,
+    correct: wgpu::ComputePipeline,
+    correct_last: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+}
+
+/// The bind groups of one step: which φ array each evaluation reads and writes.
+struct Groups {
+    /// Evaluates `phi`; the predictor into `pred`, `R` into `k1`.
+    predict: wgpu::BindGroup,
+    /// Evaluates `pred` (and `spare`) as the last corrector, into `phi`, re-centred.
+    last: [wgpu::BindGroup; 2],
+    /// Evaluates `pred` (`spare`) as a middle corrector, into `spare` (`pred`).
+    middle: [wgpu::BindGroup; 2],
+}
+
+/// The GPU backend: the state and every buffer of the step on the device, and the steps
+/// recorded since they were last submitted.
+///
+/// Storage and arithmetic are f32 (the CPU default stores f32 and computes in f64): the cost
+/// of the f32 arithmetic against the CPU is measured by the tests and docs/performance.md.
+pub struct GpuBackend {
+    dev: Device,
+    pipelines: Pipelines,
+    groups: Groups,
+    phi: wgpu::Buffer,
+    k1: wgpu::Buffer,
+    lat: wgpu::Buffer,
+    cell: wgpu::Buffer,
+    origin: wgpu::Buffer,
+    status: wgpu::Buffer,
+    params_buf: wgpu::Buffer,
+    lattice: Lattice,
+    shape: PatchShape,
+    n_cells: usize,
+    npc: usize,
+    params: Params,
+    groups_cells: (u32, u32),
+    groups_nodes: (u32, u32),
+    groups_bins: u32,
+    encoder: Option<wgpu::CommandEncoder>,
+    recorded: usize,
+    /// The clock at the last sync or upload, and the size of every step queued since.
+    base: (u64, f64),
+    queued: Vec<f64>,
+}
+
+impl std::fmt::Debug for GpuBackend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuBackend")
+            .field("adapter", &self.dev.describe())
+            .field("n_cells", &self.n_cells)
+            .finish_non_exhaustive()
+    }
+}
+
+impl GpuBackend {
+    /// Opens a device ([`Device::open`]) and builds the backend for `tissue` stepped with
+    /// `step`.
+    ///
+    /// # Errors
+    /// See [`GpuBackend::on`].
+    pub fn new<T: Real>(tissue: &Tissue<T>, step: &StepParams) -> Result<Self, GpuError> {
+        Self::check(tissue, step)?;
+        Self::on(Device::open()?, tissue, step)
+    }
+
+    /// What the GPU backend refuses in a tissue and step, before any device is opened: the
+    /// model's extensions (each named), full-domain storage, and forward Euler.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] or [`GpuError::Setting`].
+    pub fn check<T: Real>(tissue: &Tissue<T>, step: &StepParams) -> Result<(), GpuError> {
+        let ext = tissue.extensions();
+        if !ext.is_empty() {
+            return Err(GpuError::Unsupported(ext.join(", ")));
+        }
+        if tissue.cells().shape().margin.is_none() {
+            return Err(GpuError::Setting(
+                "the GPU backend needs patches: [integrator] margin = 0 (the full-domain reference) runs with backend = \"cpu\"".into(),
+            ));
+        }
+        if step.npc == 0 {
+            return Err(GpuError::Setting(
+                "the GPU backend runs Heun's method, with at least one corrector: set [integrator] npc = 1 (forward Euler, npc = 0, runs with backend = \"cpu\")".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The backend on an open device.
+    ///
+    /// # Errors
+    /// [`GpuError::Unsupported`] or [`GpuError::Setting`] (see [`GpuBackend::check`]);
+    /// [`GpuError::TooLarge`] when a φ array passes the device's largest binding (the
+    /// figures in the message).
+    pub fn on<T: Real>(
+        dev: Device,
+        tissue: &Tissue<T>,
+        step: &StepParams,
+    ) -> Result<Self, GpuError> {
+        Self::check(tissue, step)?;
+        let cells = tissue.cells();
+        let (lattice, shape, n) = (cells.lattice(), cells.shape().clone(), cells.n_cells());
+        let mem = GpuMemory::estimate(lattice, &shape, n, step.npc);
+        if mem.phi_array > dev.max_binding() {
+            return Err(GpuError::TooLarge(format!(
+                "{n} cells on patches of {}×{} need a φ array of {:.2} GB, above the device's largest binding of {:.2} GB ({}); reduce [cells] count or [integrator] margin",
+                shape.nx,
+                shape.ny,
+                mem.phi_array as f64 / 1e9,
+                dev.max_binding() as f64 / 1e9,
+                dev.describe()
+            )));
+        }
+        let (nb, cap) = bins(lattice, &shape, n);
+        let (nbx, nby) = bin_grid(lattice, &shape);
+        let d = &dev.device;
+        let storage = |label: &str, bytes: u64, extra: wgpu::BufferUsages| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | extra,
+                mapped_at_creation: false,
+            })
+        };
+        let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        let phi_bytes = mem.phi_array;
+        let phi = storage("phi", phi_bytes, copy);
+        let pred = storage("pred", phi_bytes, copy);
+        let k1 = storage("k1", phi_bytes, copy);
+        let spare = (step.npc >= 2).then(|| storage("spare", phi_bytes, copy));
+        let dummy = storage("dummy", 16, copy);
+        let cell = storage("cell", (n * CELL_STRIDE * 4) as u64, copy);
+        let origin = storage("origin", (n * 8) as u64, copy);
+        let lat = storage("lattice sums", lattice.len() as u64 * 16, copy);
+        let bin_count = storage("bin counts", u64::from(nb) * 4, copy);
+        let bin_cells = storage("bin cells", u64::from(nb) * u64::from(cap) * 4, copy);
+        let status = storage("status", 16, copy);
+        let tab = |l: usize| {
+            (0..l).map(move |s| {
+                let t = 2.0 * std::f64::consts::PI * s as f64 / l as f64;
+                [t.cos() as f32, t.sin() as f32]
+            })
+        };
+        let trig_values: Vec<[f32; 2]> = tab(lattice.lx).chain(tab(lattice.ly)).collect();
+        let trig = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("trig"),
+            contents: bytemuck::cast_slice(&trig_values),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let groups_cells = grid(n as u32);
+        let params = Params {
+            double_well: 0.0,
+            gradient: 0.0,
+            area: 0.0,
+            inv_target_area: 0.0,
+            repulsion: 0.0,
+            zeta: 0.0,
+            xi: 1.0,
+            dt: 0.0,
+            lx: lattice.lx as u32,
+            ly: lattice.ly as u32,
+            nbx,
+            nby,
+            n_cells: n as u32,
+            grid_x: groups_cells.0,
+            bound: mechanics::PHI_BOUND as f32,
+            pad: 0,
+        };
+        let params_buf = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<Params>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+
+        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("step.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(
+                shader_source(&shape, tissue.params().pressure, cap).into(),
+            ),
+        });
+        let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }];
+        for b in 1..=11 {
+            entries.push(storage_entry(b, b == 1 || b == 10));
+        }
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("step"),
+            entries: &entries,
+        });
+        let pipeline_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("step"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry: &str, constants: &[(&str, f64)]| {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..Default::default()
+                },
+                cache: None,
+            })
+        };
+        let pipelines = Pipelines {
+            cell_check: pipeline("cell_sums", &[("CHECK", 1.0)]),
+            cell: pipeline("cell_sums", &[("CHECK", 0.0)]),
+            bin_clear: pipeline("bin_clear", &[]),
+            bin_fill: pipeline("bin_fill", &[]),
+            bin_sort: pipeline("bin_sort", &[]),
+            lattice: pipeline("lattice_sums", &[]),
+            predict: pipeline("force_update", &[("MODE", 0.0)]),
+            correct: pipeline("force_update", &[("MODE", 1.0)]),
+            correct_last: pipeline("force_update", &[("MODE", 2.0)]),
+            count: pipeline("count_step", &[]),
+        };
+        let group = |x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
+            let bufs: [&wgpu::Buffer; 12] = [
+                &params_buf,
+                x,
+                old,
+                &k1,
+                out,
+                &cell,
+                &origin,
+                &lat,
+                &bin_count,
+                &bin_cells,
+                &trig,
+                &status,
+            ];
+            let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
+                .iter()
+                .enumerate()
+                .map(|(b, buf)| wgpu::BindGroupEntry {
+                    binding: b as u32,
+                    resource: buf.as_entire_binding(),
+                })
+                .collect();
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &layout,
+                entries: &entries,
+            })
+        };
+        let spare_ref = spare.as_ref().unwrap_or(&dummy);
+        let groups = Groups {
+            predict: group(&phi, &dummy, &pred),
+            last: [group(&pred, &phi, &dummy), group(spare_ref, &phi, &dummy)],
+            middle: [group(&pred, &phi, spare_ref), group(spare_ref, &phi, &pred)],
+        };
+        let nodes = (lattice.len() as u32).div_ceil(WG);
+        let mut backend = Self {
+            pipelines,
+            groups,
+            phi,
+            k1,
+            lat,
+            cell,
+            origin,
+            status,
+            params_buf,
+            lattice,
+            shape,
+            n_cells: n,
+            npc: step.npc,
+            params,
+            groups_cells,
+            groups_nodes: grid(nodes),
+            groups_bins: nb.div_ceil(WG),
+            encoder: None,
+            recorded: 0,
+            base: (tissue.iteration(), tissue.time()),
+            queued: Vec::new(),
+            dev,
+        };
+        backend.upload_state(tissue)?;
+        Ok(backend)
+    }
+
+    /// The adapter, described.
+    pub fn adapter(&self) -> String {
+        self.dev.describe()
+    }
+
+    fn params_of<T: Real>(&self, tissue: &Tissue<T>, dt: f64) -> Params {
+        let p = tissue.params();
+        let c = p.energy.coefficients();
+        Params {
+            double_well: c.double_well as f32,
+            gradient: c.gradient as f32,
+            area: c.area as f32,
+            inv_target_area: c.inv_target_area as f32,
+            repulsion: c.repulsion as f32,
+            zeta: p.zeta as f32,
+            xi: p.xi as f32,
+            dt: dt as f32,
+            ..self.params
+        }
+    }
+
+    fn upload_state<T: Real>(&mut self, tissue: &Tissue<T>) -> Result<(), GpuError> {
+        let cells = tissue.cells();
+        if cells.n_cells() != self.n_cells || cells.shape().len() != self.shape.len() {
+            return Err(GpuError::Setting(format!(
+                "the backend was built for {} cells, and the tissue has {}: build a new backend",
+                self.n_cells,
+                cells.n_cells()
+            )));
+        }
+        let plen = self.shape.len();
+        let mut values = vec![0.0f32; self.n_cells * plen];
+        let mut patch = vec![0.0f64; plen];
+        for (i, out) in values.chunks_exact_mut(plen).enumerate() {
+            cells.unrolled_into(i, &mut patch);
+            for (o, &v) in out.iter_mut().zip(&patch) {
+                *o = v as f32;
+            }
+        }
+        let origins: Vec<[u32; 2]> = cells
+            .map()
+            .origin
+            .iter()
+            .map(|o| [o[0] as u32, o[1] as u32])
+            .collect();
+        let q = &self.dev.queue;
+        q.write_buffer(&self.phi, 0, bytemuck::cast_slice(&values));
+        q.write_buffer(&self.origin, 0, bytemuck::cast_slice(&origins));
+        q.write_buffer(&self.status, 0, bytemuck::cast_slice(&[0u32; 4]));
+        self.params = self.params_of(tissue, f64::from(self.params.dt));
+        q.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
+        self.base = (tissue.iteration(), tissue.time());
+        self.queued.clear();
+        Ok(())
+    }
+
+    /// Submits the steps recorded so far.
+    fn flush(&mut self) {
+        if let Some(enc) = self.encoder.take() {
+            self.dev.queue.submit(Some(enc.finish()));
+            self.recorded = 0;
+        }
+    }
+
+    /// Records one step into the pending command encoder.
+    fn record(&mut self) {
+        self.record_passes(false);
+    }
+
+    /// One evaluation of the current state, as a step's first (with its check), without
+    /// stepping: `R(φ)`, the lattice sums and the per-cell quantities, read back.
+    ///
+    /// # Errors
+    /// [`GpuError::Lost`].
+    pub fn evaluate<T: Real>(
+        &mut self,
+        tissue: &Tissue<T>,
+        dt: f64,
+    ) -> Result<Evaluation, GpuError> {
+        self.flush();
+        let want = self.params_of(tissue, dt);
+        if want != self.params {
+            self.params = want;
+            self.dev
+                .queue
+                .write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
+        }
+        self.record_passes(true);
+        self.flush();
+        let plen = self.shape.len();
+        let rhs = self.read(&self.k1, (self.n_cells * plen * 4) as u64)?;
+        let lat = self.read(&self.lat, self.lattice.len() as u64 * 16)?;
+        Ok(Evaluation {
+            rhs: bytemuck::cast_slice(&rhs).to_vec(),
+            lattice: bytemuck::cast_slice(&lat).to_vec(),
+            cells: self.cell_quantities()?,
+        })
+    }
+
+    fn record_passes(&mut self, evaluate_only: bool) {
+        let enc = self.encoder.get_or_insert_with(|| {
+            self.dev
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("steps"),
+                })
+        });
+        let p = &self.pipelines;
+        let g = &self.groups;
+        let (cx, cy) = self.groups_cells;
+        let (nx, ny) = self.groups_nodes;
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("step"),
+            timestamp_writes: None,
+        });
+        // The bins of this step's patch origins.
+        pass.set_bind_group(0, &g.predict, &[]);
+        pass.set_pipeline(&p.bin_clear);
+        pass.dispatch_workgroups(self.groups_bins, 1, 1);
+        pass.set_pipeline(&p.bin_fill);
+        pass.dispatch_workgroups((self.n_cells as u32).div_ceil(WG), 1, 1);
+        pass.set_pipeline(&p.bin_sort);
+        pass.dispatch_workgroups(self.groups_bins, 1, 1);
+        // k1 = R(φ) with the check, and the predictor.
+        let passes = if evaluate_only { 0 } else { self.npc };
+        for (cell, group, force) in std::iter::once((&p.cell_check, &g.predict, &p.predict)).chain(
+            (0..passes).map(|pass| {
+                let last = pass + 1 == self.npc;
+                let group = if last {
+                    &g.last[pass % 2]
+                } else {
+                    &g.middle[pass % 2]
+                };
+                let force = if last { &p.correct_last } else { &p.correct };
+                (&p.cell, group, force)
+            }),
+        ) {
+            pass.set_bind_group(0, group, &[]);
+            pass.set_pipeline(cell);
+            pass.dispatch_workgroups(cx, cy, 1);
+            pass.set_pipeline(&p.lattice);
+            pass.dispatch_workgroups(nx, ny, 1);
+            pass.set_pipeline(force);
+            pass.dispatch_workgroups(cx, cy, 1);
+        }
+        if !evaluate_only {
+            pass.set_pipeline(&p.count);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        drop(pass);
+        self.recorded += 1;
+    }
+
+    /// Copies `bytes` of `buffer` to the host.
+    fn read(&self, buffer: &wgpu::Buffer, bytes: u64) -> Result<Vec<u8>, GpuError> {
+        let d = &self.dev.device;
+        let staging = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: bytes.max(16),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        self.dev.queue.submit(Some(enc.finish()));
+        let (tx, rx) = mpsc::channel();
+        staging
+            .slice(..bytes)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                let _ = tx.send(r);
+            });
+        d.poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| GpuError::Lost(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| GpuError::Lost(e.to_string()))?
+            .map_err(|e| GpuError::Lost(e.to_string()))?;
+        let data = staging
+            .slice(..bytes)
+            .get_mapped_range()
+            .map_err(|e| GpuError::Lost(e.to_string()))?
+            .to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// The per-cell quantities of the last evaluation, per slot: area, `S_xx`, `S_xy`,
+    /// `φ_min`, `φ_max`, `F`, `v` and the centre (12 floats each, the last unused).
+    ///
+    /// # Errors
+    /// [`GpuError::Lost`].
+    pub fn cell_quantities(&mut self) -> Result<Vec<f32>, GpuError> {
+        self.flush();
+        let bytes = self.read(&self.cell, (self.n_cells * CELL_STRIDE * 4) as u64)?;
+        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    }
+
+    /// The state on the device: every cell's field in logical patch order and the patches'
+    /// origins.
+    ///
+    /// # Errors
+    /// [`GpuError::Lost`].
+    pub fn state(&mut self) -> Result<(Vec<f32>, Vec<[usize; 2]>), GpuError> {
+        self.flush();
+        let phi = self.read(&self.phi, (self.n_cells * self.shape.len() * 4) as u64)?;
+        let origin = self.read(&self.origin, (self.n_cells * 8) as u64)?;
+        let origin: &[[u32; 2]] = bytemuck::cast_slice(&origin);
+        Ok((
+            bytemuck::cast_slice(&phi).to_vec(),
+            origin
+                .iter()
+                .map(|o| [o[0] as usize, o[1] as usize])
+                .collect(),
+        ))
+    }
+
+    fn error(message: String) -> StepError {
+        StepError::Backend {
+            backend: "gpu".into(),
+            message,
+        }
+    }
+}
+
+impl<T: Real> Backend<T> for GpuBackend {
+    fn name(&self) -> &str {
+        "gpu"
+    }
+
+    fn step(&mut self, tissue: &Tissue<T>, params: &StepParams) -> Result<(), StepError> {
+        if params.npc != self.npc {
+            return Err(Self::error(format!(
+                "the backend was built for {} corrector passes, and the step asks for {}",
+                self.npc, params.npc
+            )));
+        }
+        let want = self.params_of(tissue, params.dt);
+        if want != self.params {
+            // A change (the activity switch) applies from this step on: the steps recorded
+            // before it go first.
+            self.flush();
+            self.params = want;
+            self.dev
+                .queue
+                .write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
+        }
+        self.record();
+        self.queued.push(params.dt);
+        if self.recorded >= BATCH {
+            self.flush();
+        }
+        Ok(())
+    }
+
+    fn sync(&mut self, tissue: &mut Tissue<T>) -> Result<(), StepError> {
+        self.flush();
+        let status = self
+            .read(&self.status, 16)
+            .map_err(|e| Self::error(e.to_string()))?;
+        let status: [u32; 4] = bytemuck::pod_read_unaligned(&status);
+        let [failed, overflow, steps, cell] = status;
+        let (phi, origins) = self.state().map_err(|e| Self::error(e.to_string()))?;
+        let quantities = self
+            .cell_quantities()
+            .map_err(|e| Self::error(e.to_string()))?;
+        let centres: Vec<[f64; 2]> = if steps > 0 {
+            quantities
+                .chunks_exact(CELL_STRIDE)
+                .map(|c| [f64::from(c[9]), f64::from(c[10])])
+                .collect()
+        } else {
+            tissue.centres().to_vec()
+        };
+        tissue.set_state_from_device(&phi, &origins, &centres);
+        let done = steps as usize;
+        let time = self.base.1 + self.queued.iter().take(done).sum::<f64>();
+        let iteration = self.base.0 + done as u64;
+        let dt = self.queued.get(done).copied().unwrap_or(0.0);
+        self.queue_reset();
+        self.base = (iteration, time);
+        if overflow != 0 {
+            tissue.set_clock(iteration, time);
+            return Err(Self::error(format!(
+                "more cells than a bin of the gather holds ({} per bin) met in one place; the cells are far denser than a confluent tissue: check the initial state",
+                bins(self.lattice, &self.shape, self.n_cells).1
+            )));
+        }
+        if failed != 0 {
+            tissue.set_clock(iteration, time);
+            let slot = cell as usize;
+            let q = &quantities[slot * CELL_STRIDE..(slot + 1) * CELL_STRIDE];
+            let (lo, hi) = (f64::from(q[3]), f64::from(q[4]));
+            return Err(if failed == 2 {
+                StepError::NonFinite {
+                    step: iteration,
+                    time,
+                    cell_idx: slot,
+                }
+            } else {
+                StepError::Unstable {
+                    step: iteration,
+                    time,
+                    cell_idx: slot,
+                    phi: if lo < -mechanics::PHI_BOUND { lo } else { hi },
+                    dt,
+                }
+            });
+        }
+        Ok(())
+    }
+
+    fn upload(&mut self, tissue: &Tissue<T>) -> Result<(), StepError> {
+        self.flush();
+        self.upload_state(tissue)
+            .map_err(|e| Self::error(e.to_string()))
+    }
+}
+
+impl GpuBackend {
+    /// Clears the step counter and the queue after a sync.
+    fn queue_reset(&mut self) {
+        self.queued.clear();
+        self.dev
+            .queue
+            .write_buffer(&self.status, 8, bytemuck::cast_slice(&[0u32]));
+    }
+}

@@ -1,0 +1,530 @@
+// The paper's time step (docs/model.md §2–5) as WGSL compute kernels: one workgroup per cell
+// for the per-cell passes, one invocation per lattice node for the lattice sums.
+//
+// The host prepends the constants NX, NY, PLEN (= NX * NY), NPT (nodes per invocation,
+// ceil(PLEN / WG)), MARGIN, CAP (cells per bin) and PAPER (1 for the paper pressure form,
+// 0 for the interaction form).
+//
+// Every equation is one function below with the name of its Rust reference in
+// `mechanics::equations` or `phasefield::EnergyCoefficients`; the tests check each against it.
+// Arithmetic is f32. Every sum has a fixed order: per-cell sums are a tree over the
+// workgroup's fixed partial sums, lattice sums add the covering cells bin by bin in a fixed
+// bin order and, inside a bin, in increasing slot order. No float atomics anywhere.
+
+const WG: u32 = 256u;
+const TAU: f32 = 6.283185307179586;
+
+struct Params {
+    // EnergyCoefficients: 8γ/λ, 2γλ, 4μ/πR², 1/πR², 2κ/λ.
+    double_well: f32,
+    gradient: f32,
+    area: f32,
+    inv_target_area: f32,
+    repulsion: f32,
+    zeta: f32,
+    xi: f32,
+    dt: f32,
+    lx: u32,
+    ly: u32,
+    nbx: u32,
+    nby: u32,
+    n_cells: u32,
+    grid_x: u32,
+    bound: f32,
+    _pad: u32,
+}
+
+struct Status {
+    failed: atomic<u32>,
+    overflow: atomic<u32>,
+    steps: atomic<u32>,
+    cell: atomic<u32>,
+}
+
+@group(0) @binding(0) var<uniform> prm: Params;
+// The state evaluated (φ in the passes' sense): read only.
+@group(0) @binding(1) var<storage, read> x_phi: array<f32>;
+// φ_old of the step (the correctors read it; the last writes the new state there).
+@group(0) @binding(2) var<storage, read_write> old_phi: array<f32>;
+// R(φ) of the first evaluation.
+@group(0) @binding(3) var<storage, read_write> k1: array<f32>;
+// The predictor's or a middle corrector's output.
+@group(0) @binding(4) var<storage, read_write> out_phi: array<f32>;
+// Per cell, 12 floats: area, S_xx, S_xy, φ_min, φ_max, F_x, F_y, v_x, v_y, centre x, y, 0.
+@group(0) @binding(5) var<storage, read_write> cell: array<f32>;
+// Per cell: the lattice origin of its patch (x, y).
+@group(0) @binding(6) var<storage, read_write> origin: array<vec2<u32>>;
+// Per node (x * ly + y): P, s2, Q_xx, Q_xy.
+@group(0) @binding(7) var<storage, read_write> lat: array<vec4<f32>>;
+// Per bin: the number of cells whose origin lies in it.
+@group(0) @binding(8) var<storage, read_write> bin_count: array<atomic<u32>>;
+// Per bin: CAP slots of cell indices, sorted.
+@group(0) @binding(9) var<storage, read_write> bin_cells: array<u32>;
+// cos, sin of 2π x/lx (lx of each), then of 2π y/ly (ly of each).
+@group(0) @binding(10) var<storage, read> trig: array<vec2<f32>>;
+@group(0) @binding(11) var<storage, read_write> status: Status;
+
+var<workgroup> red: array<vec4<f32>, WG>;
+var<workgroup> shared_v: vec4<f32>;
+var<workgroup> shared_shift: vec2<i32>;
+var<workgroup> wg_halt: u32;
+
+// Which update the force pass ends with: 0 the predictor (k1 and φ*), 1 a middle corrector,
+// 2 the last corrector with the centres and the re-centred patches.
+override MODE: u32 = 0u;
+// Whether the cell pass checks the state (the first evaluation of a step).
+override CHECK: u32 = 0u;
+
+const CELL_STRIDE: u32 = 12u;
+
+// ---- the equations ----
+
+// phasefield::EnergyCoefficients::area_factor
+fn area_factor(area: f32) -> f32 {
+    return -prm.area * (1.0 - area * prm.inv_target_area);
+}
+
+// phasefield::EnergyCoefficients::free_energy_derivative
+fn free_energy_derivative(phi: f32, lap: f32, af: f32, others_sq: f32) -> f32 {
+    let ch = prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi) - prm.gradient * lap;
+    return ch + af * phi + prm.repulsion * phi * others_sq;
+}
+
+// mechanics::equations::shape_tensor_density
+fn shape_tensor_density(grad: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(0.5 * (grad.y * grad.y - grad.x * grad.x), -(grad.x * grad.y));
+}
+
+// mechanics::equations::pressure_cell_part
+fn pressure_cell_part(phi: f32, lap: f32, af: f32) -> f32 {
+    if (PAPER == 1u) {
+        return -prm.repulsion * (phi * phi) * phi
+            - prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
+            + prm.gradient * lap - af * phi;
+    }
+    return -prm.repulsion * (phi * phi) * (phi * phi);
+}
+
+// mechanics::equations::pressure
+fn pressure(s1: f32, s2: f32, u: f32) -> f32 {
+    if (PAPER == 1u) {
+        return prm.repulsion * s1 * s2 + u;
+    }
+    return prm.repulsion * s2 * s2 + u;
+}
+
+// The same pressure regrouped for f32: the repulsion's cross term from the sums,
+// (2κ/λ)(s1 s2 − s3) (paper) or (2κ/λ)(s2² − s4) (interaction), which is exactly zero where one
+// cell is alone, and `own = Σ_i pressure_own_part`. In f32 the form of `pressure`, whose two
+// repulsion terms cancel where one cell is alone, is off by about 1e-6 of the largest P.
+fn pressure_regrouped(s1: f32, s2: f32, s3: f32, s4: f32, own: f32) -> f32 {
+    if (PAPER == 1u) {
+        return prm.repulsion * (s1 * s2 - s3) + own;
+    }
+    return prm.repulsion * (s2 * s2 - s4) + own;
+}
+
+// `pressure_cell_part` less its repulsion term −(2κ/λ)φ³ (paper) or −(2κ/λ)φ⁴ (interaction).
+fn pressure_own_part(phi: f32, lap: f32, af: f32) -> f32 {
+    if (PAPER == 1u) {
+        return -prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
+            + prm.gradient * lap - af * phi;
+    }
+    return 0.0;
+}
+
+// mechanics::equations::pressure_self_part
+fn pressure_self_part(phi: f32) -> f32 {
+    if (PAPER == 1u) {
+        return -(prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi));
+    }
+    return 0.0;
+}
+
+// mechanics::equations::force_density
+fn force_density(p_cell: f32, zeta: f32, q: vec2<f32>, grad: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(
+        p_cell * grad.x + zeta * (q.x * grad.x + q.y * grad.y),
+        p_cell * grad.y + zeta * (q.y * grad.x - q.x * grad.y),
+    );
+}
+
+// mechanics::equations::velocity
+fn velocity(force: vec2<f32>, xi: f32) -> vec2<f32> {
+    return force / xi;
+}
+
+// mechanics::equations::rhs
+fn rhs(v: vec2<f32>, grad: vec2<f32>, dfdphi: f32) -> f32 {
+    return -v.x * grad.x - v.y * grad.y - dfdphi;
+}
+
+// mechanics::equations::heun_predictor
+fn heun_predictor(phi_old: f32, dt: f32, r_old: f32) -> f32 {
+    return phi_old + dt * r_old;
+}
+
+// mechanics::equations::heun_corrector
+fn heun_corrector(phi_old: f32, dt: f32, r_old: f32, r_new: f32) -> f32 {
+    return phi_old + 0.5 * dt * (r_old + r_new);
+}
+
+// ---- the stencil on a cell's periodic patch (logical order, index a * NY + b) ----
+
+struct Stencil {
+    c: f32,
+    xm: f32,
+    xp: f32,
+    ym: f32,
+    yp: f32,
+}
+
+fn stencil(base: u32, a: u32, b: u32) -> Stencil {
+    let am = select(a - 1u, NX - 1u, a == 0u);
+    let ap = select(a + 1u, 0u, a + 1u == NX);
+    let bm = select(b - 1u, NY - 1u, b == 0u);
+    let bp = select(b + 1u, 0u, b + 1u == NY);
+    var s: Stencil;
+    s.c = x_phi[base + a * NY + b];
+    s.xm = x_phi[base + am * NY + b];
+    s.xp = x_phi[base + ap * NY + b];
+    s.ym = x_phi[base + a * NY + bm];
+    s.yp = x_phi[base + a * NY + bp];
+    return s;
+}
+
+// The five-point Laplacian as a sum of differences, each exact in f32 where the neighbours are
+// within a factor 2 of the centre (Sterbenz): its rounding error is that of a small result,
+// where `xm + xp + ym + yp − 4c` loses the digits of values near 1.
+fn laplacian(s: Stencil) -> f32 {
+    return ((s.xm - s.c) + (s.xp - s.c)) + ((s.ym - s.c) + (s.yp - s.c));
+}
+
+fn gradient(s: Stencil) -> vec2<f32> {
+    return 0.5 * vec2<f32>(s.xp - s.xm, s.yp - s.ym);
+}
+
+// ---- helpers ----
+
+fn cell_index(wid: vec3<u32>) -> u32 {
+    return wid.x + wid.y * prm.grid_x;
+}
+
+fn halted() -> bool {
+    return atomicLoad(&status.failed) != 0u;
+}
+
+// `halted`, the same for every invocation of a workgroup (so that barriers stay uniform).
+fn halted_uniform(lid: u32) -> bool {
+    if (lid == 0u) {
+        wg_halt = select(0u, 1u, halted());
+    }
+    return workgroupUniformLoad(&wg_halt) != 0u;
+}
+
+// A fixed tree over the workgroup's partial sums: the same order on every run.
+fn reduce(lid: u32, v: vec4<f32>) -> vec4<f32> {
+    red[lid] = v;
+    workgroupBarrier();
+    var s = WG / 2u;
+    loop {
+        if (s == 0u) {
+            break;
+        }
+        if (lid < s) {
+            red[lid] = red[lid] + red[lid + s];
+        }
+        workgroupBarrier();
+        s = s / 2u;
+    }
+    let r = red[0];
+    workgroupBarrier();
+    return r;
+}
+
+fn bin_of(o: vec2<u32>) -> u32 {
+    let bx = o.x * prm.nbx / prm.lx;
+    let by = o.y * prm.nby / prm.ly;
+    return bx * prm.nby + by;
+}
+
+// ---- pass 1: per cell, area, deformation tensor, range, and the check ----
+
+@compute @workgroup_size(256)
+fn cell_sums(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid3: vec3<u32>) {
+    let i = cell_index(wid);
+    let lid = lid3.x;
+    if (i >= prm.n_cells || halted_uniform(lid)) {
+        return;
+    }
+    let base = i * PLEN;
+    var acc = vec4<f32>(0.0);
+    var lo = 3.0e38;
+    var hi = -3.0e38;
+    var bad = false;
+    for (var k = lid; k < PLEN; k += WG) {
+        let a = k / NY;
+        let b = k % NY;
+        let s = stencil(base, a, b);
+        let sh = shape_tensor_density(gradient(s));
+        acc += vec4<f32>(s.c * s.c, sh.x, sh.y, 0.0);
+        lo = min(lo, s.c);
+        hi = max(hi, s.c);
+        // NaN and ±∞ fail this test.
+        if (!(abs(s.c) <= 3.0e38)) {
+            bad = true;
+        }
+    }
+    let total = reduce(lid, acc);
+    // The range: a second tree, with max in the place of +.
+    red[lid] = vec4<f32>(-lo, hi, select(0.0, 1.0, bad), 0.0);
+    workgroupBarrier();
+    var s = WG / 2u;
+    loop {
+        if (s == 0u) {
+            break;
+        }
+        if (lid < s) {
+            red[lid] = max(red[lid], red[lid + s]);
+        }
+        workgroupBarrier();
+        s = s / 2u;
+    }
+    if (lid == 0u) {
+        let m = red[0];
+        let c = i * CELL_STRIDE;
+        cell[c + 0u] = total.x;
+        cell[c + 1u] = total.y;
+        cell[c + 2u] = total.z;
+        cell[c + 3u] = -m.x;
+        cell[c + 4u] = m.y;
+        if (CHECK == 1u) {
+            let finite = m.z == 0.0 && abs(total.x) <= 3.0e38;
+            if (!finite || -m.x < -prm.bound || m.y > 1.0 + prm.bound) {
+                if (atomicMax(&status.failed, select(2u, 1u, finite)) == 0u) {
+                    atomicStore(&status.cell, i);
+                }
+            }
+        }
+    }
+}
+
+// ---- bins of patch origins, for the gather ----
+
+@compute @workgroup_size(256)
+fn bin_clear(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let b = gid.x;
+    if (b < prm.nbx * prm.nby) {
+        atomicStore(&bin_count[b], 0u);
+    }
+}
+
+@compute @workgroup_size(256)
+fn bin_fill(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= prm.n_cells || halted()) {
+        return;
+    }
+    let b = bin_of(origin[i]);
+    let slot = atomicAdd(&bin_count[b], 1u);
+    if (slot < CAP) {
+        bin_cells[b * CAP + slot] = i;
+    } else {
+        atomicMax(&status.overflow, 1u);
+    }
+}
+
+// The slots were taken in whatever order the invocations ran: sort each bin's cells, so that
+// the sums add them in increasing index order.
+@compute @workgroup_size(256)
+fn bin_sort(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let b = gid.x;
+    if (b >= prm.nbx * prm.nby || halted()) {
+        return;
+    }
+    let n = min(atomicLoad(&bin_count[b]), CAP);
+    let o = b * CAP;
+    for (var j = 1u; j < n; j++) {
+        let v = bin_cells[o + j];
+        var k = j;
+        loop {
+            if (k == 0u || bin_cells[o + k - 1u] <= v) {
+                break;
+            }
+            bin_cells[o + k] = bin_cells[o + k - 1u];
+            k -= 1u;
+        }
+        bin_cells[o + k] = v;
+    }
+}
+
+// ---- pass 2: the lattice sums and the pressure, gathered node by node ----
+
+@compute @workgroup_size(256)
+fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let node = gid.x + gid.y * nwg.x * WG;
+    if (node >= prm.lx * prm.ly || halted()) {
+        return;
+    }
+    let x = node / prm.ly;
+    let y = node % prm.ly;
+    let bx = x * prm.nbx / prm.lx;
+    let by = y * prm.nby / prm.ly;
+    let nx_b = min(prm.nbx, 2u);
+    let ny_b = min(prm.nby, 2u);
+    var s1 = 0.0;
+    var s2 = 0.0;
+    var s3 = 0.0;
+    var s4 = 0.0;
+    var own = 0.0;
+    var q = vec2<f32>(0.0);
+    for (var dx = 0u; dx < nx_b; dx++) {
+        let cx = (bx + prm.nbx - dx) % prm.nbx;
+        for (var dy = 0u; dy < ny_b; dy++) {
+            let cy = (by + prm.nby - dy) % prm.nby;
+            let b = cx * prm.nby + cy;
+            let n = min(atomicLoad(&bin_count[b]), CAP);
+            for (var j = 0u; j < n; j++) {
+                let i = bin_cells[b * CAP + j];
+                let o = origin[i];
+                let a = (x + prm.lx - o.x) % prm.lx;
+                let bb = (y + prm.ly - o.y) % prm.ly;
+                if (a < NX && bb < NY) {
+                    let st = stencil(i * PLEN, a, bb);
+                    let c = i * CELL_STRIDE;
+                    let af = area_factor(cell[c]);
+                    let sh = vec2<f32>(cell[c + 1u], cell[c + 2u]);
+                    let p = st.c;
+                    let p2 = p * p;
+                    s1 += p;
+                    s2 += p2;
+                    s3 += p2 * p;
+                    s4 += p2 * p2;
+                    own += pressure_own_part(p, laplacian(st), af);
+                    q += p * sh;
+                }
+            }
+        }
+    }
+    lat[node] = vec4<f32>(pressure_regrouped(s1, s2, s3, s4, own), s2, q.x, q.y);
+}
+
+// ---- pass 3: forces, velocities, the right-hand side and the Heun update ----
+
+@compute @workgroup_size(256)
+fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid3: vec3<u32>) {
+    let i = cell_index(wid);
+    let lid = lid3.x;
+    if (i >= prm.n_cells || halted_uniform(lid)) {
+        return;
+    }
+    let base = i * PLEN;
+    let o = origin[i];
+    let c = i * CELL_STRIDE;
+    var fields: array<vec4<f32>, NPT>;
+    var acc = vec4<f32>(0.0);
+    for (var j = 0u; j < NPT; j++) {
+        let k = lid + j * WG;
+        if (k < PLEN) {
+            let a = k / NY;
+            let b = k % NY;
+            let gx = (o.x + a) % prm.lx;
+            let gy = (o.y + b) % prm.ly;
+            let f = lat[gx * prm.ly + gy];
+            fields[j] = f;
+            let s = stencil(base, a, b);
+            let p = f.x - pressure_self_part(s.c);
+            let fd = force_density(p, prm.zeta, f.zw, gradient(s));
+            acc += vec4<f32>(fd, 0.0, 0.0);
+        }
+    }
+    let force = reduce(lid, acc).xy;
+    let v = velocity(force, prm.xi);
+    let af = area_factor(cell[c]);
+    var vals: array<f32, NPT>;
+    var four = vec4<f32>(0.0);
+    for (var j = 0u; j < NPT; j++) {
+        let k = lid + j * WG;
+        if (k < PLEN) {
+            let a = k / NY;
+            let b = k % NY;
+            let s = stencil(base, a, b);
+            let others = fields[j].y - s.c * s.c;
+            let r = rhs(v, gradient(s), free_energy_derivative(s.c, laplacian(s), af, others));
+            let idx = base + k;
+            if (MODE == 0u) {
+                k1[idx] = r;
+                out_phi[idx] = heun_predictor(s.c, prm.dt, r);
+            } else if (MODE == 1u) {
+                out_phi[idx] = heun_corrector(old_phi[idx], prm.dt, k1[idx], r);
+            } else {
+                let n = heun_corrector(old_phi[idx], prm.dt, k1[idx], r);
+                vals[j] = n;
+                let gx = (o.x + a) % prm.lx;
+                let gy = (o.y + b) % prm.ly;
+                let tx = trig[gx];
+                let ty = trig[prm.lx + gy];
+                four += n * vec4<f32>(tx.x, tx.y, ty.x, ty.y);
+            }
+        }
+    }
+    if (lid == 0u) {
+        cell[c + 5u] = force.x;
+        cell[c + 6u] = force.y;
+        cell[c + 7u] = v.x;
+        cell[c + 8u] = v.y;
+    }
+    if (MODE == 2u) {
+        // The centre of mass by Fourier phase (phasefield::ComTable::centre_of_mass), then the
+        // patch re-centred on it (phasefield::Cells::recentre): every value stays on its node.
+        let f = reduce(lid, four);
+        if (lid == 0u) {
+            let lxf = f32(prm.lx);
+            let lyf = f32(prm.ly);
+            var cx = atan2(f.y, f.x) / TAU * lxf;
+            var cy = atan2(f.w, f.z) / TAU * lyf;
+            cx = select(cx, cx + lxf, cx < 0.0);
+            cy = select(cy, cy + lyf, cy < 0.0);
+            cx = select(cx, cx - lxf, cx >= lxf);
+            cy = select(cy, cy - lyf, cy >= lyf);
+            cell[c + 9u] = cx;
+            cell[c + 10u] = cy;
+            let lxi = i32(prm.lx);
+            let lyi = i32(prm.ly);
+            let nox = ((i32(floor(cx + 0.5)) - i32(MARGIN)) % lxi + lxi) % lxi;
+            let noy = ((i32(floor(cy + 0.5)) - i32(MARGIN)) % lyi + lyi) % lyi;
+            // The shift by the nearest image.
+            var dx = (nox - i32(o.x)) % lxi;
+            var dy = (noy - i32(o.y)) % lyi;
+            dx = select(dx, dx + lxi, dx < -lxi / 2);
+            dx = select(dx, dx - lxi, dx > lxi / 2);
+            dy = select(dy, dy + lyi, dy < -lyi / 2);
+            dy = select(dy, dy - lyi, dy > lyi / 2);
+            shared_shift = vec2<i32>(dx, dy);
+            origin[i] = vec2<u32>(u32(nox), u32(noy));
+        }
+        storageBarrier();
+        workgroupBarrier();
+        let d = workgroupUniformLoad(&shared_shift);
+        let nxi = i32(NX);
+        let nyi = i32(NY);
+        for (var j = 0u; j < NPT; j++) {
+            let k = lid + j * WG;
+            if (k < PLEN) {
+                let a = i32(k / NY);
+                let b = i32(k % NY);
+                let na = ((a - d.x) % nxi + nxi) % nxi;
+                let nb = ((b - d.y) % nyi + nyi) % nyi;
+                old_phi[base + u32(na) * NY + u32(nb)] = vals[j];
+            }
+        }
+    }
+}
+
+// One step done: counted unless the check stopped the run.
+@compute @workgroup_size(1)
+fn count_step() {
+    if (!halted()) {
+        atomicAdd(&status.steps, 1u);
+    }
+}

@@ -1,0 +1,149 @@
+//! The GPU step against the CPU step (docs/model.md §2–5), on whichever Vulkan adapter is
+//! present (lavapipe in CI). An adapter is required: without one these tests fail, they do
+//! not skip.
+
+use gpu::GpuBackend;
+use mechanics::prelude::*;
+use mechanics::{CellState, SumField};
+use phasefield::{init, Cells, Lattice, PatchShape, Real};
+
+/// 60 cells on 100² at margin 12, relaxed 40 TU on the CPU: the paper's scene at a stage
+/// where the cells touch and press on each other.
+fn paper_tissue(zeta: f64) -> Tissue<f32> {
+    let lattice = Lattice::new(100, 100);
+    let shape = PatchShape::new(lattice, 12).unwrap();
+    let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 1 }).unwrap();
+    let cells = init::discs(lattice, shape, &centres, 4.0, 2.5).to_precision::<f32>();
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0));
+    let mut ws = Workspace::new(t.cells());
+    for _ in 0..200 {
+        t.step(&mut ws, &StepParams::paper()).unwrap();
+    }
+    t.params_mut().zeta = zeta;
+    t
+}
+
+fn max_abs(v: impl Iterator<Item = f64>) -> f64 {
+    v.fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// Logical-order values of every cell.
+fn logical<T: Real>(cells: &Cells<T>) -> Vec<f64> {
+    let plen = cells.shape().len();
+    let mut out = vec![0.0; cells.n_cells() * plen];
+    for (i, o) in out.chunks_exact_mut(plen).enumerate() {
+        cells.unrolled_into(i, o);
+    }
+    out
+}
+
+#[test]
+fn one_evaluation_agrees_with_the_cpu() {
+    for zeta in [0.0, 0.005] {
+        let tissue = paper_tissue(zeta);
+        let sp = StepParams::paper();
+        let mut gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
+        let ev = gpu.evaluate(&tissue, sp.dt).unwrap();
+        let mut ws = Workspace::new(tissue.cells());
+        tissue.refresh(&mut ws);
+        // R in logical order on the CPU (patches are stored in logical order after a step).
+        assert!(tissue.cells().map().offset.iter().all(|&o| o == [0, 0]));
+        let r_cpu: Vec<f64> = ws.rhs().iter().map(|v| v.to_f64()).collect();
+        let r_gpu: Vec<f64> = ev.rhs.iter().map(|&v| f64::from(v)).collect();
+        let scale = max_abs(r_cpu.iter().copied());
+        let err = max_abs(r_cpu.iter().zip(&r_gpu).map(|(a, b)| a - b));
+        println!("ζ = {zeta}: R: max |Δ| = {err:.3e}, max |R| = {scale:.3e}");
+        assert!(err <= 1e-6 * scale, "R differs by {err:e} (max {scale:e})");
+        for (k, field) in [SumField::P, SumField::S2, SumField::Qxx, SumField::Qxy]
+            .into_iter()
+            .enumerate()
+        {
+            let cpu = ws.sum_field(field);
+            let scale = max_abs(cpu.iter().copied());
+            let err = max_abs(
+                cpu.iter()
+                    .zip(&ev.lattice)
+                    .map(|(a, b)| a - f64::from(b[k])),
+            );
+            println!("ζ = {zeta}: {field:?}: max |Δ| = {err:.3e}, max = {scale:.3e}");
+            assert!(
+                err <= 1e-6 * scale,
+                "{field:?} differs by {err:e} (max {scale:e})"
+            );
+        }
+        let cells = ws.cell_states();
+        let per_cell = |f: &dyn Fn(&CellState) -> f64, k: usize, name: &str| {
+            let scale = max_abs(cells.iter().map(f));
+            let err = max_abs(
+                cells
+                    .iter()
+                    .enumerate()
+                    .map(|(i, c)| f(c) - f64::from(ev.cells[i * 12 + k])),
+            );
+            println!("ζ = {zeta}: {name}: max |Δ| = {err:.3e}, max = {scale:.3e}");
+            assert!(
+                err <= 1e-6 * scale,
+                "{name} differs by {err:e} (max {scale:e})"
+            );
+        };
+        per_cell(&|c| c.area, 0, "area");
+        per_cell(&|c| c.shape.components()[0], 1, "S_xx");
+        per_cell(&|c| c.shape.components()[1], 2, "S_xy");
+        per_cell(&|c| c.force.x, 5, "F_x");
+        per_cell(&|c| c.force.y, 6, "F_y");
+        per_cell(&|c| c.velocity.x, 7, "v_x");
+        per_cell(&|c| c.velocity.y, 8, "v_y");
+    }
+}
+
+/// Steps on both backends from the same state; returns the largest differences of φ (on the
+/// lattice, as each cell's patch values) and of the centres.
+fn steps_agree(zeta: f64, steps: u64) -> (f64, f64) {
+    let tissue = paper_tissue(zeta);
+    let sp = StepParams::paper();
+    let gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
+    let mut on_gpu = Simulation::new(tissue.clone(), sp)
+        .with_backend(Box::new(gpu))
+        .stop_iteration(tissue.iteration() + steps);
+    on_gpu.run().unwrap();
+    let mut cpu = tissue.clone();
+    let mut ws = Workspace::new(cpu.cells());
+    for _ in 0..steps {
+        cpu.step(&mut ws, &sp).unwrap();
+    }
+    let g = on_gpu.tissue();
+    assert_eq!(g.iteration(), cpu.iteration());
+    let lattice = cpu.lattice();
+    let mut dphi: f64 = 0.0;
+    let (mut fa, mut fb) = (vec![0.0; lattice.len()], vec![0.0; lattice.len()]);
+    for i in 0..cpu.n_cells() {
+        fa.fill(0.0);
+        fb.fill(0.0);
+        cpu.cells().add_to_lattice(i, &mut fa);
+        g.cells().add_to_lattice(i, &mut fb);
+        dphi = dphi.max(max_abs(fa.iter().zip(&fb).map(|(a, b)| a - b)));
+    }
+    let dc = max_abs(cpu.centres().iter().zip(g.centres()).flat_map(|(a, b)| {
+        let d = |x: f64, l: usize| {
+            let l = l as f64;
+            x - l * (x / l).round()
+        };
+        [d(a[0] - b[0], lattice.lx), d(a[1] - b[1], lattice.ly)]
+    }));
+    let _ = logical(g.cells());
+    (dphi, dc)
+}
+
+#[test]
+fn a_hundred_passive_steps_agree_with_the_cpu() {
+    let (dphi, dc) = steps_agree(0.0, 100);
+    println!("ζ = 0, 100 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
+    assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
+}
+
+#[test]
+fn twenty_active_steps_agree_with_the_cpu() {
+    let (dphi, dc) = steps_agree(0.005, 20);
+    println!("ζ = 0.005, 20 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
+    assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
+}
