@@ -20,6 +20,7 @@ macro_rules! say {
     }};
 }
 
+pub mod backend;
 pub mod guard;
 pub mod lines;
 pub mod reproduce;

@@ -39,11 +39,12 @@ pub fn run(
     overwrite: bool,
     quiet: bool,
 ) -> Result<RunInfo> {
+    let opened = crate::backend::open(scene)?;
     let dir = RunDir::create(out, scene.clone(), state, overwrite, Interrupt::install()?)?;
     for w in scene.warnings() {
         crate::say!("warning: {w}");
     }
-    drive(&dir, quiet)
+    drive(&dir, opened, quiet)
 }
 
 /// The scene's file paths, `[cells] from` and `[walls] mask`, made absolute, as overrides
@@ -92,7 +93,7 @@ pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Ve
 }
 
 /// Continues the run in `dir` from its latest readable checkpoint to the end of its scene,
-/// with `set` overrides of `run.time` (to extend a finished run). Rows and frames at or
+/// with `set` overrides of `run.time` (to extend a finished run) and `integrator.backend`. Rows and frames at or
 /// after the checkpoint are written again, so the directory ends as one uninterrupted run
 /// would have left it.
 ///
@@ -106,18 +107,23 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<RunInfo> {
             crate::say!("note: skipping {s}");
         }
     }
-    drive(&run, quiet)
+    let opened = crate::backend::open(run.scene())?;
+    drive(&run, opened, quiet)
 }
 
-fn drive(dir: &RunDir, quiet: bool) -> Result<RunInfo> {
+fn drive(dir: &RunDir, opened: crate::backend::Opened, quiet: bool) -> Result<RunInfo> {
+    if let (false, Some(adapter)) = (quiet, opened.describe()) {
+        crate::say!("steps on the GPU: {adapter}");
+    }
     match dir.scene().precision() {
-        Precision::F64 => drive_in::<f64>(dir, quiet),
-        Precision::F32 => drive_in::<f32>(dir, quiet),
+        Precision::F64 => drive_in::<f64>(dir, opened, quiet),
+        Precision::F32 => drive_in::<f32>(dir, opened, quiet),
     }
 }
 
-fn drive_in<T: Real>(dir: &RunDir, quiet: bool) -> Result<RunInfo> {
-    let (mut sim, written) = dir.simulation::<T>()?;
+fn drive_in<T: Real>(dir: &RunDir, opened: crate::backend::Opened, quiet: bool) -> Result<RunInfo> {
+    let (sim, written) = dir.simulation::<T>()?;
+    let mut sim = crate::backend::attach(sim, opened)?;
     let scene = dir.scene();
     sim.add_output_writer(
         "progress",

@@ -92,6 +92,19 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
         Some(p) => format!("in scene {}", p.display()),
         None => format!("in the sweep recorded in {}", a.out.display()),
     })?;
+    if a.action == SweepAction::Local {
+        if let Some(p) = points
+            .iter()
+            .find(|p| p.scene.backend() == scene::ComputeBackend::Gpu)
+        {
+            anyhow::bail!(
+                "sweep point {}: [integrator] backend = \"gpu\": a local sweep runs its points on the CPU, several at a time; \
+                 run GPU points one at a time with `monolayer run SCENE --set integrator.backend=gpu`, \
+                 or write them as a SLURM job array (`--slurm`), whose tasks each run `monolayer run`",
+                p.name
+            );
+        }
+    }
     if a.action != SweepAction::Collect {
         // The saved states the points start from (init = "frame"), each read once and
         // checked against its points before anything runs.

@@ -6,6 +6,7 @@ mod common;
 mod division;
 mod docs;
 mod from_state;
+mod gpu;
 mod signals;
 mod terms;
 mod view;

@@ -83,7 +83,9 @@ impl Device {
 
     /// The largest storage-buffer binding, in bytes.
     pub fn max_binding(&self) -> u64 {
-        self.limits.max_storage_buffer_binding_size.min(self.limits.max_buffer_size)
+        self.limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size)
     }
 
     /// The wgpu device and queue, for tests that run kernels of their own.

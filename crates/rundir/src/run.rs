@@ -92,8 +92,8 @@ pub enum RunError {
         /// The checkpoint's active time.
         time: f64,
     },
-    /// `--resume` with an override other than `run.time`.
-    #[error("--resume continues the run as it was: only --set run.time=T (to extend it) can change; {key} would make it another run (start a new scene instead)")]
+    /// `--resume` with an override other than `run.time` and `integrator.backend`.
+    #[error("--resume continues the run as it was: only --set run.time=T (to extend it) and --set integrator.backend=cpu|gpu (where its steps run) can change; {key} would make it another run (start a new scene instead)")]
     Override {
         /// The key.
         key: String,
@@ -231,7 +231,7 @@ impl RunDir {
     }
 
     /// The run in `dir`, to be continued from its newest readable checkpoint, with `set`
-    /// overrides of `run.time` only (to extend it). A checkpoint whose scene is not the one in
+    /// overrides of `run.time` (to extend it) and `integrator.backend` only. A checkpoint whose scene is not the one in
     /// `dir/scene.toml` (but for `run.time`) is refused; unreadable ones are skipped
     /// ([`RunDir::skipped`] says which and why).
     ///
@@ -240,10 +240,15 @@ impl RunDir {
     /// [`RunError::OtherRun`], [`RunError::Complete`], or the last checkpoint's error when
     /// none can be read.
     pub fn resume(dir: &Path, set: &[String], interrupt: Interrupt) -> Result<Self> {
+        // `run.time` extends a run; `integrator.backend` moves it between CPU and GPU (both
+        // read and write the same checkpoint).
+        let mut extends = false;
         for s in set {
             let key = s.split('=').next().unwrap_or("").trim();
-            if key != "run.time" {
-                return Err(RunError::Override { key: key.into() });
+            match key {
+                "run.time" => extends = true,
+                "integrator.backend" => {}
+                _ => return Err(RunError::Override { key: key.into() }),
             }
         }
         if !dir.is_dir() {
@@ -299,7 +304,7 @@ impl RunDir {
                 ),
                 None => (*step >= total, format!("step {step} of {total}")),
             };
-            if complete && !set.is_empty() {
+            if complete && extends {
                 let end = match scene.adaptive() {
                     Some(_) => format!("t = {}", scene.end_time()),
                     None => format!("step {total}"),
@@ -502,7 +507,8 @@ fn scene_diff(own: &str, other: &str) -> String {
                 }
                 let (k, v) = l.split_once('=')?;
                 let key = format!("{section}.{}", k.trim());
-                (key != "run.time").then(|| (key, v.trim().to_string()))
+                (key != "run.time" && key != "integrator.backend")
+                    .then(|| (key, v.trim().to_string()))
             })
             .collect()
     };

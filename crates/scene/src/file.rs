@@ -147,6 +147,30 @@ pub struct Integrator {
     /// phase, as for a fixed `dt`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dt_max: Option<f64>,
+    /// Where the steps run: `"cpu"` (default) or `"gpu"` (the `gpu` crate: wgpu on any Vulkan
+    /// device; a binary built with `--features gpu`). The GPU runs the paper's minimal model
+    /// with the fixed Heun step (`npc` ≥ 1) on patches (`margin` > 0), in f32 storage and f32
+    /// arithmetic; other settings and the extra physics sections are refused by name.
+    #[serde(skip_serializing_if = "ComputeBackend::is_cpu")]
+    pub backend: ComputeBackend,
+}
+
+/// `[integrator] backend`: where the steps run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ComputeBackend {
+    /// The CPU step of `mechanics` (threads: `--threads`).
+    #[default]
+    Cpu,
+    /// The `gpu` crate's device step.
+    Gpu,
+}
+
+impl ComputeBackend {
+    /// The default, which a written scene leaves out.
+    pub fn is_cpu(&self) -> bool {
+        *self == Self::Cpu
+    }
 }
 
 impl Default for Integrator {
@@ -163,6 +187,7 @@ impl Default for Integrator {
             adaptive: false,
             tolerance: None,
             dt_max: None,
+            backend: ComputeBackend::Cpu,
         }
     }
 }

@@ -39,8 +39,8 @@ mod validate;
 mod walls;
 
 pub use file::{
-    AdhesionSpec, CellsSpec, DivisionAxis, DivisionSpec, Domain, InitKind, Integrator, Model,
-    PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
+    AdhesionSpec, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain, InitKind,
+    Integrator, Model, PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
 };
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
@@ -159,6 +159,11 @@ impl Scene {
     /// The storage precision of the fields.
     pub fn precision(&self) -> Precision {
         self.file.integrator.precision
+    }
+
+    /// Where the steps run (`[integrator] backend`).
+    pub fn backend(&self) -> ComputeBackend {
+        self.file.integrator.backend
     }
 
     /// The model parameters at activity `zeta`.

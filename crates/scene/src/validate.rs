@@ -3,7 +3,7 @@
 
 use phasefield::{init, Lattice, PatchShape};
 
-use crate::file::{AlignKind, InitKind, SceneFile};
+use crate::file::{AlignKind, ComputeBackend, InitKind, SceneFile};
 use crate::Scene;
 
 /// A problem with a scene, naming the key and the fix.
@@ -86,6 +86,77 @@ fn readable(v: String) -> String {
 }
 
 impl SceneFile {
+    /// What the GPU backend does not run, refused by key: the adaptive step, forward Euler,
+    /// full-domain storage, f64 storage, and every section beyond the paper's model (named
+    /// together, so one edit fixes them all).
+    fn check_gpu(&self) -> Result<(), SceneError> {
+        let it = &self.integrator;
+        let gpu = |key, value: String, problem: &str, fix: &str| {
+            invalid(
+                "integrator",
+                key,
+                value,
+                format!("the GPU backend {problem}"),
+                format!("{fix}, or set backend = \"cpu\""),
+            )
+        };
+        if it.adaptive {
+            return Err(gpu("adaptive", "true".into(), "runs the fixed step only (its error estimate would need a second field on the device)", "set adaptive = false"));
+        }
+        if it.npc == 0 {
+            return Err(gpu(
+                "npc",
+                "0".into(),
+                "runs Heun's predictor–corrector, not forward Euler",
+                "set npc = 1",
+            ));
+        }
+        if it.margin == 0 {
+            return Err(gpu(
+                "margin",
+                "0".into(),
+                "stores every cell on a patch; the full domain is the CPU's reference setting",
+                "set margin = 16 (or the paper's 12)",
+            ));
+        }
+        if it.precision == mechanics::Precision::F64 {
+            return Err(gpu(
+                "precision",
+                "\"f64\"".into(),
+                "stores and computes in f32",
+                "set precision = \"f32\"",
+            ));
+        }
+        let mut sections = Vec::new();
+        if self.polarity.is_some() {
+            sections.push("[polarity]");
+        }
+        if self.adhesion.is_some() {
+            sections.push("[adhesion]");
+        }
+        if !self.population.is_empty() {
+            sections.push("[[population]]");
+        }
+        if self.walls.is_some() {
+            sections.push("[walls]");
+        }
+        if self.division.is_some() {
+            sections.push("[division]");
+        }
+        if !sections.is_empty() {
+            return Err(gpu(
+                "backend",
+                "\"gpu\"".into(),
+                &format!(
+                    "runs the paper's minimal model only, and this scene has {}",
+                    sections.join(", ")
+                ),
+                &format!("remove {} to run on the GPU", sections.join(", ")),
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks every value once and returns the valid [`Scene`]; the error names the first bad
     /// key and how to fix it.
     ///
@@ -572,6 +643,9 @@ impl SceneFile {
                     (c.radius + 2.0 * m.lambda).ceil()
                 ),
             ));
+        }
+        if it.backend == ComputeBackend::Gpu {
+            self.check_gpu()?;
         }
         let lattice = Lattice::new(d.lx, d.ly);
         if let Err(e) = PatchShape::new(lattice, it.margin) {

@@ -1,0 +1,79 @@
+//! `[integrator] backend`: where a run's steps go. The GPU backend (the `gpu` crate, wgpu on
+//! Vulkan) is compiled in with the `gpu` cargo feature, so that the default build stays free
+//! of wgpu's compile time; a binary without it refuses `backend = "gpu"` with the command
+//! that builds one.
+
+use anyhow::Result;
+use mechanics::Simulation;
+use phasefield::Real;
+use scene::{ComputeBackend, Scene};
+
+/// An opened device, taken before the run directory is prepared, so that a missing adapter
+/// is an error before any output is touched.
+pub struct Opened {
+    #[cfg(feature = "gpu")]
+    device: Option<gpu::Device>,
+}
+
+impl Opened {
+    /// The adapter a GPU run will use, in words (`None` for a CPU run).
+    pub fn describe(&self) -> Option<String> {
+        #[cfg(feature = "gpu")]
+        {
+            self.device.as_ref().map(gpu::Device::describe)
+        }
+        #[cfg(not(feature = "gpu"))]
+        {
+            None
+        }
+    }
+}
+
+/// Opens what `scene`'s backend needs: nothing for the CPU, the Vulkan adapter for the GPU.
+///
+/// # Errors
+/// `backend = "gpu"` in a binary built without the `gpu` feature, or no usable adapter.
+pub fn open(scene: &Scene) -> Result<Opened> {
+    match scene.backend() {
+        ComputeBackend::Cpu => Ok(Opened {
+            #[cfg(feature = "gpu")]
+            device: None,
+        }),
+        ComputeBackend::Gpu => open_gpu(),
+    }
+}
+
+#[cfg(feature = "gpu")]
+fn open_gpu() -> Result<Opened> {
+    let device =
+        gpu::Device::open().map_err(|e| anyhow::anyhow!("[integrator] backend = \"gpu\": {e}"))?;
+    Ok(Opened {
+        device: Some(device),
+    })
+}
+
+#[cfg(not(feature = "gpu"))]
+fn open_gpu() -> Result<Opened> {
+    anyhow::bail!(
+        "[integrator] backend = \"gpu\": this monolayer binary was built without the GPU backend; \
+         build one with `cargo build --release -p monolayer-cli --features gpu` (it needs a Vulkan \
+         driver at run time: `apt-get install mesa-vulkan-drivers libvulkan1` for the CPU driver, \
+         or the GPU vendor's), or set backend = \"cpu\""
+    )
+}
+
+/// `sim` with its steps on the opened device (unchanged for the CPU).
+///
+/// # Errors
+/// What the GPU backend refuses in the state (its memory estimate above the device's, say).
+pub fn attach<T: Real>(sim: Simulation<T>, opened: Opened) -> Result<Simulation<T>> {
+    #[cfg(feature = "gpu")]
+    if let Some(device) = opened.device {
+        let backend = gpu::GpuBackend::on(device, sim.tissue(), sim.step_params())
+            .map_err(|e| anyhow::anyhow!("[integrator] backend = \"gpu\": {e}"))?;
+        return Ok(sim.with_backend(Box::new(backend)));
+    }
+    #[cfg(not(feature = "gpu"))]
+    let _ = opened;
+    Ok(sim)
+}

@@ -1,0 +1,193 @@
+//! `[integrator] backend = "gpu"` end to end, on whichever Vulkan adapter is present
+//! (lavapipe in CI, where `MONOLAYER_GPU_REQUIRED=1` makes a missing adapter a failure):
+//! runs are bit-identical run to run and for any number of lavapipe threads; a checkpoint
+//! written by one backend resumes on the other; what the GPU does not run is refused by
+//! name before any output is written.
+
+use std::path::Path;
+use std::process::Output;
+
+use crate::common::{bin, paper, run_files, scene_path, stderr};
+
+/// The paper's scene, short: 20 TU of relaxation and 20 TU at ζ = 0.005 (80 steps of 0.5),
+/// frames every 10 TU, a checkpoint at 30.
+const SHORT: [&str; 12] = [
+    "--set",
+    "run.relax_time=20",
+    "--set",
+    "run.time=20",
+    "--set",
+    "run.output_every=10",
+    "--set",
+    "run.series_every=2",
+    "--set",
+    "run.checkpoint_every=10",
+    "--set",
+    "model.zeta=0.005",
+];
+
+fn run_paper(out: &Path, backend: &str, lp_threads: &str, extra: &[&str]) -> Output {
+    bin()
+        .arg("run")
+        .arg(paper())
+        .arg("--out")
+        .arg(out)
+        .args(SHORT)
+        .args(["--set", &format!("integrator.backend={backend}"), "--quiet"])
+        .args(extra)
+        .env("LP_NUM_THREADS", lp_threads)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+/// Whether a failed GPU run failed for want of an adapter, which skips the test unless
+/// `MONOLAYER_GPU_REQUIRED=1`.
+fn no_adapter(o: &Output) -> bool {
+    let e = stderr(o);
+    if o.status.success() || !e.contains("no Vulkan adapter") {
+        return false;
+    }
+    assert!(
+        std::env::var("MONOLAYER_GPU_REQUIRED").as_deref() != Ok("1"),
+        "MONOLAYER_GPU_REQUIRED=1 and: {e}"
+    );
+    eprintln!("skipped: {e}");
+    true
+}
+
+fn ok(o: &Output) {
+    assert!(o.status.success(), "{}", stderr(o));
+}
+
+/// Two runs on 2 lavapipe threads and one on 1 thread write byte-identical series and
+/// frames; the run says which adapter it stepped on.
+#[test]
+fn gpu_runs_are_bit_identical_for_any_driver_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b, c) = (
+        dir.path().join("a"),
+        dir.path().join("b"),
+        dir.path().join("c"),
+    );
+    let o = run_paper(&a, "gpu", "2", &[]);
+    if no_adapter(&o) {
+        return;
+    }
+    ok(&o);
+    ok(&run_paper(&b, "gpu", "2", &[]));
+    ok(&run_paper(&c, "gpu", "1", &[]));
+    let want = run_files(&a);
+    assert_eq!(want.len(), 6, "series.csv and five frames");
+    for (other, what) in [(&b, "a second run"), (&c, "one lavapipe thread")] {
+        let got = run_files(other);
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!(g == w, "{what}: {} differs", w.0);
+        }
+    }
+    let scene = std::fs::read_to_string(a.join("scene.toml")).unwrap();
+    assert!(scene.contains("backend = \"gpu\""), "{scene}");
+}
+
+/// The columns of `series.csv` by name, as numbers, row by row.
+fn series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
+
+/// A run that starts on one backend and is resumed from its checkpoint on the other follows
+/// the run done on the first backend throughout: the rows from the checkpoint on agree in
+/// v_rms, S_rms and the mean area to f32 round-off amplified over 20 steps (1e-3 of their
+/// value; the backends differ by ~1e-6 in φ per step), and the clock is the same.
+#[test]
+fn a_checkpoint_resumes_on_the_other_backend() {
+    let dir = tempfile::tempdir().unwrap();
+    for (first, second) in [("cpu", "gpu"), ("gpu", "cpu")] {
+        let whole = dir.path().join(format!("{first}-whole"));
+        let part = dir.path().join(format!("{first}-then-{second}"));
+        let o = run_paper(&whole, first, "2", &[]);
+        if no_adapter(&o) {
+            return;
+        }
+        ok(&o);
+        // The same run cut at 30 TU (its checkpoint there), then extended on the other.
+        ok(&run_paper(&part, first, "2", &["--set", "run.time=10"]));
+        let o = bin()
+            .args(["run", "--resume"])
+            .arg(&part)
+            .args([
+                "--set",
+                "run.time=20",
+                "--set",
+                &format!("integrator.backend={second}"),
+                "--quiet",
+            ])
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap();
+        ok(&o);
+        let (head, want) = series(&whole);
+        let (_, got) = series(&part);
+        assert_eq!(got.len(), want.len(), "{first} then {second}: rows");
+        let col = |name: &str| head.iter().position(|h| h == name).unwrap();
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!(g[col("step")], w[col("step")]);
+            for name in ["v_rms", "s_rms", "area_mean"] {
+                let (a, b) = (g[col(name)], w[col(name)]);
+                assert!(
+                    (a - b).abs() <= 1e-3 * b.abs(),
+                    "{first} then {second}: {name} at step {}: {a} against {b}",
+                    w[col("step")]
+                );
+            }
+        }
+        let scene = std::fs::read_to_string(part.join("scene.toml")).unwrap();
+        assert!(
+            scene.contains("backend = \"gpu\"") == (second == "gpu"),
+            "the resumed run records where its steps run: {scene}"
+        );
+    }
+}
+
+/// Physics beyond the paper's model and settings the GPU does not run are refused, each by
+/// its key and with the fix, before the output directory is made.
+#[test]
+fn the_gpu_refuses_what_it_does_not_run_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    for (scene, set, says) in [
+        ("walker.toml", "run.time=1", "[polarity]"),
+        ("channel.toml", "run.time=1", "[walls]"),
+        ("paper.toml", "integrator.adaptive=true", "adaptive"),
+        ("paper.toml", "integrator.npc=0", "npc"),
+        ("paper.toml", "integrator.margin=0", "margin"),
+        ("paper.toml", "integrator.precision=\"f64\"", "precision"),
+    ] {
+        let out = dir.path().join(scene).join(set.replace(['=', '"'], "_"));
+        let o = bin()
+            .arg("run")
+            .arg(scene_path(scene))
+            .arg("--out")
+            .arg(&out)
+            .args(["--set", "integrator.backend=gpu", "--set", set, "--quiet"])
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert!(!o.status.success(), "{scene} {set}: refused");
+        assert!(
+            e.contains(says) && e.contains("backend = \"cpu\""),
+            "{scene} {set}: the message names {says} and the fix: {e}"
+        );
+        assert!(!out.exists(), "{scene} {set}: nothing written");
+    }
+}

@@ -1,0 +1,344 @@
+//! Each WGSL function of `step.wgsl` that implements an equation against its Rust reference
+//! (`mechanics::equations`, `phasefield::EnergyCoefficients`), on random inputs, for both
+//! pressure forms: so that every formula keeps one reference, and a GPU formula that drifts
+//! from it fails here by name.
+//!
+//! A small kernel appended to the step's own source calls each function on a table of
+//! inputs; the references take the same f32 inputs in f64.
+
+use mechanics::{equations as eq, PressureKind};
+use phasefield::{EnergyCoefficients, EnergyParams, Lattice, PatchShape};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use wgpu::util::DeviceExt;
+
+mod common;
+
+/// Inputs per sample: φ, ∇²φ, area, Σ_{j≠i} φ_j², ∂_xφ, ∂_yφ, Q_xx, Q_xy, s1, s2, u,
+/// v_x, v_y, R_old, R_new, Δt.
+const IN: usize = 16;
+/// Outputs per sample, in the order of `NAMES`.
+const OUT: usize = 16;
+const NAMES: [&str; 16] = [
+    "area_factor",
+    "free_energy_derivative",
+    "shape_tensor_density.xx",
+    "shape_tensor_density.xy",
+    "pressure_cell_part",
+    "pressure",
+    "pressure_self_part",
+    "force_density.x",
+    "force_density.y",
+    "velocity.x",
+    "velocity.y",
+    "rhs",
+    "heun_predictor",
+    "heun_corrector",
+    "pressure_regrouped",
+    "laplacian",
+];
+
+const HARNESS: &str = r#"
+@group(1) @binding(0) var<storage, read> eq_in: array<f32>;
+@group(1) @binding(1) var<storage, read_write> eq_out: array<f32>;
+
+@compute @workgroup_size(64)
+fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= arrayLength(&eq_out) / 16u) {
+        return;
+    }
+    let x = i * 16u;
+    let phi = eq_in[x];
+    let lap = eq_in[x + 1u];
+    let area = eq_in[x + 2u];
+    let others = eq_in[x + 3u];
+    let g = vec2<f32>(eq_in[x + 4u], eq_in[x + 5u]);
+    let q = vec2<f32>(eq_in[x + 6u], eq_in[x + 7u]);
+    let s1 = eq_in[x + 8u];
+    let s2 = eq_in[x + 9u];
+    let u = eq_in[x + 10u];
+    let v = vec2<f32>(eq_in[x + 11u], eq_in[x + 12u]);
+    let r_old = eq_in[x + 13u];
+    let r_new = eq_in[x + 14u];
+    let dt = eq_in[x + 15u];
+    let af = area_factor(area);
+    let o = i * 16u;
+    eq_out[o] = af;
+    eq_out[o + 1u] = free_energy_derivative(phi, lap, af, others);
+    let sh = shape_tensor_density(g);
+    eq_out[o + 2u] = sh.x;
+    eq_out[o + 3u] = sh.y;
+    eq_out[o + 4u] = pressure_cell_part(phi, lap, af);
+    eq_out[o + 5u] = pressure(s1, s2, u);
+    eq_out[o + 6u] = pressure_self_part(phi);
+    let fd = force_density(u, prm.zeta, q, g);
+    eq_out[o + 7u] = fd.x;
+    eq_out[o + 8u] = fd.y;
+    let vel = velocity(v, prm.xi);
+    eq_out[o + 9u] = vel.x;
+    eq_out[o + 10u] = vel.y;
+    eq_out[o + 11u] = rhs(v, g, r_old);
+    eq_out[o + 12u] = heun_predictor(phi, dt, r_old);
+    eq_out[o + 13u] = heun_corrector(phi, dt, r_old, r_new);
+    // The regrouped pressure with s3 = s4 = 0 and own = u is `pressure` less nothing but
+    // the cell's own repulsion: checked against the sum of the Rust parts below.
+    eq_out[o + 14u] = pressure_regrouped(s1, s2, lap, others, u);
+    var st: Stencil;
+    st.c = phi;
+    st.xm = eq_in[x + 4u];
+    st.xp = eq_in[x + 5u];
+    st.ym = eq_in[x + 6u];
+    st.yp = eq_in[x + 7u];
+    eq_out[o + 15u] = laplacian(st);
+}
+"#;
+
+/// The kernel's uniform block (the shader's `Params`), with the coefficients of `coef`.
+fn params_bytes(coef: &EnergyCoefficients, zeta: f32, xi: f32) -> Vec<u8> {
+    let f = [
+        coef.double_well as f32,
+        coef.gradient as f32,
+        coef.area as f32,
+        coef.inv_target_area as f32,
+        coef.repulsion as f32,
+        zeta,
+        xi,
+        0.1,
+    ];
+    let mut out: Vec<u8> = bytemuck::cast_slice(&f).to_vec();
+    out.extend_from_slice(bytemuck::cast_slice(&[0u32; 6]));
+    out.extend_from_slice(bytemuck::cast_slice(&[0.0f32]));
+    out.extend_from_slice(bytemuck::cast_slice(&[0u32]));
+    out
+}
+
+fn run_kernel(
+    device: &gpu::Device,
+    kind: PressureKind,
+    coef: &EnergyCoefficients,
+    zeta: f32,
+    xi: f32,
+    input: &[f32],
+) -> Vec<f32> {
+    let (d, q) = device.raw();
+    let shape = PatchShape::new(Lattice::new(64, 64), 8).unwrap();
+    let source = gpu::shader_source(&shape, kind, 32) + HARNESS;
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("equations"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("equations"),
+        layout: None,
+        module: &module,
+        entry_point: Some("equations"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let n = input.len() / IN;
+    let prm = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: &params_bytes(coef, zeta, xi),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let inp = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(input),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let bytes = (n * OUT * 4) as u64;
+    let out = d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let staging = d.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: prm.as_entire_binding(),
+        }],
+    });
+    let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(1),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: inp.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: out.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &g0, &[]);
+        pass.set_bind_group(1, &g1, &[]);
+        pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
+    q.submit(Some(enc.finish()));
+    staging
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
+    d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let data = staging.slice(..).get_mapped_range().unwrap();
+    bytemuck::cast_slice(&data).to_vec()
+}
+
+/// The Rust references on one sample, in the order of `NAMES`, and for each the sum of the
+/// magnitudes of its terms (the scale of its f32 round-off).
+fn reference(
+    kind: PressureKind,
+    c: &EnergyCoefficients,
+    zeta: f64,
+    xi: f64,
+    x: &[f64],
+) -> [(f64, f64); OUT] {
+    let [phi, lap, area, others, gx, gy, qxx, qxy, s1, s2, u, vx, vy, r_old, r_new, dt] =
+        x.try_into().unwrap();
+    let af = c.area_factor(area);
+    let g = [gx, gy];
+    let sh = eq::shape_tensor_density(g);
+    let fd = eq::force_density(u, zeta, [qxx, qxy], g);
+    let vel = eq::velocity([vx, vy], xi);
+    let dw = c.double_well * (phi * (1.0 - phi) * (1.0 - 2.0 * phi)).abs();
+    // The regrouped pressure with s3 = ∇²φ and s4 = Σφ_j² stood in for: (2κ/λ)(s1 s2 − s3)
+    // + own (paper), (2κ/λ)(s2² − s4) + own (interaction), which equals `pressure` of
+    // `u − (2κ/λ) s3` or `u − (2κ/λ) s4`.
+    let (regrouped, reg_scale) = match kind {
+        PressureKind::Paper => (
+            eq::pressure(kind, c, s1, s2, u - c.repulsion * lap),
+            c.repulsion * (s1 * s2).abs() + c.repulsion * lap.abs() + u.abs(),
+        ),
+        PressureKind::Interaction => (
+            eq::pressure(kind, c, s1, s2, u - c.repulsion * others),
+            c.repulsion * s2 * s2 + c.repulsion * others.abs() + u.abs(),
+        ),
+    };
+    let p_scale = match kind {
+        PressureKind::Paper => c.repulsion * (s1 * s2).abs() + u.abs(),
+        PressureKind::Interaction => c.repulsion * s2 * s2 + u.abs(),
+    };
+    let cell_scale = c.repulsion * phi.abs().powi(4).max(phi.abs().powi(3))
+        + dw
+        + c.gradient * lap.abs()
+        + (af * phi).abs();
+    // The stencil of the harness: xm = ∂_xφ's slot and so on (any four numbers do).
+    let nb = [gx, gy, qxx, qxy];
+    let lap5 = nb.iter().map(|v| v - phi).sum::<f64>();
+    [
+        (af, c.area * (1.0 + (area * c.inv_target_area).abs())),
+        (
+            c.free_energy_derivative(phi, lap, af, others),
+            dw + c.gradient * lap.abs() + (af * phi).abs() + c.repulsion * (phi * others).abs(),
+        ),
+        (sh[0], 0.5 * (gx * gx + gy * gy)),
+        (sh[1], (gx * gy).abs()),
+        (eq::pressure_cell_part(kind, c, phi, lap, af), cell_scale),
+        (eq::pressure(kind, c, s1, s2, u), p_scale),
+        (eq::pressure_self_part(kind, c, phi), dw),
+        (
+            fd[0],
+            (u * gx).abs() + zeta.abs() * ((qxx * gx).abs() + (qxy * gy).abs()),
+        ),
+        (
+            fd[1],
+            (u * gy).abs() + zeta.abs() * ((qxy * gx).abs() + (qxx * gy).abs()),
+        ),
+        (vel[0], (vx / xi).abs()),
+        (vel[1], (vy / xi).abs()),
+        (
+            eq::rhs([vx, vy], g, r_old),
+            (vx * gx).abs() + (vy * gy).abs() + r_old.abs(),
+        ),
+        (
+            eq::heun_predictor(phi, dt, r_old),
+            phi.abs() + (dt * r_old).abs(),
+        ),
+        (
+            eq::heun_corrector(phi, dt, r_old, r_new),
+            phi.abs() + (dt * (r_old.abs() + r_new.abs())),
+        ),
+        (regrouped, reg_scale),
+        (lap5, nb.iter().map(|v| (v - phi).abs()).sum::<f64>()),
+    ]
+}
+
+fn sample(rng: &mut ChaCha8Rng) -> [f32; IN] {
+    let mut s = [0.0f32; IN];
+    let ranges: [(f32, f32); IN] = [
+        (-0.1, 1.1),   // φ
+        (-0.5, 0.5),   // ∇²φ
+        (0.0, 100.0),  // area
+        (0.0, 2.0),    // Σ others²
+        (-0.6, 0.6),   // ∂_xφ
+        (-0.6, 0.6),   // ∂_yφ
+        (-3.0, 3.0),   // Q_xx
+        (-3.0, 3.0),   // Q_xy
+        (0.0, 2.5),    // s1
+        (0.0, 2.0),    // s2
+        (-0.2, 0.2),   // u
+        (-0.01, 0.01), // v_x
+        (-0.01, 0.01), // v_y
+        (-0.05, 0.05), // R_old
+        (-0.05, 0.05), // R_new
+        (0.05, 1.0),   // Δt
+    ];
+    for (v, (lo, hi)) in s.iter_mut().zip(ranges) {
+        *v = rng.random_range(lo..hi);
+    }
+    s
+}
+
+/// f32 round-off of a formula of at most a dozen operations: a few ulps (2⁻²⁴ ≈ 6e-8 each)
+/// of the sum of its terms' magnitudes; 16 ulps is the bound, and a wrong coefficient, sign
+/// or term is off by far more (the smallest term of any function here is above 1e-4 of its
+/// scale on these ranges).
+const ULPS: f64 = 16.0 * f32::EPSILON as f64 / 2.0;
+
+#[test]
+fn every_wgsl_equation_matches_its_rust_reference() {
+    let Some(device) = common::try_device() else {
+        return;
+    };
+    let coef = EnergyParams::paper().coefficients();
+    let (zeta, xi) = (0.005f32, 1.0f32);
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let n = 4096;
+    let input: Vec<f32> = (0..n).flat_map(|_| sample(&mut rng)).collect();
+    for kind in [PressureKind::Paper, PressureKind::Interaction] {
+        let out = run_kernel(&device, kind, &coef, zeta, xi, &input);
+        let mut worst = [0.0f64; OUT];
+        for (x, o) in input.chunks_exact(IN).zip(out.chunks_exact(OUT)) {
+            let xf: Vec<f64> = x.iter().map(|&v| f64::from(v)).collect();
+            let refs = reference(kind, &coef, f64::from(zeta), f64::from(xi), &xf);
+            for (k, ((want, scale), &got)) in refs.iter().zip(o).enumerate() {
+                let err = (f64::from(got) - want).abs() / scale.max(f64::MIN_POSITIVE);
+                worst[k] = worst[k].max(err);
+                assert!(
+                    err <= ULPS,
+                    "{kind:?}: {} = {got:e} on the GPU, {want:e} in Rust (inputs {x:?}): {err:.2e} of its scale",
+                    NAMES[k]
+                );
+            }
+        }
+        for (name, w) in NAMES.iter().zip(worst) {
+            println!("{kind:?}: {name}: worst error {w:.2e} of its scale (bound {ULPS:.1e})");
+        }
+    }
+}
