@@ -73,8 +73,10 @@ struct Params {
 /// What the device holds, in bytes, for a state: for the memory estimate and its refusal.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GpuMemory {
-    /// One φ array (all cells' patches in f32): the largest binding.
+    /// One φ array (all cells' patches in f32), before it is split into chunks.
     pub phi_array: u64,
+    /// The φ arrays of a step: 3 (φ, the predictor, `R(φ)`), 4 with `npc` ≥ 2.
+    pub phi_arrays: u64,
     /// Every buffer together.
     pub total: u64,
 }
@@ -85,15 +87,47 @@ impl GpuMemory {
     pub fn estimate(lattice: Lattice, shape: &PatchShape, n_cells: usize, npc: usize) -> Self {
         let n = n_cells as u64;
         let phi_array = n * shape.len() as u64 * 4;
-        let n_phi = if npc >= 2 { 4 } else { 3 };
+        let phi_arrays = if npc >= 2 { 4 } else { 3 };
         let (nb, cap) = bins(lattice, shape, n_cells);
-        let total = n_phi * phi_array
+        let total = phi_arrays * phi_array
             + n * (CELL_STRIDE as u64 * 4 + 8)
-            + lattice.len() as u64 * 16
+            + lattice.len() as u64 * (16 + 32)
             + u64::from(nb) * (4 + 4 * u64::from(cap))
             + (lattice.lx + lattice.ly) as u64 * 8;
-        Self { phi_array, total }
+        Self {
+            phi_array,
+            phi_arrays,
+            total,
+        }
     }
+
+    /// The estimate in words, for messages: `"3 φ arrays of 1.23 GB, 3.80 GB in all"`.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} φ arrays of {:.2} GB, {:.2} GB in all",
+            self.phi_arrays,
+            self.phi_array as f64 / 1e9,
+            self.total as f64 / 1e9
+        )
+    }
+}
+
+/// How the backend lays out the state (for tests and measurements; the defaults fit it to
+/// the device).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GpuOptions {
+    /// The most cells in one chunk of the per-cell φ arrays; `None`: as many as the device's
+    /// largest storage binding holds (2³¹ − 1 bytes on Vulkan: about 490 k cells at margin
+    /// 16). A smaller figure splits a small state into chunks, which tests the split.
+    pub max_chunk_cells: Option<usize>,
+}
+
+/// The split of cells `0..n` into chunks of at most `per` cells: `(lo, count)` each.
+fn chunks(n: usize, per: usize) -> Vec<(usize, usize)> {
+    let per = per.max(1);
+    (0..n.div_ceil(per).max(1))
+        .map(|k| (k * per, per.min(n - (k * per).min(n))))
+        .collect()
 }
 
 /// The bins of patch origins for the gather: `(number of bins, cells per bin)`. A bin is at
@@ -133,14 +167,15 @@ struct Pipelines {
     count: wgpu::ComputePipeline,
 }
 
-/// The bind groups of one step: which φ array each evaluation reads and writes.
+/// The bind groups of one step, one per chunk each: which φ array each evaluation reads and
+/// writes.
 struct Groups {
     /// Evaluates `phi`; the predictor into `pred`, `R` into `k1`.
-    predict: wgpu::BindGroup,
+    predict: Vec<wgpu::BindGroup>,
     /// Evaluates `pred` (and `spare`) as the last corrector, into `phi`, re-centred.
-    last: [wgpu::BindGroup; 2],
+    last: [Vec<wgpu::BindGroup>; 2],
     /// Evaluates `pred` (`spare`) as a middle corrector, into `spare` (`pred`).
-    middle: [wgpu::BindGroup; 2],
+    middle: [Vec<wgpu::BindGroup>; 2],
 }
 
 /// The GPU backend: the state and every buffer of the step on the device, and the steps
@@ -152,8 +187,10 @@ pub struct GpuBackend {
     dev: Device,
     pipelines: Pipelines,
     groups: Groups,
-    phi: wgpu::Buffer,
-    k1: wgpu::Buffer,
+    /// The chunks of cells, `(lo, count)`, and the φ and `R(φ)` arrays of each.
+    chunks: Vec<(usize, usize)>,
+    phi: Vec<wgpu::Buffer>,
+    k1: Vec<wgpu::Buffer>,
     lat: wgpu::Buffer,
     cell: wgpu::Buffer,
     origin: wgpu::Buffer,
@@ -179,6 +216,7 @@ impl std::fmt::Debug for GpuBackend {
         f.debug_struct("GpuBackend")
             .field("adapter", &self.dev.describe())
             .field("n_cells", &self.n_cells)
+            .field("chunks", &self.chunks.len())
             .finish_non_exhaustive()
     }
 }
@@ -228,20 +266,46 @@ impl GpuBackend {
         tissue: &Tissue<T>,
         step: &StepParams,
     ) -> Result<Self, GpuError> {
+        Self::with_options(dev, tissue, step, GpuOptions::default())
+    }
+
+    /// The backend on an open device, laid out as `options` say.
+    ///
+    /// The per-cell φ arrays are split into chunks of at most the device's largest binding;
+    /// when the buffers do not fit the device's memory, the error gives the estimate.
+    ///
+    /// # Errors
+    /// As [`GpuBackend::on`].
+    pub fn with_options<T: Real>(
+        dev: Device,
+        tissue: &Tissue<T>,
+        step: &StepParams,
+        options: GpuOptions,
+    ) -> Result<Self, GpuError> {
         Self::check(tissue, step)?;
         let cells = tissue.cells();
         let (lattice, shape, n) = (cells.lattice(), cells.shape().clone(), cells.n_cells());
         let mem = GpuMemory::estimate(lattice, &shape, n, step.npc);
-        if mem.phi_array > dev.max_binding() {
+        let patch_bytes = shape.len() as u64 * 4;
+        let fit = (dev.max_binding() / patch_bytes) as usize;
+        if fit == 0 || n > u32::MAX as usize / 2 {
             return Err(GpuError::TooLarge(format!(
-                "{n} cells on patches of {}×{} need a φ array of {:.2} GB, above the device's largest binding of {:.2} GB ({}); reduce [cells] count or [integrator] margin",
+                "{n} cells on patches of {}×{}: the device's largest binding of {:.2} GB ({}) holds {fit} patches; reduce [integrator] margin or [cells] count",
                 shape.nx,
                 shape.ny,
-                mem.phi_array as f64 / 1e9,
                 dev.max_binding() as f64 / 1e9,
                 dev.describe()
             )));
         }
+        let per_chunk = options
+            .max_chunk_cells
+            .unwrap_or(fit)
+            .clamp(1, fit)
+            .min(n.max(1));
+        let chunks = chunks(n, per_chunk);
+        // Allocation failures (the state does not fit the device) are caught here and
+        // reported with the estimate, not left to a later panic.
+        let oom = dev.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let (nb, cap) = bins(lattice, &shape, n);
         let (nbx, nby) = bin_grid(lattice, &shape);
         let d = &dev.device;
@@ -254,12 +318,43 @@ impl GpuBackend {
             })
         };
         let copy = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
-        let phi_bytes = mem.phi_array;
-        let phi = storage("phi", phi_bytes, copy);
-        let pred = storage("pred", phi_bytes, copy);
-        let k1 = storage("k1", phi_bytes, copy);
-        let spare = (step.npc >= 2).then(|| storage("spare", phi_bytes, copy));
+        let per_chunk_array = |label: &str| -> Vec<wgpu::Buffer> {
+            chunks
+                .iter()
+                .map(|&(_, count)| storage(label, count as u64 * patch_bytes, copy))
+                .collect()
+        };
+        let phi = per_chunk_array("phi");
+        let pred = per_chunk_array("pred");
+        let k1 = per_chunk_array("k1");
+        let spare = (step.npc >= 2).then(|| per_chunk_array("spare"));
         let dummy = storage("dummy", 16, copy);
+        let acc = storage(
+            "chunk sums",
+            if chunks.len() > 1 {
+                lattice.len() as u64 * 32
+            } else {
+                16
+            },
+            copy,
+        );
+        let chunk_info: Vec<wgpu::Buffer> = chunks
+            .iter()
+            .enumerate()
+            .map(|(k, &(lo, count))| {
+                let v = [
+                    lo as u32,
+                    count as u32,
+                    u32::from(k == 0),
+                    u32::from(k + 1 == chunks.len()),
+                ];
+                d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("chunk"),
+                    contents: bytemuck::cast_slice(&v),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                })
+            })
+            .collect();
         let cell = storage("cell", (n * CELL_STRIDE * 4) as u64, copy);
         let origin = storage("origin", (n * 8) as u64, copy);
         let lat = storage("lattice sums", lattice.len() as u64 * 16, copy);
@@ -278,7 +373,7 @@ impl GpuBackend {
             contents: bytemuck::cast_slice(&trig_values),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let groups_cells = grid(n as u32);
+        let groups_cells = grid(per_chunk as u32);
         let params = Params {
             double_well: 0.0,
             gradient: 0.0,
@@ -333,6 +428,17 @@ impl GpuBackend {
         for b in 1..=11 {
             entries.push(storage_entry(b, b == 1 || b == 10));
         }
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 12,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        });
+        entries.push(storage_entry(13, false));
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("step"),
             entries: &entries,
@@ -367,12 +473,12 @@ impl GpuBackend {
             correct_last: pipeline("force_update", &[("MODE", 2.0)]),
             count: pipeline("count_step", &[]),
         };
-        let group = |x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 12] = [
+        let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
+            let bufs: [&wgpu::Buffer; 14] = [
                 &params_buf,
                 x,
                 old,
-                &k1,
+                &k1[k],
                 out,
                 &cell,
                 &origin,
@@ -381,6 +487,8 @@ impl GpuBackend {
                 &bin_cells,
                 &trig,
                 &status,
+                &chunk_info[k],
+                &acc,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -396,16 +504,33 @@ impl GpuBackend {
                 entries: &entries,
             })
         };
-        let spare_ref = spare.as_ref().unwrap_or(&dummy);
+        let per = |f: &dyn Fn(usize) -> wgpu::BindGroup| (0..chunks.len()).map(f).collect();
+        let spare_of = |k: usize| spare.as_ref().map_or(&dummy, |s| &s[k]);
         let groups = Groups {
-            predict: group(&phi, &dummy, &pred),
-            last: [group(&pred, &phi, &dummy), group(spare_ref, &phi, &dummy)],
-            middle: [group(&pred, &phi, spare_ref), group(spare_ref, &phi, &pred)],
+            predict: per(&|k| group(k, &phi[k], &dummy, &pred[k])),
+            last: [
+                per(&|k| group(k, &pred[k], &phi[k], &dummy)),
+                per(&|k| group(k, spare_of(k), &phi[k], &dummy)),
+            ],
+            middle: [
+                per(&|k| group(k, &pred[k], &phi[k], spare_of(k))),
+                per(&|k| group(k, spare_of(k), &phi[k], &pred[k])),
+            ],
         };
+        if let Some(e) = pollster::block_on(oom.pop()) {
+            return Err(GpuError::TooLarge(format!(
+                "{n} cells on patches of {}×{} need {} on the device ({}), which could not allocate them ({e}); reduce [cells] count or [integrator] margin",
+                shape.nx,
+                shape.ny,
+                mem.describe(),
+                dev.describe()
+            )));
+        }
         let nodes = (lattice.len() as u32).div_ceil(WG);
         let mut backend = Self {
             pipelines,
             groups,
+            chunks,
             phi,
             k1,
             lat,
@@ -477,7 +602,13 @@ impl GpuBackend {
             .map(|o| [o[0] as u32, o[1] as u32])
             .collect();
         let q = &self.dev.queue;
-        q.write_buffer(&self.phi, 0, bytemuck::cast_slice(&values));
+        for (&(lo, count), buf) in self.chunks.iter().zip(&self.phi) {
+            q.write_buffer(
+                buf,
+                0,
+                bytemuck::cast_slice(&values[lo * plen..(lo + count) * plen]),
+            );
+        }
         q.write_buffer(&self.origin, 0, bytemuck::cast_slice(&origins));
         q.write_buffer(&self.status, 0, bytemuck::cast_slice(&[0u32; 4]));
         self.params = self.params_of(tissue, f64::from(self.params.dt));
@@ -521,7 +652,7 @@ impl GpuBackend {
         self.record_passes(true);
         self.flush();
         let plen = self.shape.len();
-        let rhs = self.read(&self.k1, (self.n_cells * plen * 4) as u64)?;
+        let rhs = self.read_chunks(&self.k1, plen)?;
         let lat = self.read(&self.lat, self.lattice.len() as u64 * 16)?;
         Ok(Evaluation {
             rhs: bytemuck::cast_slice(&rhs).to_vec(),
@@ -547,7 +678,7 @@ impl GpuBackend {
             timestamp_writes: None,
         });
         // The bins of this step's patch origins.
-        pass.set_bind_group(0, &g.predict, &[]);
+        pass.set_bind_group(0, &g.predict[0], &[]);
         pass.set_pipeline(&p.bin_clear);
         pass.dispatch_workgroups(self.groups_bins, 1, 1);
         pass.set_pipeline(&p.bin_fill);
@@ -568,13 +699,23 @@ impl GpuBackend {
                 (&p.cell, group, force)
             }),
         ) {
-            pass.set_bind_group(0, group, &[]);
+            // Each pass over every chunk before the next pass: the lattice sums need every
+            // cell's area and shape, the forces every node's sums (chunk by chunk, in order).
             pass.set_pipeline(cell);
-            pass.dispatch_workgroups(cx, cy, 1);
+            for g in group {
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups(cx, cy, 1);
+            }
             pass.set_pipeline(&p.lattice);
-            pass.dispatch_workgroups(nx, ny, 1);
+            for g in group {
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups(nx, ny, 1);
+            }
             pass.set_pipeline(force);
-            pass.dispatch_workgroups(cx, cy, 1);
+            for g in group {
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups(cx, cy, 1);
+            }
         }
         if !evaluate_only {
             pass.set_pipeline(&p.count);
@@ -582,6 +723,49 @@ impl GpuBackend {
         }
         drop(pass);
         self.recorded += 1;
+    }
+
+    /// Copies a per-chunk array (`per_cell` floats a cell) to the host, chunk after chunk.
+    fn read_chunks(&self, arrays: &[wgpu::Buffer], per_cell: usize) -> Result<Vec<u8>, GpuError> {
+        let mut out = Vec::with_capacity(self.n_cells * per_cell * 4);
+        for (&(_, count), buf) in self.chunks.iter().zip(arrays) {
+            out.extend(self.read(buf, (count * per_cell * 4) as u64)?);
+        }
+        Ok(out)
+    }
+
+    /// Submits the steps queued so far and waits until the device has run them, without
+    /// reading anything back (for timing).
+    ///
+    /// # Errors
+    /// [`GpuError::Lost`].
+    pub fn wait(&mut self) -> Result<(), GpuError> {
+        self.flush();
+        self.dev
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Lost(e.to_string()))
+    }
+
+    /// Bytes the step moves to and from device memory per node-update (one cell's patch node
+    /// in one step), counted from the kernels: per evaluation the cell pass reads φ (4), the
+    /// gather reads φ once more (4), the force pass reads φ and the node's sums (4 + 16) and
+    /// writes `R` and the new φ (8; the corrector also reads `R` and φⁿ, 8 more); the lattice
+    /// sums write 16 bytes a lattice node, 2 evaluations a step, counted per patch node with
+    /// `lattice_nodes / patch_nodes`. Neighbours of the stencil are taken as cached.
+    pub fn bytes_per_node_update(&self) -> f64 {
+        let predictor = 4.0 + 4.0 + 4.0 + 16.0 + 8.0;
+        let corrector = predictor + 8.0;
+        let correctors = self.npc as f64;
+        let lattice = 16.0 * (1.0 + correctors) * self.lattice.len() as f64
+            / (self.n_cells * self.shape.len()).max(1) as f64;
+        predictor + correctors * corrector + lattice
+    }
+
+    /// The number of chunks the per-cell arrays are split into.
+    pub fn n_chunks(&self) -> usize {
+        self.chunks.len()
     }
 
     /// Copies `bytes` of `buffer` to the host.
@@ -634,7 +818,7 @@ impl GpuBackend {
     /// [`GpuError::Lost`].
     pub fn state(&mut self) -> Result<(Vec<f32>, Vec<[usize; 2]>), GpuError> {
         self.flush();
-        let phi = self.read(&self.phi, (self.n_cells * self.shape.len() * 4) as u64)?;
+        let phi = self.read_chunks(&self.phi, self.shape.len())?;
         let origin = self.read(&self.origin, (self.n_cells * 8) as u64)?;
         let origin: &[[u32; 2]] = bytemuck::cast_slice(&origin);
         Ok((

@@ -34,6 +34,16 @@ struct Params {
     _pad: u32,
 }
 
+// The cells of one chunk (the per-cell φ arrays are split into chunks of at most a binding's
+// size): cells lo .. lo + count, whose φ sit at (i − lo) * PLEN in this dispatch's arrays;
+// first and last say whether the lattice pass starts or ends the sums over chunks.
+struct Chunk {
+    lo: u32,
+    count: u32,
+    first: u32,
+    last: u32,
+}
+
 struct Status {
     failed: atomic<u32>,
     overflow: atomic<u32>,
@@ -63,6 +73,10 @@ struct Status {
 // cos, sin of 2π x/lx (lx of each), then of 2π y/ly (ly of each).
 @group(0) @binding(10) var<storage, read> trig: array<vec2<f32>>;
 @group(0) @binding(11) var<storage, read_write> status: Status;
+@group(0) @binding(12) var<uniform> chunk: Chunk;
+// Per node, with more than one chunk: the partial sums s1, s2, s3, s4, own, Q_xx, Q_xy (and
+// one unused) of the chunks before this one, two vec4 a node.
+@group(0) @binding(13) var<storage, read_write> acc: array<vec4<f32>>;
 
 var<workgroup> red: array<vec4<f32>, WG>;
 var<workgroup> shared_v: vec4<f32>;
@@ -252,12 +266,13 @@ fn bin_of(o: vec2<u32>) -> u32 {
 
 @compute @workgroup_size(256)
 fn cell_sums(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid3: vec3<u32>) {
-    let i = cell_index(wid);
+    let li = cell_index(wid);
     let lid = lid3.x;
-    if (i >= prm.n_cells || halted_uniform(lid)) {
+    if (li >= chunk.count || halted_uniform(lid)) {
         return;
     }
-    let base = i * PLEN;
+    let i = chunk.lo + li;
+    let base = li * PLEN;
     var acc = vec4<f32>(0.0);
     var lo = 3.0e38;
     var hi = -3.0e38;
@@ -378,6 +393,17 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     var s4 = 0.0;
     var own = 0.0;
     var q = vec2<f32>(0.0);
+    if (chunk.first == 0u) {
+        let a0 = acc[2u * node];
+        let a1 = acc[2u * node + 1u];
+        s1 = a0.x;
+        s2 = a0.y;
+        s3 = a0.z;
+        s4 = a0.w;
+        own = a1.x;
+        q = a1.yz;
+    }
+    let hi = chunk.lo + chunk.count;
     for (var dx = 0u; dx < nx_b; dx++) {
         let cx = (bx + prm.nbx - dx) % prm.nbx;
         for (var dy = 0u; dy < ny_b; dy++) {
@@ -386,11 +412,14 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             let n = min(atomicLoad(&bin_count[b]), CAP);
             for (var j = 0u; j < n; j++) {
                 let i = bin_cells[b * CAP + j];
+                if (i < chunk.lo || i >= hi) {
+                    continue;
+                }
                 let o = origin[i];
                 let a = (x + prm.lx - o.x) % prm.lx;
                 let bb = (y + prm.ly - o.y) % prm.ly;
                 if (a < NX && bb < NY) {
-                    let st = stencil(i * PLEN, a, bb);
+                    let st = stencil((i - chunk.lo) * PLEN, a, bb);
                     let c = i * CELL_STRIDE;
                     let af = area_factor(cell[c]);
                     let sh = vec2<f32>(cell[c + 1u], cell[c + 2u]);
@@ -406,19 +435,25 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             }
         }
     }
-    lat[node] = vec4<f32>(pressure_regrouped(s1, s2, s3, s4, own), s2, q.x, q.y);
+    if (chunk.last == 1u) {
+        lat[node] = vec4<f32>(pressure_regrouped(s1, s2, s3, s4, own), s2, q.x, q.y);
+    } else {
+        acc[2u * node] = vec4<f32>(s1, s2, s3, s4);
+        acc[2u * node + 1u] = vec4<f32>(own, q.x, q.y, 0.0);
+    }
 }
 
 // ---- pass 3: forces, velocities, the right-hand side and the Heun update ----
 
 @compute @workgroup_size(256)
 fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid3: vec3<u32>) {
-    let i = cell_index(wid);
+    let li = cell_index(wid);
     let lid = lid3.x;
-    if (i >= prm.n_cells || halted_uniform(lid)) {
+    if (li >= chunk.count || halted_uniform(lid)) {
         return;
     }
-    let base = i * PLEN;
+    let i = chunk.lo + li;
+    let base = li * PLEN;
     let o = origin[i];
     let c = i * CELL_STRIDE;
     var fields: array<vec4<f32>, NPT>;

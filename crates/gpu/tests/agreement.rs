@@ -146,3 +146,64 @@ fn twenty_active_steps_agree_with_the_cpu() {
     println!("ζ = 0.005, 20 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
     assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
 }
+
+/// The per-cell arrays split into chunks (here 25 + 25 + 10 cells, as 10⁶ cells are split
+/// at a binding's 2³¹ bytes) give the state of one array to f32 round-off: only the order in
+/// which the lattice sums add the cells changes (chunk by chunk).
+#[test]
+fn chunked_arrays_agree_with_one_array() {
+    if common::try_device().is_none() {
+        return;
+    }
+    let tissue = paper_tissue(0.005);
+    let sp = StepParams::paper();
+    let whole = GpuBackend::new(&tissue, &sp).unwrap();
+    let options = gpu::GpuOptions {
+        max_chunk_cells: Some(25),
+    };
+    let mut split =
+        GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap();
+    assert_eq!(split.n_chunks(), 3);
+    let a = split.evaluate(&tissue, sp.dt).unwrap();
+    let mut one = GpuBackend::new(&tissue, &sp).unwrap();
+    let b = one.evaluate(&tissue, sp.dt).unwrap();
+    let scale = max_abs(b.rhs.iter().map(|&v| f64::from(v)));
+    let err = max_abs(a.rhs.iter().zip(&b.rhs).map(|(x, y)| f64::from(x - y)));
+    println!("chunks: R: max |Δ| = {err:.3e} of max |R| = {scale:.3e}");
+    assert!(err <= 1e-6 * scale, "R differs by {err:e}");
+    let steps = 20;
+    let run = |backend: GpuBackend| {
+        let mut sim = Simulation::new(tissue.clone(), sp)
+            .with_backend(Box::new(backend))
+            .stop_iteration(tissue.iteration() + steps);
+        sim.run().unwrap();
+        sim.into_parts().0
+    };
+    let (x, y) = (run(whole), run(split));
+    let dphi = max_abs(
+        x.cells()
+            .phi()
+            .iter()
+            .zip(y.cells().phi())
+            .map(|(p, q)| p.to_f64() - q.to_f64()),
+    );
+    println!("chunks: {steps} steps: max |Δφ| = {dphi:.3e}");
+    assert!(dphi <= 1e-5, "φ differs by {dphi:e} after {steps} steps");
+    assert_eq!(x.cells().map().origin, y.cells().map().origin);
+}
+
+/// The device-memory estimate (quoted when a state does not fit) counts the three φ arrays
+/// of a step at 4 bytes a patch node and the lattice arrays at 48 bytes a node.
+#[test]
+fn the_memory_estimate_counts_every_array() {
+    let lattice = Lattice::new(12_910, 12_910);
+    let shape = PatchShape::new(lattice, 16).unwrap();
+    let m = gpu::GpuMemory::estimate(lattice, &shape, 1_000_000, 1);
+    // 10⁶ patches of 33² f32: 4.36 GB an array, three of them, plus the lattice (48 B a node).
+    assert_eq!(m.phi_array, 1_000_000 * 33 * 33 * 4);
+    assert_eq!(m.phi_arrays, 3);
+    let lattice_bytes = 12_910u64 * 12_910 * 48;
+    assert!(m.total >= 3 * m.phi_array + lattice_bytes);
+    assert!(m.total <= 3 * m.phi_array + lattice_bytes + 200_000_000);
+    println!("10⁶ cells at m = 16: {}", m.describe());
+}
