@@ -7,7 +7,7 @@ use gpu::GpuBackend;
 mod common;
 use mechanics::prelude::*;
 use mechanics::{CellState, SumField};
-use phasefield::{init, Lattice, PatchShape, Real};
+use phasefield::{init, Cells, Lattice, PatchShape, Real};
 
 /// 60 cells on 100² at margin 12, relaxed 40 TU on the CPU: the paper's scene at a stage
 /// where the cells touch and press on each other.
@@ -91,6 +91,22 @@ fn one_evaluation_agrees_with_the_cpu() {
     }
 }
 
+/// The largest difference of two states' fields, each cell compared on the lattice (so that
+/// patches placed differently compare node by node).
+fn lattice_diff<A: Real, B: Real>(a: &Cells<A>, b: &Cells<B>) -> f64 {
+    let n = a.lattice().len();
+    let (mut fa, mut fb) = (vec![0.0; n], vec![0.0; n]);
+    let mut d: f64 = 0.0;
+    for i in 0..a.n_cells() {
+        fa.fill(0.0);
+        fb.fill(0.0);
+        a.add_to_lattice(i, &mut fa);
+        b.add_to_lattice(i, &mut fb);
+        d = d.max(max_abs(fa.iter().zip(&fb).map(|(x, y)| x - y)));
+    }
+    d
+}
+
 /// Steps on both backends from the same state; returns the largest differences of φ (on the
 /// lattice, as each cell's patch values) and of the centres.
 fn steps_agree(zeta: f64, steps: u64) -> Option<(f64, f64)> {
@@ -110,15 +126,7 @@ fn steps_agree(zeta: f64, steps: u64) -> Option<(f64, f64)> {
     let g = on_gpu.tissue();
     assert_eq!(g.iteration(), cpu.iteration());
     let lattice = cpu.lattice();
-    let mut dphi: f64 = 0.0;
-    let (mut fa, mut fb) = (vec![0.0; lattice.len()], vec![0.0; lattice.len()]);
-    for i in 0..cpu.n_cells() {
-        fa.fill(0.0);
-        fb.fill(0.0);
-        cpu.cells().add_to_lattice(i, &mut fa);
-        g.cells().add_to_lattice(i, &mut fb);
-        dphi = dphi.max(max_abs(fa.iter().zip(&fb).map(|(a, b)| a - b)));
-    }
+    let dphi = lattice_diff(cpu.cells(), g.cells());
     let dc = max_abs(cpu.centres().iter().zip(g.centres()).flat_map(|(a, b)| {
         let d = |x: f64, l: usize| {
             let l = l as f64;
@@ -206,4 +214,45 @@ fn the_memory_estimate_counts_every_array() {
     assert!(m.total >= 3 * m.phi_array + lattice_bytes);
     assert!(m.total <= 3 * m.phi_array + lattice_bytes + 200_000_000);
     println!("10⁶ cells at m = 16: {}", m.describe());
+}
+
+/// What f32 arithmetic costs: 100 steps (20 TU) at ζ = 0.005 from one state, on the GPU (f32
+/// storage and arithmetic) and on the CPU (f32 storage, f64 arithmetic, its default), each
+/// against the CPU with f64 storage (the same patches and step: only the rounding differs).
+/// Both errors are set by f32 storage (about 1e-7 a step, growing through the dynamics);
+/// the GPU's f32 arithmetic may add to it, but by no more than a factor 4 (measured: see the
+/// printed figures and docs/performance.md).
+#[test]
+fn f32_arithmetic_costs_little_against_f32_storage() {
+    if common::try_device().is_none() {
+        return;
+    }
+    let t32 = paper_tissue(0.005);
+    let sp = StepParams::paper();
+    let steps = 100;
+    let mut t64 = Tissue::new(t32.cells().to_precision::<f64>(), t32.params().clone());
+    let mut ws = Workspace::new(t64.cells());
+    for _ in 0..steps {
+        t64.step(&mut ws, &sp).unwrap();
+    }
+    let mut cpu32 = t32.clone();
+    let mut ws = Workspace::new(cpu32.cells());
+    for _ in 0..steps {
+        cpu32.step(&mut ws, &sp).unwrap();
+    }
+    let gpu = GpuBackend::new(&t32, &sp).unwrap();
+    let mut sim = Simulation::new(t32.clone(), sp)
+        .with_backend(Box::new(gpu))
+        .stop_iteration(t32.iteration() + steps);
+    sim.run().unwrap();
+    let e_cpu = lattice_diff(t64.cells(), cpu32.cells());
+    let e_gpu = lattice_diff(t64.cells(), sim.tissue().cells());
+    println!(
+        "{steps} steps against f64: CPU f32 storage {e_cpu:.3e}, GPU f32 storage and arithmetic {e_gpu:.3e} (×{:.2})",
+        e_gpu / e_cpu
+    );
+    assert!(
+        e_cpu > 0.0 && e_gpu <= 4.0 * e_cpu,
+        "{e_gpu:e} against {e_cpu:e}"
+    );
 }
