@@ -22,7 +22,7 @@
 //! ```
 //!
 //! The layout of the step (buffers, kernels, dispatch order, how the sums are made
-//! deterministic) is in ARCHITECTURE.md; [`device`] finds the adapter, [`GpuBackend`] holds
+//! deterministic) is in ARCHITECTURE.md; [`Device`] finds the adapter, [`GpuBackend`] holds
 //! the buffers and records the steps.
 
 mod device;
