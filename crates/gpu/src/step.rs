@@ -24,13 +24,18 @@ const SOURCE: &str = include_str!("step.wgsl");
 /// The WGSL source of the step for patches of `shape` and the pressure form `kind`, with
 /// `cap` cells per bin: the file `step.wgsl` after its constants.
 pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String {
+    shader_source_split(shape, kind, cap, u32::MAX)
+}
+
+/// [`shader_source`] with the lattice arrays split into two bindings at node `split`.
+fn shader_source_split(shape: &PatchShape, kind: PressureKind, cap: u32, split: u32) -> String {
     let (nx, ny) = (shape.nx as u32, shape.ny as u32);
     let plen = nx * ny;
     let margin = shape.margin.unwrap_or(0) as u32;
     format!(
         "const NX: u32 = {nx}u;\nconst NY: u32 = {ny}u;\nconst PLEN: u32 = {plen}u;\n\
          const NPT: u32 = {npt}u;\nconst MARGIN: u32 = {margin}u;\nconst CAP: u32 = {cap}u;\n\
-         const PAPER: u32 = {paper}u;\n{SOURCE}",
+         const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n{SOURCE}",
         npt = plen.div_ceil(WG),
         paper = u32::from(kind == PressureKind::Paper),
     )
@@ -120,6 +125,11 @@ pub struct GpuOptions {
     /// largest storage binding holds (2³¹ − 1 bytes on Vulkan: about 490 k cells at margin
     /// 16). A smaller figure splits a small state into chunks, which tests the split.
     pub max_chunk_cells: Option<usize>,
+    /// The most lattice nodes in the first binding of each lattice array (the rest go into a
+    /// second); `None`: as many as a binding holds (2³¹ − 1 bytes: 1.3·10⁸ nodes of 16
+    /// bytes, a lattice of 11 585² or about 800 k cells at the paper's density). A smaller
+    /// figure splits a small lattice, which tests the split.
+    pub max_lattice_nodes: Option<usize>,
 }
 
 /// The split of cells `0..n` into chunks of at most `per` cells: `(lo, count)` each.
@@ -192,6 +202,9 @@ pub struct GpuBackend {
     phi: Vec<wgpu::Buffer>,
     k1: Vec<wgpu::Buffer>,
     lat: wgpu::Buffer,
+    lat_hi: wgpu::Buffer,
+    /// The nodes in `lat`; the rest are in `lat_hi`.
+    lat_split: usize,
     cell: wgpu::Buffer,
     origin: wgpu::Buffer,
     status: wgpu::Buffer,
@@ -303,6 +316,22 @@ impl GpuBackend {
             .clamp(1, fit)
             .min(n.max(1));
         let chunks = chunks(n, per_chunk);
+        let nodes = lattice.len();
+        let split = options
+            .max_lattice_nodes
+            .unwrap_or(usize::MAX)
+            .min((dev.max_binding() / 16) as usize)
+            .min(u32::MAX as usize)
+            .max(1);
+        if nodes > 2 * split {
+            return Err(GpuError::TooLarge(format!(
+                "a lattice of {}×{} ({nodes} nodes) needs more than two bindings of {split} nodes for each of its arrays ({}); reduce [domain] lx and ly",
+                lattice.lx,
+                lattice.ly,
+                dev.describe()
+            )));
+        }
+        let (lo_nodes, hi_nodes) = (nodes.min(split), nodes.saturating_sub(split));
         // Allocation failures (the state does not fit the device) are caught here and
         // reported with the estimate, not left to a later panic.
         let oom = dev.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
@@ -329,15 +358,20 @@ impl GpuBackend {
         let k1 = per_chunk_array("k1");
         let spare = (step.npc >= 2).then(|| per_chunk_array("spare"));
         let dummy = storage("dummy", 16, copy);
-        let acc = storage(
-            "chunk sums",
-            if chunks.len() > 1 {
-                lattice.len() as u64 * 32
-            } else {
-                16
-            },
-            copy,
-        );
+        // The lattice arrays, each in one binding of up to `split` nodes and one of the rest;
+        // the chunks' partial sums only where there is more than one chunk.
+        let lattice_array = |label: &str, nodes: usize, needed: bool| {
+            storage(label, if needed { nodes as u64 * 16 } else { 16 }, copy)
+        };
+        let several = chunks.len() > 1;
+        let lat = lattice_array("lattice sums", lo_nodes, true);
+        let lat_hi = lattice_array("lattice sums, second", hi_nodes, hi_nodes > 0);
+        let acc = [
+            lattice_array("chunk sums a", lo_nodes, several),
+            lattice_array("chunk sums a, second", hi_nodes, several && hi_nodes > 0),
+            lattice_array("chunk sums b", lo_nodes, several),
+            lattice_array("chunk sums b, second", hi_nodes, several && hi_nodes > 0),
+        ];
         let chunk_info: Vec<wgpu::Buffer> = chunks
             .iter()
             .enumerate()
@@ -357,7 +391,6 @@ impl GpuBackend {
             .collect();
         let cell = storage("cell", (n * CELL_STRIDE * 4) as u64, copy);
         let origin = storage("origin", (n * 8) as u64, copy);
-        let lat = storage("lattice sums", lattice.len() as u64 * 16, copy);
         let bin_count = storage("bin counts", u64::from(nb) * 4, copy);
         let bin_cells = storage("bin cells", u64::from(nb) * u64::from(cap) * 4, copy);
         let status = storage("status", 16, copy);
@@ -402,7 +435,7 @@ impl GpuBackend {
         let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("step.wgsl"),
             source: wgpu::ShaderSource::Wgsl(
-                shader_source(&shape, tissue.params().pressure, cap).into(),
+                shader_source_split(&shape, tissue.params().pressure, cap, split as u32).into(),
             ),
         });
         let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
@@ -438,7 +471,9 @@ impl GpuBackend {
             },
             count: None,
         });
-        entries.push(storage_entry(13, false));
+        for b in 13..=17 {
+            entries.push(storage_entry(b, false));
+        }
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("step"),
             entries: &entries,
@@ -474,7 +509,7 @@ impl GpuBackend {
             count: pipeline("count_step", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 14] = [
+            let bufs: [&wgpu::Buffer; 18] = [
                 &params_buf,
                 x,
                 old,
@@ -488,7 +523,11 @@ impl GpuBackend {
                 &trig,
                 &status,
                 &chunk_info[k],
-                &acc,
+                &acc[0],
+                &lat_hi,
+                &acc[1],
+                &acc[2],
+                &acc[3],
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -534,6 +573,8 @@ impl GpuBackend {
             phi,
             k1,
             lat,
+            lat_hi,
+            lat_split: lo_nodes,
             cell,
             origin,
             status,
@@ -653,7 +694,11 @@ impl GpuBackend {
         self.flush();
         let plen = self.shape.len();
         let rhs = self.read_chunks(&self.k1, plen)?;
-        let lat = self.read(&self.lat, self.lattice.len() as u64 * 16)?;
+        let mut lat = self.read(&self.lat, self.lat_split as u64 * 16)?;
+        let rest = self.lattice.len() - self.lat_split;
+        if rest > 0 {
+            lat.extend(self.read(&self.lat_hi, rest as u64 * 16)?);
+        }
         Ok(Evaluation {
             rhs: bytemuck::cast_slice(&rhs).to_vec(),
             lattice: bytemuck::cast_slice(&lat).to_vec(),

@@ -2,8 +2,9 @@
 // for the per-cell passes, one invocation per lattice node for the lattice sums.
 //
 // The host prepends the constants NX, NY, PLEN (= NX * NY), NPT (nodes per invocation,
-// ceil(PLEN / WG)), MARGIN, CAP (cells per bin) and PAPER (1 for the paper pressure form,
-// 0 for the interaction form).
+// ceil(PLEN / WG)), MARGIN, CAP (cells per bin), PAPER (1 for the paper pressure form,
+// 0 for the interaction form) and LAT_SPLIT (the lattice nodes in the first binding of each
+// lattice array).
 //
 // Every equation is one function below with the name of its Rust reference in
 // `mechanics::equations` or `phasefield::EnergyCoefficients`; the tests check each against it.
@@ -65,7 +66,10 @@ struct Status {
 // Per cell: the lattice origin of its patch (x, y).
 @group(0) @binding(6) var<storage, read_write> origin: array<vec2<u32>>;
 // Per node (x * ly + y): P, s2, Q_xx, Q_xy.
+// Split at node LAT_SPLIT into two bindings (lat, then lat_hi), so that a lattice of more
+// than 2³¹ bytes (1.3·10⁸ nodes) fits: read and written through lat_get and lat_set.
 @group(0) @binding(7) var<storage, read_write> lat: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read_write> lat_hi: array<vec4<f32>>;
 // Per bin: the number of cells whose origin lies in it.
 @group(0) @binding(8) var<storage, read_write> bin_count: array<atomic<u32>>;
 // Per bin: CAP slots of cell indices, sorted.
@@ -74,9 +78,47 @@ struct Status {
 @group(0) @binding(10) var<storage, read> trig: array<vec2<f32>>;
 @group(0) @binding(11) var<storage, read_write> status: Status;
 @group(0) @binding(12) var<uniform> chunk: Chunk;
-// Per node, with more than one chunk: the partial sums s1, s2, s3, s4, own, Q_xx, Q_xy (and
-// one unused) of the chunks before this one, two vec4 a node.
-@group(0) @binding(13) var<storage, read_write> acc: array<vec4<f32>>;
+// Per node, with more than one chunk: the partial sums of the chunks before this one,
+// s1, s2, s3, s4 in acc_a and own, Q_xx, Q_xy (and one unused) in acc_b, each split at
+// LAT_SPLIT as `lat` is.
+@group(0) @binding(13) var<storage, read_write> acc_a: array<vec4<f32>>;
+@group(0) @binding(15) var<storage, read_write> acc_a_hi: array<vec4<f32>>;
+@group(0) @binding(16) var<storage, read_write> acc_b: array<vec4<f32>>;
+@group(0) @binding(17) var<storage, read_write> acc_b_hi: array<vec4<f32>>;
+
+fn lat_get(node: u32) -> vec4<f32> {
+    if (node < LAT_SPLIT) {
+        return lat[node];
+    }
+    return lat_hi[node - LAT_SPLIT];
+}
+
+fn lat_set(node: u32, v: vec4<f32>) {
+    if (node < LAT_SPLIT) {
+        lat[node] = v;
+    } else {
+        lat_hi[node - LAT_SPLIT] = v;
+    }
+}
+
+fn acc_get(node: u32) -> array<vec4<f32>, 2> {
+    if (node < LAT_SPLIT) {
+        return array<vec4<f32>, 2>(acc_a[node], acc_b[node]);
+    }
+    let k = node - LAT_SPLIT;
+    return array<vec4<f32>, 2>(acc_a_hi[k], acc_b_hi[k]);
+}
+
+fn acc_set(node: u32, a: vec4<f32>, b: vec4<f32>) {
+    if (node < LAT_SPLIT) {
+        acc_a[node] = a;
+        acc_b[node] = b;
+    } else {
+        let k = node - LAT_SPLIT;
+        acc_a_hi[k] = a;
+        acc_b_hi[k] = b;
+    }
+}
 
 var<workgroup> red: array<vec4<f32>, WG>;
 var<workgroup> shared_v: vec4<f32>;
@@ -394,8 +436,9 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     var own = 0.0;
     var q = vec2<f32>(0.0);
     if (chunk.first == 0u) {
-        let a0 = acc[2u * node];
-        let a1 = acc[2u * node + 1u];
+        let ab = acc_get(node);
+        let a0 = ab[0];
+        let a1 = ab[1];
         s1 = a0.x;
         s2 = a0.y;
         s3 = a0.z;
@@ -436,10 +479,9 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         }
     }
     if (chunk.last == 1u) {
-        lat[node] = vec4<f32>(pressure_regrouped(s1, s2, s3, s4, own), s2, q.x, q.y);
+        lat_set(node, vec4<f32>(pressure_regrouped(s1, s2, s3, s4, own), s2, q.x, q.y));
     } else {
-        acc[2u * node] = vec4<f32>(s1, s2, s3, s4);
-        acc[2u * node + 1u] = vec4<f32>(own, q.x, q.y, 0.0);
+        acc_set(node, vec4<f32>(s1, s2, s3, s4), vec4<f32>(own, q.x, q.y, 0.0));
     }
 }
 
@@ -465,7 +507,7 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             let b = k % NY;
             let gx = (o.x + a) % prm.lx;
             let gy = (o.y + b) % prm.ly;
-            let f = lat[gx * prm.ly + gy];
+            let f = lat_get(gx * prm.ly + gy);
             fields[j] = f;
             let s = stencil(base, a, b);
             let p = f.x - pressure_self_part(s.c);

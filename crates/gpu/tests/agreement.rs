@@ -156,8 +156,9 @@ fn twenty_active_steps_agree_with_the_cpu() {
 }
 
 /// The per-cell arrays split into chunks (here 25 + 25 + 10 cells, as 10⁶ cells are split
-/// at a binding's 2³¹ bytes) give the state of one array to f32 round-off: only the order in
-/// which the lattice sums add the cells changes (chunk by chunk).
+/// at a binding's 2³¹ bytes) and the lattice arrays into two bindings (at node 6007 of 10⁴, mid-row)
+/// give the state of one array to f32 round-off: only the order in which the lattice sums
+/// add the cells changes (chunk by chunk).
 #[test]
 fn chunked_arrays_agree_with_one_array() {
     if common::try_device().is_none() {
@@ -168,6 +169,7 @@ fn chunked_arrays_agree_with_one_array() {
     let whole = GpuBackend::new(&tissue, &sp).unwrap();
     let options = gpu::GpuOptions {
         max_chunk_cells: Some(25),
+        max_lattice_nodes: Some(6_007),
     };
     let mut split =
         GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap();
@@ -230,7 +232,7 @@ fn f32_arithmetic_costs_little_against_f32_storage() {
     let t32 = paper_tissue(0.005);
     let sp = StepParams::paper();
     let steps = 100;
-    let mut t64 = Tissue::new(t32.cells().to_precision::<f64>(), t32.params().clone());
+    let mut t64 = Tissue::new(t32.cells().to_precision::<f64>(), *t32.params());
     let mut ws = Workspace::new(t64.cells());
     for _ in 0..steps {
         t64.step(&mut ws, &sp).unwrap();
@@ -255,4 +257,40 @@ fn f32_arithmetic_costs_little_against_f32_storage() {
         e_cpu > 0.0 && e_gpu <= 4.0 * e_cpu,
         "{e_gpu:e} against {e_cpu:e}"
     );
+}
+
+/// The lattice arrays split into two bindings (at node 6007 of 10⁴, mid-row, as a lattice above 1.3·10⁸
+/// nodes is split) change no sum's order: R and the state after 20 steps are bit-identical.
+#[test]
+fn a_split_lattice_is_the_same_to_the_bit() {
+    if common::try_device().is_none() {
+        return;
+    }
+    let tissue = paper_tissue(0.005);
+    let sp = StepParams::paper();
+    let options = gpu::GpuOptions {
+        max_chunk_cells: None,
+        max_lattice_nodes: Some(6_007),
+    };
+    let open = |options| {
+        GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap()
+    };
+    let (mut a, mut b) = (open(options), open(gpu::GpuOptions::default()));
+    let (ea, eb) = (
+        a.evaluate(&tissue, sp.dt).unwrap(),
+        b.evaluate(&tissue, sp.dt).unwrap(),
+    );
+    assert!(
+        ea.rhs == eb.rhs && ea.lattice == eb.lattice,
+        "one evaluation"
+    );
+    let run = |backend: GpuBackend| {
+        let mut sim = Simulation::new(tissue.clone(), sp)
+            .with_backend(Box::new(backend))
+            .stop_iteration(tissue.iteration() + 20);
+        sim.run().unwrap();
+        sim.into_parts().0
+    };
+    let (x, y) = (run(a), run(b));
+    assert!(x.cells().phi() == y.cells().phi(), "20 steps");
 }
