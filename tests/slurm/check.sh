@@ -17,8 +17,14 @@ if ! command -v sbatch >/dev/null || ! command -v munged >/dev/null; then
     apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq slurm-wlm munge >/dev/null
 fi
-cargo build --release --locked -p monolayer-cli
-bin="$PWD/target/release/monolayer"
+# MONOLAYER_BIN: a binary built already (.ci/run passes the test build's, so that CI does not
+# build the workspace's dependencies a second time with another feature set).
+if [ -n "${MONOLAYER_BIN:-}" ]; then
+    bin="$MONOLAYER_BIN"
+else
+    cargo build --release --locked -p monolayer-cli
+    bin="$PWD/target/release/monolayer"
+fi
 
 work=$(mktemp -d /tmp/monolayer-slurm.XXXXXX)
 export SLURM_CONF="$work/slurm.conf"
