@@ -16,12 +16,28 @@ fn paper_tissue(zeta: f64) -> Tissue<f32> {
     let shape = PatchShape::new(lattice, 12).unwrap();
     let centres = init::positions(lattice, 60, 4.0, &init::Layout::Random { seed: 1 }).unwrap();
     let cells = init::discs(lattice, shape, &centres, 4.0, 2.5).to_precision::<f32>();
-    let mut t = Tissue::new(cells, ModelParams::paper(0.0));
-    let mut ws = Workspace::new(t.cells());
-    for _ in 0..200 {
-        t.step(&mut ws, &StepParams::paper()).unwrap();
-    }
+    let relaxing = Tissue::new(cells, ModelParams::paper(0.0));
+    let mut t = cpu_steps(&relaxing, StepParams::paper(), 200);
     t.params_mut().zeta = zeta;
+    t
+}
+
+/// The state after `steps` steps of `backend` from `tissue`.
+fn gpu_steps(backend: GpuBackend, tissue: &Tissue<f32>, sp: StepParams, steps: u64) -> Tissue<f32> {
+    let mut sim = Simulation::new(tissue.clone(), sp)
+        .with_backend(Box::new(backend))
+        .stop_iteration(tissue.iteration() + steps);
+    sim.run().unwrap();
+    sim.into_parts().0
+}
+
+/// The state after `steps` steps of the CPU backend from `tissue`.
+fn cpu_steps<T: Real>(tissue: &Tissue<T>, sp: StepParams, steps: u64) -> Tissue<T> {
+    let mut t = tissue.clone();
+    let mut ws = Workspace::new(t.cells());
+    for _ in 0..steps {
+        t.step(&mut ws, &sp).unwrap();
+    }
     t
 }
 
@@ -114,16 +130,8 @@ fn steps_agree(zeta: f64, steps: u64) -> Option<(f64, f64)> {
     let tissue = paper_tissue(zeta);
     let sp = StepParams::paper();
     let gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
-    let mut on_gpu = Simulation::new(tissue.clone(), sp)
-        .with_backend(Box::new(gpu))
-        .stop_iteration(tissue.iteration() + steps);
-    on_gpu.run().unwrap();
-    let mut cpu = tissue.clone();
-    let mut ws = Workspace::new(cpu.cells());
-    for _ in 0..steps {
-        cpu.step(&mut ws, &sp).unwrap();
-    }
-    let g = on_gpu.tissue();
+    let g = &gpu_steps(gpu, &tissue, sp, steps);
+    let cpu = cpu_steps(&tissue, sp, steps);
     assert_eq!(g.iteration(), cpu.iteration());
     let lattice = cpu.lattice();
     let dphi = lattice_diff(cpu.cells(), g.cells());
@@ -156,9 +164,9 @@ fn twenty_active_steps_agree_with_the_cpu() {
 }
 
 /// The per-cell arrays split into chunks (here 25 + 25 + 10 cells, as 10⁶ cells are split
-/// at a binding's 2³¹ bytes) and the lattice arrays into two bindings (at node 6007 of 10⁴, mid-row)
-/// give the state of one array to f32 round-off: only the order in which the lattice sums
-/// add the cells changes (chunk by chunk).
+/// at a binding's 2³¹ bytes) and the lattice arrays into two bindings (at node 6007 of 10⁴,
+/// mid-row) give the state of one array to f32 round-off: only the order in which the
+/// lattice sums add the cells changes (chunk by chunk).
 #[test]
 fn chunked_arrays_agree_with_one_array() {
     if common::try_device().is_none() {
@@ -182,14 +190,10 @@ fn chunked_arrays_agree_with_one_array() {
     println!("chunks: R: max |Δ| = {err:.3e} of max |R| = {scale:.3e}");
     assert!(err <= 1e-6 * scale, "R differs by {err:e}");
     let steps = 20;
-    let run = |backend: GpuBackend| {
-        let mut sim = Simulation::new(tissue.clone(), sp)
-            .with_backend(Box::new(backend))
-            .stop_iteration(tissue.iteration() + steps);
-        sim.run().unwrap();
-        sim.into_parts().0
-    };
-    let (x, y) = (run(whole), run(split));
+    let (x, y) = (
+        gpu_steps(whole, &tissue, sp, steps),
+        gpu_steps(split, &tissue, sp, steps),
+    );
     let dphi = max_abs(
         x.cells()
             .phi()
@@ -232,23 +236,12 @@ fn f32_arithmetic_costs_little_against_f32_storage() {
     let t32 = paper_tissue(0.005);
     let sp = StepParams::paper();
     let steps = 100;
-    let mut t64 = Tissue::new(t32.cells().to_precision::<f64>(), *t32.params());
-    let mut ws = Workspace::new(t64.cells());
-    for _ in 0..steps {
-        t64.step(&mut ws, &sp).unwrap();
-    }
-    let mut cpu32 = t32.clone();
-    let mut ws = Workspace::new(cpu32.cells());
-    for _ in 0..steps {
-        cpu32.step(&mut ws, &sp).unwrap();
-    }
-    let gpu = GpuBackend::new(&t32, &sp).unwrap();
-    let mut sim = Simulation::new(t32.clone(), sp)
-        .with_backend(Box::new(gpu))
-        .stop_iteration(t32.iteration() + steps);
-    sim.run().unwrap();
+    let t64 = Tissue::new(t32.cells().to_precision::<f64>(), *t32.params());
+    let t64 = cpu_steps(&t64, sp, steps);
+    let cpu32 = cpu_steps(&t32, sp, steps);
+    let gpu = gpu_steps(GpuBackend::new(&t32, &sp).unwrap(), &t32, sp, steps);
     let e_cpu = lattice_diff(t64.cells(), cpu32.cells());
-    let e_gpu = lattice_diff(t64.cells(), sim.tissue().cells());
+    let e_gpu = lattice_diff(t64.cells(), gpu.cells());
     println!(
         "{steps} steps against f64: CPU f32 storage {e_cpu:.3e}, GPU f32 storage and arithmetic {e_gpu:.3e} (×{:.2})",
         e_gpu / e_cpu
@@ -259,8 +252,9 @@ fn f32_arithmetic_costs_little_against_f32_storage() {
     );
 }
 
-/// The lattice arrays split into two bindings (at node 6007 of 10⁴, mid-row, as a lattice above 1.3·10⁸
-/// nodes is split) change no sum's order: R and the state after 20 steps are bit-identical.
+/// The lattice arrays split into two bindings (at node 6007 of 10⁴, mid-row, as a lattice
+/// above 1.3·10⁸ nodes is split) change no sum's order: R and the state after 20 steps are
+/// bit-identical.
 #[test]
 fn a_split_lattice_is_the_same_to_the_bit() {
     if common::try_device().is_none() {
@@ -284,13 +278,6 @@ fn a_split_lattice_is_the_same_to_the_bit() {
         ea.rhs == eb.rhs && ea.lattice == eb.lattice,
         "one evaluation"
     );
-    let run = |backend: GpuBackend| {
-        let mut sim = Simulation::new(tissue.clone(), sp)
-            .with_backend(Box::new(backend))
-            .stop_iteration(tissue.iteration() + 20);
-        sim.run().unwrap();
-        sim.into_parts().0
-    };
-    let (x, y) = (run(a), run(b));
+    let (x, y) = (gpu_steps(a, &tissue, sp, 20), gpu_steps(b, &tissue, sp, 20));
     assert!(x.cells().phi() == y.cells().phi(), "20 steps");
 }
