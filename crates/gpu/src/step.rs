@@ -11,6 +11,10 @@ use wgpu::util::DeviceExt;
 use crate::device::{Device, GpuError};
 
 /// Invocations per workgroup (the shader's `WG`).
+/// The extensions of the paper's model the GPU backend runs: none yet (issue 40), so a tissue
+/// with any part of [`mechanics::Part::ALL`] is refused by [`GpuBackend::check`], naming it.
+pub const SUPPORTED: &[mechanics::Part] = &[];
+
 const WG: u32 = 256;
 /// Workgroups along one dimension of a dispatch (Vulkan's guaranteed minimum).
 const MAX_GROUPS: u32 = 65_535;
@@ -251,7 +255,7 @@ impl GpuBackend {
     /// # Errors
     /// [`GpuError::Unsupported`] or [`GpuError::Setting`].
     pub fn check<T: Real>(tissue: &Tissue<T>, step: &StepParams) -> Result<(), GpuError> {
-        let ext = tissue.extensions();
+        let ext = mechanics::backend::unsupported(tissue, SUPPORTED);
         if !ext.is_empty() {
             return Err(GpuError::Unsupported(ext.join(", ")));
         }
@@ -884,6 +888,10 @@ impl GpuBackend {
 }
 
 impl<T: Real> Backend<T> for GpuBackend {
+    fn supports(&self, part: mechanics::Part) -> bool {
+        SUPPORTED.contains(&part)
+    }
+
     fn name(&self) -> &str {
         "gpu"
     }

@@ -191,7 +191,7 @@ impl<T: Real> Tissue<T> {
             if next.is_nan() || next < params.dt_min {
                 // Back to the last good state.
                 self.cells.swap_phi(&mut ws.phi_old);
-                self.terms.restore();
+                self.ext.terms.restore();
                 return Err(StepError::StepTooSmall {
                     step: self.iteration,
                     time: self.time,

@@ -9,6 +9,7 @@
 
 use phasefield::Real;
 
+use crate::extensions::Part;
 use crate::params::StepParams;
 use crate::tissue::Tissue;
 use crate::StepError;
@@ -26,6 +27,11 @@ use crate::StepError;
 pub trait Backend<T: Real>: Send {
     /// A short name for messages, such as `"gpu"`.
     fn name(&self) -> &str;
+
+    /// Whether it runs the extension `part` of the model ([`crate::Tissue::parts`]); a
+    /// tissue with a part its backend does not support is refused before any step
+    /// ([`unsupported`]).
+    fn supports(&self, part: Part) -> bool;
 
     /// Queues one step of size `params.dt` with `params.npc` corrector passes.
     ///
@@ -80,26 +86,16 @@ impl<T: Real> Tissue<T> {
         self.iteration = iteration;
         self.time = time;
     }
+}
 
-    /// Whether the tissue has anything beyond the paper's minimal model: physics terms,
-    /// populations, walls or division. Each such part is named, for a backend's refusal.
-    pub fn extensions(&self) -> Vec<&'static str> {
-        let mut out = Vec::new();
-        if !self.terms.is_empty() {
-            out.push("physics terms ([polarity])");
-        }
-        if self.params.omega != 0.0 {
-            out.push("adhesion ([adhesion])");
-        }
-        if !self.populations.is_empty() {
-            out.push("populations ([[population]])");
-        }
-        if self.walls.is_some() {
-            out.push("walls ([walls])");
-        }
-        if self.proliferation.is_some() {
-            out.push("division ([division])");
-        }
-        out
-    }
+/// The parts of `tissue` that a backend supporting only `supported` cannot run, each named
+/// with its scene table (empty: it runs them all). The one refusal list: a backend declares
+/// what it supports, and every check derives from [`crate::Tissue::parts`].
+pub fn unsupported<T: Real>(tissue: &Tissue<T>, supported: &[Part]) -> Vec<String> {
+    tissue
+        .parts()
+        .into_iter()
+        .filter(|p| !supported.contains(p))
+        .map(Part::describe)
+        .collect()
 }

@@ -70,7 +70,7 @@ impl<T: Real> Tissue<T> {
         self.scatter_velocity(ws);
         // With populations of their own ζ the sums hold `Σ ζ_j φ_j S_j`, the active stress's
         // tensor, and `Q` is scattered again unweighted.
-        let mixed = self.populations.mixed_zeta(&self.params, self.active);
+        let mixed = self.ext.populations.mixed_zeta(&self.params, self.active);
         let zeta = if mixed { 1.0 } else { self.params.zeta };
         let [vx, vy] = ws.velocity_field();
         let mut f = TissueFields {

@@ -57,6 +57,7 @@ pub mod adaptive;
 pub mod backend;
 pub mod division;
 pub mod equations;
+pub mod extensions;
 mod fields;
 mod geometry;
 mod kernels;
@@ -71,6 +72,7 @@ pub mod walls;
 mod workspace;
 
 pub use adaptive::{AdaptiveParams, Controller};
+pub use extensions::{Extensions, Part};
 pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
 pub use kernels::thread_scratch_bytes;
@@ -133,6 +135,23 @@ pub enum StepError {
         dt: f64,
         /// The tolerance.
         tolerance: f64,
+    },
+    /// A physics term's state relaxes too fast for the time step (its stiffness `k` with
+    /// `k·dt > 2`, where Heun's step is unstable): the polarity's alignment rate, say.
+    #[error("at step {step} (t = {time:.3}) the {term} term of cell {cell} relaxes its state at a rate {stiffness:.3e} per time unit, and the step dt = {dt} is unstable above 2/dt = {limit:.3e}: lower the term's rate (for polarity: [polarity] align_rate, or the population's) by {factor:.1}× or more, or [integrator] dt", limit = 2.0 / dt, factor = stiffness * dt / 2.0)]
+    TermUnstable {
+        /// Step at which it was found.
+        step: u64,
+        /// Model time at which it was found.
+        time: f64,
+        /// The term's name.
+        term: String,
+        /// The identity of the stiffest cell.
+        cell: usize,
+        /// Its stiffness (per time unit).
+        stiffness: f64,
+        /// The time step.
+        dt: f64,
     },
     /// The device of a [`backend::Backend`] failed or cannot run what was asked.
     #[error("the {backend} backend: {message}")]

@@ -148,6 +148,19 @@ pub enum SimulationError {
         /// Its error.
         source: CallbackError,
     },
+    /// Every cell died or was extruded: the last one was due to go too, and a tissue cannot
+    /// be empty, so the run stops with it in place.
+    #[error("every cell is gone at step {iteration} (t = {time:.3}): the last one (cell {cell}) was due for {why} too, and a tissue cannot be empty, so the run stops here; for a tissue that lasts, lower [division] death_rate or extrusion, or raise the division rate")]
+    Extinct {
+        /// The iteration.
+        iteration: u64,
+        /// The time.
+        time: f64,
+        /// The last cell's identity.
+        cell: usize,
+        /// Why it was due to go: `"death"` or `"extrusion"`.
+        why: &'static str,
+    },
     /// Nothing would stop the run.
     #[error(
         "the simulation has no stop criterion: set stop_iteration, stop_time or wall_time_limit"
@@ -764,8 +777,16 @@ impl<T: Real> Simulation<T> {
                 }
             }
             self.apply_activity();
-            self.tissue.proliferate(&mut self.workspace);
+            let events = self.tissue.proliferate(&mut self.workspace);
             let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
+            if let Some((cell, why)) = events.spared {
+                return Err(SimulationError::Extinct {
+                    iteration,
+                    time,
+                    cell,
+                    why: why.name(),
+                });
+            }
             for (name, timer, fix) in &mut self.fixes {
                 if timer.fires(iteration, time, false) {
                     fix.apply(&mut self.tissue)

@@ -184,19 +184,35 @@ impl<T: Real> Tissue<T> {
             dt,
         };
         check.check(at, cell_state)?;
+        if !self.ext.terms.is_empty() {
+            if let Some((term, stiffness, cell)) =
+                self.ext.terms.stiffest(&self.terms_view(cell_state))
+            {
+                if stiffness.is_nan() || stiffness * dt > 2.0 {
+                    return Err(StepError::TermUnstable {
+                        step: self.iteration,
+                        time: self.time,
+                        term: term.to_string(),
+                        cell,
+                        stiffness,
+                        dt,
+                    });
+                }
+            }
+        }
         self.cells.swap_phi(phi_old);
-        if !self.terms.is_empty() {
+        if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.begin(view));
         }
         if let Some(h) = predict {
-            self.terms.predict(h);
+            self.ext.terms.predict(h);
         }
         Ok(())
     }
 
     /// The walls in effect, with their coefficients.
     fn wall_term(&self) -> Option<WallTerm<'_>> {
-        let walls = self.walls.as_ref()?;
+        let walls = self.ext.walls.as_ref()?;
         Some(WallTerm {
             field: walls.field(self.active)?,
             coefficients: wall_coefficients(walls.kappa, walls.omega, self.params.energy.lambda),
@@ -210,7 +226,7 @@ impl<T: Real> Tissue<T> {
             ids: &self.cell_id,
             centres: &self.centre,
             active: self.active,
-            populations: &self.populations,
+            populations: &self.ext.populations,
             iteration: self.iteration,
         }
     }
@@ -222,9 +238,9 @@ impl<T: Real> Tissue<T> {
         cell_state: &[CellState],
         f: impl FnOnce(&mut crate::terms::Terms, &CellsView<'_>),
     ) {
-        let mut terms = std::mem::take(&mut self.terms);
+        let mut terms = std::mem::take(&mut self.ext.terms);
         f(&mut terms, &self.terms_view(cell_state));
-        self.terms = terms;
+        self.ext.terms = terms;
     }
 
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
@@ -260,7 +276,7 @@ impl<T: Real> Tissue<T> {
             },
         );
         self.cells.swap_phi(phi_old);
-        if !self.terms.is_empty() {
+        if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
         }
     }
@@ -268,7 +284,7 @@ impl<T: Real> Tissue<T> {
     /// The predictor `φ = φ_old + h k1` (forward Euler) from what [`Tissue::start_step`]
     /// left in `ws`.
     pub(crate) fn predict(&mut self, ws: &Workspace<T>, h: f64) {
-        self.terms.predict(h);
+        self.ext.terms.predict(h);
         let phi = self.cells.phi_mut();
         phi.par_iter_mut()
             .zip(ws.phi_old.par_iter().zip(ws.k1.par_iter()))
@@ -297,7 +313,7 @@ impl<T: Real> Tissue<T> {
             term_scratch,
             Post::Nothing,
         );
-        if !self.terms.is_empty() {
+        if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
         }
         let updates = self
@@ -325,7 +341,7 @@ impl<T: Real> Tissue<T> {
     /// Whether a step computes the deformation tensors and `Q`: only the active force uses
     /// them (see [`evaluate`]).
     fn step_needs_shapes(&self) -> bool {
-        self.populations.any_activity(&self.params, self.active)
+        self.ext.populations.any_activity(&self.params, self.active)
     }
 
     /// [`evaluate`] of the current fields, into `out` and the workspace parts given.
@@ -365,10 +381,12 @@ impl<T: Real> Tissue<T> {
         }
         // The terms' whole-cell forces of the current state, from the per-cell quantities the
         // last evaluation left (see `CellContext::state`).
-        let cell_force = if self.terms.is_empty() {
+        let cell_force = if self.ext.terms.is_empty() {
             None
         } else {
-            self.terms.forces(&self.terms_view(cell_state), cell_force);
+            self.ext
+                .terms
+                .forces(&self.terms_view(cell_state), cell_force);
             Some(&cell_force[..])
         };
         evaluate(
@@ -383,10 +401,10 @@ impl<T: Real> Tissue<T> {
             lap_s1,
             node_terms,
             (
-                &self.populations,
+                &self.ext.populations,
                 &self.cell_id,
                 self.active,
-                &self.target_scale,
+                &self.ext.target_scale,
             ),
             kind_constants,
             self.wall_term(),

@@ -4,7 +4,7 @@ use nalgebra::Vector2;
 use phasefield::{Cells, ComTable, Lattice, Real};
 use rayon::prelude::*;
 
-use crate::division::Proliferation;
+use crate::extensions::{Extensions, Part};
 use crate::params::ModelParams;
 use crate::terms::{Populations, Terms};
 use crate::walls::Walls;
@@ -32,19 +32,10 @@ pub struct Tissue<T: Real = f64> {
     /// is the sort key. Only the step writes it.
     pub(crate) centre: Vec<[f64; 2]>,
     pub(crate) cell_id: Vec<usize>,
-    /// The physics terms beyond the minimal model, with their per-cell state by identity.
-    pub(crate) terms: Terms,
     /// Whether activity is on (the relaxation switch; see [`Tissue::set_active`]).
     pub(crate) active: bool,
-    /// Per-cell parameters (empty: every cell has `params`').
-    pub(crate) populations: Populations,
-    /// Walls (`crate::walls`), if any.
-    pub(crate) walls: Option<Walls>,
-    /// The cell-cycle clock and the lineage (`crate::division`), if cells divide.
-    pub(crate) proliferation: Option<Box<Proliferation>>,
-    /// Each identity's target area as a multiple of `πR²` (the growth before a division;
-    /// empty: 1 for every cell), set by the clock after each step.
-    pub(crate) target_scale: Vec<f64>,
+    /// Every part of the model beyond the paper's (terms, populations, walls, division).
+    pub(crate) ext: Extensions,
 }
 
 impl<T: Real> Tissue<T> {
@@ -52,10 +43,7 @@ impl<T: Real> Tissue<T> {
     /// With [`crate::Workspace::heap_bytes`], the memory a simulation needs.
     pub fn heap_bytes(&self) -> usize {
         self.cells.heap_bytes()
-            + self.terms.heap_bytes()
-            + self.walls.as_ref().map_or(0, Walls::heap_bytes)
-            + self.proliferation.as_ref().map_or(0, |p| p.heap_bytes())
-            + self.target_scale.capacity() * std::mem::size_of::<f64>()
+            + self.ext.heap_bytes()
             + self.centre.capacity() * std::mem::size_of::<[f64; 2]>()
             + self.cell_id.capacity() * std::mem::size_of::<usize>()
     }
@@ -96,12 +84,8 @@ impl<T: Real> Tissue<T> {
             params,
             time,
             iteration,
-            terms: Terms::default(),
             active: true,
-            populations: Populations::default(),
-            walls: None,
-            proliferation: None,
-            target_scale: Vec::new(),
+            ext: Extensions::none(),
         };
         let com = ComTable::new(t.cells.lattice());
         let mut centre = std::mem::take(&mut t.centre);
@@ -142,20 +126,58 @@ impl<T: Real> Tissue<T> {
             iteration,
             centre,
             cell_id,
-            terms: Terms::default(),
             active: true,
-            populations: Populations::default(),
-            walls: None,
-            proliferation: None,
-            target_scale: Vec::new(),
+            ext: Extensions::none(),
         })
+    }
+
+    /// This tissue with the extensions `ext` (all of them at once: what a scene builds),
+    /// replacing any it had: the terms' per-cell state initialised from their seed where it
+    /// is not there already, and the clock's growth factors set.
+    ///
+    /// # Panics
+    /// If the populations do not assign every identity `0..`[`Tissue::next_id`], or the walls
+    /// are on another lattice.
+    pub fn with_extensions(self, ext: Extensions) -> Self {
+        let Extensions {
+            terms,
+            populations,
+            walls,
+            proliferation,
+            target_scale: _,
+        } = ext;
+        let mut t = self.with_terms(terms).with_populations(populations);
+        t.ext.walls = None;
+        if let Some(walls) = walls {
+            t = t.with_walls(walls);
+        }
+        t.ext.proliferation = None;
+        t.ext.target_scale.clear();
+        match proliferation {
+            Some(clock) => t.with_proliferation(*clock),
+            None => t,
+        }
+    }
+
+    /// The extensions of the paper's model this tissue has.
+    pub fn extensions(&self) -> &Extensions {
+        &self.ext
+    }
+
+    /// The parts beyond the paper's model this tissue has, in [`Part::ALL`]'s order (for a
+    /// backend's refusal: [`crate::backend::Backend`]).
+    pub fn parts(&self) -> Vec<Part> {
+        Part::ALL
+            .into_iter()
+            .filter(|&p| self.ext.has(p, &self.params))
+            .collect()
     }
 
     /// This tissue with the physics terms `terms` (`crate::terms`), their per-cell state
     /// initialised from their seed unless it is there already.
     pub fn with_terms(mut self, mut terms: Terms) -> Self {
         terms.initialise(self.next_id());
-        self.terms = terms;
+        self.ext.terms = terms;
         self
     }
 
@@ -170,7 +192,7 @@ impl<T: Real> Tissue<T> {
             populations.of_cell().len(),
             self.next_id()
         );
-        self.populations = populations;
+        self.ext.populations = populations;
         self
     }
 
@@ -181,34 +203,34 @@ impl<T: Real> Tissue<T> {
             Some(self.lattice()),
             "the walls' lattice is the tissue's"
         );
-        self.walls = Some(walls);
+        self.ext.walls = Some(walls);
         self
     }
 
     /// The walls, if any.
     pub fn walls(&self) -> Option<&Walls> {
-        self.walls.as_ref()
+        self.ext.walls.as_ref()
     }
 
     /// The wall field in effect now (none without walls, or once a wound has opened).
     pub fn wall_field(&self) -> Option<&phasefield::WallField> {
-        self.walls.as_ref().and_then(|w| w.field(self.active))
+        self.ext.walls.as_ref().and_then(|w| w.field(self.active))
     }
 
     /// The populations (empty when every cell has the tissue's parameters).
     pub fn populations(&self) -> &Populations {
-        &self.populations
+        &self.ext.populations
     }
 
     /// The physics terms and their per-cell state.
     pub fn terms(&self) -> &Terms {
-        &self.terms
+        &self.ext.terms
     }
 
     /// The physics terms, to restore their state from a checkpoint
     /// ([`Terms::set_variable`]) or change them between steps.
     pub fn terms_mut(&mut self) -> &mut Terms {
-        &mut self.terms
+        &mut self.ext.terms
     }
 
     /// Whether activity is on: the active terms (ζ is set apart, by [`Tissue::params_mut`]) act

@@ -19,8 +19,9 @@
 //! | `cell_id` | `(N,)` int64 | identity of each slot |
 //! | `scene` | `(bytes,)` uint8 | the resolved scene (TOML) |
 //! | `controller` | `(5,)` | adaptive runs only: [`mechanics::Controller::to_array`] |
+//! | the extensions' state | | every array of [`mechanics::Extensions::state_arrays`], under its name: |
 //! | `TERM.VARIABLE` | `(M,)` | each physics term's per-cell state, by identity `0..M` (e.g. `polarity.theta`; [`mechanics::terms::Terms::variables`]; `M = N` while no cell divided) |
-//! | `population` | `(M,)` int64 | with `[[population]]` and `[division]`: each identity's population |
+//! | `population` | `(M,)` int64 | with `[[population]]`: each identity's population |
 //! | `lineage` | `(K, 9)` | with `[division]`: every cell that lived, one row each: id, parent (−1 for a founder), birth, death (NaN while alive), ending (0 alive, 1 division, 2 extrusion, 3 death), generation, cycle, and the centre `x, y` where it ended |
 //!
 //! Each is written under a temporary name, flushed to disk (`fsync`) and renamed, so a kill
@@ -30,8 +31,8 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use mechanics::division::{Ending, LineageRecord, Proliferation};
-use mechanics::{Controller, Tissue};
+use mechanics::extensions::Source;
+use mechanics::{Controller, Extensions, Tissue};
 use phasefield::{Cells, Real};
 
 use crate::frame::{npy, read_npz, write_zip};
@@ -130,22 +131,20 @@ pub fn write_checkpoint<T: Real>(
         .into_iter()
         .map(|(name, a)| (name.to_string(), a))
         .collect();
-    for (name, values) in term_arrays(tissue) {
-        let a =
-            npy(&[values.len() as u64], values).map_err(|e| RunDirError::io("encode", &path, e))?;
-        arrays.push((name, a));
-    }
-    if let Some(clock) = tissue.proliferation() {
-        let pops = tissue.populations().of_cell();
-        if !pops.is_empty() {
-            let a = npy(&[pops.len() as u64], pops.iter().map(|&k| i64::from(k)))
-                .map_err(|e| RunDirError::io("encode", &path, e))?;
-            arrays.push(("population".into(), a));
+    for array in tissue.extensions().state_arrays() {
+        let rows = (array.values.len() / array.columns) as u64;
+        let shape = if array.columns == 1 {
+            vec![rows]
+        } else {
+            vec![rows, array.columns as u64]
+        };
+        let a = if array.integer {
+            npy(&shape, array.values.iter().map(|&v| v as i64))
+        } else {
+            npy(&shape, array.values.iter().copied())
         }
-        let rows = lineage_rows(clock);
-        let a = npy(&[rows.len() as u64, 9], rows.into_iter().flatten())
-            .map_err(|e| RunDirError::io("encode", &path, e))?;
-        arrays.push(("lineage".into(), a));
+        .map_err(|e| RunDirError::io("encode", &path, e))?;
+        arrays.push((array.name, a));
     }
     if let Some(c) = controller {
         let a = npy(&[5], c.to_array()).map_err(|e| RunDirError::io("encode", &path, e))?;
@@ -288,156 +287,37 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
     let centre: Vec<[f64; 2]> = a[9].data.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
     let ids: Vec<usize> = a[10].data.iter().map(|&v| v as usize).collect();
     let tissue = Tissue::restore(cells, scene.model_params(zeta), time, step, centre, ids)
-        .map_err(|r| bad("cell_id", r))?
-        .with_terms(scene.terms());
-    let Some(restored) = scene.restored_clock(read_lineage(path)?) else {
-        return read_terms(path, tissue.with_populations(scene.populations()), true);
-    };
-    let clock = restored.map_err(|r| bad("lineage", r))?;
-    let populations = scene.populations();
-    let populations = if populations.is_empty() {
-        populations
-    } else {
-        let of_cell = read_npz(path, &["population"])?.remove(0).data;
-        populations
-            .reassigned(&of_cell, tissue.next_id())
-            .map_err(|r| bad("population", r))?
-    };
-    let tissue = tissue
-        .with_populations(populations)
-        .with_proliferation(clock);
-    read_terms(path, tissue, true)
+        .map_err(|r| bad("cell_id", r))?;
+    let ext = scene.extensions(&tissue);
+    read_extensions(path, tissue, ext, Source::Checkpoint)
 }
 
-/// How the `lineage` array codes why a cell's life ended (0: it lives).
-const ENDING_CODES: [(Ending, f64); 3] = [
-    (Ending::Division, 1.0),
-    (Ending::Extrusion, 2.0),
-    (Ending::Death, 3.0),
-];
-
-/// The lineage of `clock` as the rows of the checkpoint's `lineage` array.
-fn lineage_rows(clock: &Proliferation) -> Vec<[f64; 9]> {
-    clock
-        .lineage()
-        .map(|r| {
-            let (death, ending) = match r.death {
-                None => (f64::NAN, 0.0),
-                Some((t, why)) => {
-                    let code = ENDING_CODES.iter().find(|(e, _)| *e == why);
-                    (t, code.expect("every ending has a code").1)
-                }
-            };
-            [
-                r.id as f64,
-                r.parent.map_or(-1.0, |p| p as f64),
-                r.birth,
-                death,
-                ending,
-                f64::from(r.generation),
-                r.cycle,
-                r.place[0],
-                r.place[1],
-            ]
-        })
-        .collect()
-}
-
-/// The lineage of a checkpoint (empty when it has none).
-///
-/// # Errors
-/// A damaged `lineage` array.
-fn read_lineage(path: &Path) -> Result<Vec<LineageRecord>> {
-    let a = match read_npz(path, &["lineage"]) {
-        Err(RunDirError::MissingArray { .. }) => return Ok(Vec::new()),
-        Err(e) => return Err(e),
-        Ok(mut a) => a.remove(0),
-    };
-    let bad = |reason: String| RunDirError::BadArray {
-        path: path.to_path_buf(),
-        name: "lineage".into(),
-        reason,
-    };
-    if a.data.len() % 9 != 0 {
-        return Err(bad(format!("{} values is not rows of 9", a.data.len())));
-    }
-    a.data
-        .chunks_exact(9)
-        .map(|r| {
-            let whole = |v: f64| v >= 0.0 && v.fract() == 0.0;
-            let ending = ENDING_CODES
-                .iter()
-                .find(|(_, code)| *code == r[4])
-                .map(|(e, _)| *e);
-            if !(whole(r[0]) && (r[1] == -1.0 || whole(r[1])) && whole(r[5]))
-                || !r[2].is_finite()
-                || !r[6].is_finite()
-                || (r[4] != 0.0 && ending.is_none())
-            {
-                return Err(bad(format!("the row {r:?} is not a cell's lineage")));
-            }
-            Ok(LineageRecord {
-                id: r[0] as usize,
-                parent: (r[1] >= 0.0).then_some(r[1] as usize),
-                birth: r[2],
-                death: ending.map(|e| (r[3], e)),
-                place: [r[7], r[8]],
-                generation: r[5] as u32,
-                cycle: r[6],
-            })
-        })
-        .collect()
-}
-
-/// The name of the array that holds a term's state variable (`polarity/theta` →
-/// `polarity.theta`), in checkpoints and frames.
-pub(crate) fn term_array_name(variable: &str) -> String {
-    variable.replace('/', ".")
-}
-
-/// Every term state variable of `tissue` as (array name, values by identity).
-pub(crate) fn term_arrays<T: Real>(tissue: &Tissue<T>) -> Vec<(String, Vec<f64>)> {
-    tissue
-        .terms()
-        .variables()
-        .into_iter()
-        .map(|(name, values)| (term_array_name(&name), values))
-        .collect()
-}
-
-/// `tissue` with the state of its terms from the arrays of `path` (a checkpoint or a frame,
-/// cells in identity order). A missing array is an error when `required`, and otherwise
-/// leaves the state as the terms initialised it (a frame of a run without the term).
+/// `tissue` with the extensions `ext` (the scene's, [`scene::Scene::extensions`]), their state
+/// read from the arrays of `path` ([`mechanics::Extensions::restore_arrays`]): from a
+/// checkpoint every array the parts keep, from a frame (cells in identity order) the
+/// per-identity ones it has.
 ///
 /// # Errors
 /// A damaged or missing array, naming the file and the array.
-pub fn read_terms<T: Real>(
+pub fn read_extensions<T: Real>(
     path: &Path,
-    mut tissue: Tissue<T>,
-    required: bool,
+    tissue: Tissue<T>,
+    mut ext: Extensions,
+    source: Source,
 ) -> Result<Tissue<T>> {
-    for (name, _) in tissue.terms().variables() {
-        let array = term_array_name(&name);
-        let values = match read_npz(path, &[&array]) {
-            Ok(mut a) => a.remove(0).data,
-            Err(RunDirError::MissingArray { .. }) if !required => continue,
-            Err(e) => return Err(e),
-        };
-        if values.iter().any(|v| !v.is_finite()) {
-            return Err(RunDirError::BadArray {
-                path: path.to_path_buf(),
-                name: array,
-                reason: "holds non-finite values".into(),
-            });
-        }
-        tissue
-            .terms_mut()
-            .set_variable(&name, &values)
-            .map_err(|reason| RunDirError::BadArray {
-                path: path.to_path_buf(),
-                name: array.clone(),
-                reason,
-            })?;
-    }
-    Ok(tissue)
+    ext.restore_arrays(
+        tissue.next_id(),
+        source,
+        |name| match read_npz(path, &[name]) {
+            Ok(mut a) => Ok(Some(a.remove(0).data)),
+            Err(RunDirError::MissingArray { .. }) => Ok(None),
+            Err(e) => Err(e),
+        },
+        |name, reason| RunDirError::BadArray {
+            path: path.to_path_buf(),
+            name: name.into(),
+            reason,
+        },
+    )?;
+    Ok(tissue.with_extensions(ext))
 }

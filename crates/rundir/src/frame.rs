@@ -134,7 +134,6 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
         .into_iter()
         .map(|(name, a)| (name.to_string(), a))
         .collect();
-    let terms = crate::checkpoint::term_arrays(tissue);
     let mut extra = Vec::new();
     if !tissue.terms().is_empty() {
         extra.push((
@@ -145,25 +144,21 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
             ),
         ));
     }
-    if let Some((_, theta)) = terms.iter().find(|(name, _)| name == "polarity.theta") {
-        extra.push((
-            "polarity".to_string(),
-            npy(
-                &[n64, 2],
-                ids.iter().flat_map(|&i| [theta[i].cos(), theta[i].sin()]),
-            ),
-        ));
-    }
-    // The terms' state and the populations are by identity: one row per living cell.
-    for (name, values) in terms {
-        extra.push((name, npy(&[n64], ids.iter().map(|&i| values[i]))));
-    }
-    let pops = tissue.populations();
-    if !pops.is_empty() {
-        extra.push((
-            "population".to_string(),
-            npy(&[n64], ids.iter().map(|&i| i64::from(pops.of_cell()[i]))),
-        ));
+    // The extensions' per-cell arrays are by identity: one row per living cell.
+    for array in tissue.extensions().frame_arrays() {
+        let w = array.columns;
+        let rows = ids.iter().flat_map(|&i| &array.values[i * w..(i + 1) * w]);
+        let shape = if w == 1 {
+            vec![n64]
+        } else {
+            vec![n64, w as u64]
+        };
+        let a = if array.integer {
+            npy(&shape, rows.map(|&v| v as i64))
+        } else {
+            npy(&shape, rows.copied())
+        };
+        extra.push((array.name, a));
     }
     for (name, a) in extra {
         let a = a.map_err(|e| RunDirError::io("encode", &path, e))?;

@@ -29,7 +29,7 @@ mod writers;
 
 use std::path::{Path, PathBuf};
 
-pub use checkpoint::read_terms;
+pub use checkpoint::read_extensions;
 pub use frame::{
     last_frame, npy, read_npz, write_frame, write_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ,
 };

@@ -79,7 +79,9 @@ pub fn read_lineage(dir: &Path) -> Result<Option<Vec<LineageRecord>>> {
                 if f.len() != 9 {
                     return None;
                 }
-                let num = |s: &str| s.parse::<f64>().ok();
+                // No number a lineage holds is NaN (it would make a cell's age meaningless;
+                // a cycle may be infinite); an empty field is "none".
+                let num = |s: &str| s.parse::<f64>().ok().filter(|v| !v.is_nan());
                 let opt = |s: &str| {
                     if s.is_empty() {
                         Some(None)
@@ -99,7 +101,7 @@ pub fn read_lineage(dir: &Path) -> Result<Option<Vec<LineageRecord>>> {
                     } else {
                         Some(f[1].parse().ok()?)
                     },
-                    birth: num(f[2])?,
+                    birth: num(f[2]).filter(|b| b.is_finite())?,
                     death,
                     place: [
                         opt(f[7])?.unwrap_or(f64::NAN),

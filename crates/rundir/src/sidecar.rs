@@ -49,7 +49,8 @@ fn unit(column: &str) -> &'static str {
     }
 }
 
-/// The frame arrays of the scene's physics terms and populations, with their meaning.
+/// The frame arrays of the scene's extensions ([`mechanics::Extensions::frame_arrays`]), with
+/// their meaning.
 fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
     let mut m = BTreeMap::new();
     let terms = scene.terms();
@@ -59,27 +60,17 @@ fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
             "(N, 2): the physics terms' whole-cell force on each cell (force units), beside the interface force 'force'".into(),
         );
     }
-    for (name, _) in terms.variables() {
-        let array = crate::checkpoint::term_array_name(&name);
-        let meaning = match array.as_str() {
-            "polarity.theta" => {
-                "(N,): each cell's polarity angle, radians counterclockwise from +x".to_string()
-            }
-            _ => format!("(N,): the per-cell state variable {name} of a physics term"),
+    let ext = mechanics::Extensions::none()
+        .with_terms(terms)
+        .with_populations(scene.populations());
+    for array in ext.frame_arrays() {
+        let shape = if array.columns == 1 {
+            "(N,)".to_string()
+        } else {
+            format!("(N, {})", array.columns)
         };
-        m.insert(array, meaning);
-    }
-    if terms.get("polarity").is_some() {
-        m.insert(
-            "polarity".into(),
-            "(N, 2): each cell's polarity (cos theta, sin theta)".into(),
-        );
-    }
-    if !scene.populations().is_empty() {
-        m.insert(
-            "population".into(),
-            "(N,) int64: each cell's population, an index into 'populations'".into(),
-        );
+        let dtype = if array.integer { " int64" } else { "" };
+        m.insert(array.name, format!("{shape}{dtype}: {}", array.meaning));
     }
     m
 }

@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use mechanics::extensions::Source;
 use mechanics::Tissue;
 use phasefield::{Cells, Lattice, PatchShape, Real};
 use scene::{Scene, SceneError, MAX_SIDE};
@@ -41,12 +42,14 @@ pub fn initial_tissue<T: Real>(scene: &Scene) -> std::result::Result<Tissue<T>, 
     }
 }
 
-/// `tissue` (built from the saved state `scene` starts from) with the state of its physics
-/// terms read from that file, cell by cell, where it has them (a frame or checkpoint of a run
-/// with the same terms); terms the file lacks keep the state their seed gave them.
+/// `tissue` (built from the saved state `scene` starts from) with the state of its
+/// extensions read from that file, cell by cell, where it has them (a frame or checkpoint of a
+/// run with the same parts: the terms' state, each cell's population); parts the file lacks
+/// keep the state the scene gave them.
 ///
 /// # Errors
-/// A damaged term array in the file.
+/// A damaged array in the file, or one that does not fit the scene (a population the scene
+/// does not have).
 pub fn saved_terms<T: Real>(
     scene: &Scene,
     tissue: Tissue<T>,
@@ -54,12 +57,13 @@ pub fn saved_terms<T: Real>(
     let Some(from) = scene.init_from() else {
         return Ok(tissue);
     };
-    crate::checkpoint::read_terms(Path::new(from), tissue, false).map_err(|error| {
-        StateError::Read {
+    let ext = tissue.extensions().clone();
+    crate::checkpoint::read_extensions(Path::new(from), tissue, ext, Source::Frame).map_err(
+        |error| StateError::Read {
             from: from.to_string(),
             error,
-        }
-    })
+        },
+    )
 }
 
 /// The saved state `scene` starts from (`init = "frame"`; `None` for the other layouts),

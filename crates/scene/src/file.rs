@@ -527,6 +527,15 @@ impl SceneFile {
     pub fn parse(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string()))?;
+        // The arrays of tables: `[population]` (one table) where `[[population]]` (a list)
+        // is meant would otherwise get serde's "invalid type: map, expected a sequence".
+        for section in ARRAYS_OF_TABLES {
+            if let Some(toml::Value::Table(_)) = table.get(section) {
+                return Err(SceneError::Parse(format!(
+                    "[{section}] is written as one table, but {section}s are a list of tables: write [[{section}]] (two brackets) above each {section}"
+                )));
+            }
+        }
         for o in overrides {
             apply_override(&mut table, o)?;
         }
@@ -619,6 +628,9 @@ impl SceneFile {
     }
 }
 
+/// The sections that are lists of tables (`[[population]]`).
+const ARRAYS_OF_TABLES: [&str; 1] = ["population"];
+
 fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
     let bad = |why: &str| {
         SceneError::Parse(format!(
@@ -645,6 +657,11 @@ fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
         }
     };
     // An array of tables (`[[population]]`): `section.K.key` sets the key of its K-th table.
+    if ARRAYS_OF_TABLES.contains(&section) && !table.contains_key(section) {
+        return Err(bad(&format!(
+            "the scene has no [[{section}]] tables, and --set changes a key of one that is there; add [[{section}]] tables to the scene file (the README lists their keys)"
+        )));
+    }
     if let Some(toml::Value::Array(items)) = table.get_mut(section) {
         let Some((index, key)) = key.split_once('.') else {
             return Err(bad(&format!(

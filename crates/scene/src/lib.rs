@@ -314,39 +314,28 @@ impl Scene {
         )))
     }
 
-    /// `tissue` with the scene's terms, populations, walls and cell-cycle clock.
+    /// `tissue` with the scene's extensions ([`Scene::extensions`]).
     fn dressed<T: Real>(&self, tissue: Tissue<T>) -> Tissue<T> {
-        let tissue = tissue
-            .with_terms(self.file.terms())
-            .with_populations(self.file.populations());
-        let tissue = match self.walls() {
-            Some(walls) => tissue.with_walls(walls),
-            None => tissue,
-        };
-        match &self.file.division {
-            Some(spec) => {
-                let clock = division::clock(spec, &self.file, &tissue);
-                tissue.with_proliferation(clock)
-            }
-            None => tissue,
-        }
+        let ext = self.extensions(&tissue);
+        tissue.with_extensions(ext)
     }
 
-    /// The clock of `[division]` restored from a lineage (a checkpoint's), or `None` when
-    /// the scene has no `[division]`.
-    ///
-    /// # Errors
-    /// A message when the lineage holds a cell twice.
-    pub fn restored_clock(
-        &self,
-        lineage: Vec<mechanics::division::LineageRecord>,
-    ) -> Option<Result<mechanics::division::Proliferation, String>> {
-        let spec = self.file.division.as_ref()?;
-        let (t0, rate) = spec.cycle();
-        Some(
-            mechanics::division::Proliferation::restore(t0, rate, self.file.run.seed, lineage)
-                .map(|c| division::configure(c, spec, &self.file)),
-        )
+    /// Every extension of the paper's model the scene configures, for `tissue` (its
+    /// founders start the cell-cycle clock): the terms, the populations, the walls and the
+    /// clock, as [`mechanics::Extensions`]. The one place a scene's extensions are built, for
+    /// a new run and for a checkpoint's (whose state arrays then replace the parts' state,
+    /// [`mechanics::Extensions::restore_arrays`]).
+    pub fn extensions<T: Real>(&self, tissue: &Tissue<T>) -> mechanics::Extensions {
+        mechanics::Extensions::none()
+            .with_terms(self.file.terms())
+            .with_populations(self.file.populations())
+            .with_walls(self.walls())
+            .with_proliferation(
+                self.file
+                    .division
+                    .as_ref()
+                    .map(|spec| division::clock(spec, &self.file, tissue)),
+            )
     }
 
     /// The most cells the run can hold: `[division] max_cells` (or its default) with

@@ -644,6 +644,29 @@ impl SceneFile {
                 ),
             ));
         }
+        // A population's own radius needs the same room on the patch as the scene's.
+        if it.margin != 0 {
+            for (k, p) in self.population.iter().enumerate() {
+                let r = p.radius.unwrap_or(c.radius);
+                if (it.margin as f64) < r {
+                    return Err(invalid(
+                        "population",
+                        "radius",
+                        r,
+                        format!(
+                            "population {k} ({}) has radius {r}, more than the patch margin {} ([integrator] margin): its cells would be cut to the patch and end far below their target area",
+                            p.name(k),
+                            it.margin
+                        ),
+                        format!(
+                            "set [integrator] margin ≥ radius + 2λ ≈ {}, or a radius of at most {} for this population",
+                            (r + 2.0 * m.lambda).ceil(),
+                            it.margin
+                        ),
+                    ));
+                }
+            }
+        }
         if it.backend == ComputeBackend::Gpu {
             self.check_gpu()?;
         }
@@ -710,6 +733,17 @@ impl SceneFile {
         }
         if let Some(spec) = &self.division {
             crate::division::check(spec, &self)?;
+        }
+        if let Some(spec) = &self.walls {
+            if spec.kind == crate::file::WallKind::Wound && self.run.relax_time <= 0.0 {
+                return Err(invalid(
+                    "run",
+                    "relax_time",
+                    self.run.relax_time,
+                    "a wound ([walls] kind = \"wound\") is the band the cells relax beside, removed when the relaxation ends; with no relaxation it is removed before the first step, so the run would have no wound at all",
+                    "set [run] relax_time > 0 (scenes/wound.toml uses 200), or remove [walls] for a run without a wound",
+                ));
+            }
         }
         let walls = match &self.walls {
             Some(spec) => Some(crate::walls::walls_of(

@@ -315,9 +315,62 @@ pub(crate) fn frame_ids(path: &Path, n: usize) -> Result<Vec<usize>> {
             }
             Ok(ids.iter().map(|&v| v as usize).collect())
         }
-        Err(rundir::RunDirError::MissingArray { .. }) => Ok((0..n).collect()),
+        Err(rundir::RunDirError::MissingArray { .. }) => {
+            // Frames before format 3 had no `id`: their rows are the cells `0..n`. A frame of
+            // format 3 or later without it has lost it, and its rows cannot be told apart
+            // once cells divide.
+            let format = read_npz(path, &["format"])
+                .ok()
+                .and_then(|a| a[0].scalar())
+                .unwrap_or(0.0);
+            if format >= 3.0 {
+                return Err(input(
+                    path,
+                    format!("array 'id' is missing from a frame of format {format}, which keeps each row's cell identity; the file is damaged: write it again (resume the run from a checkpoint before it) or remove it"),
+                ));
+            }
+            Ok((0..n).collect())
+        }
         Err(e) => Err(input(path, e.to_string())),
     }
+}
+
+/// Checks that every row identity `ids` of the frame at `path` (at time `time`) has a cell in
+/// `lineage` that was alive then, as in the run that wrote both: a `lineage.csv` of another
+/// run, or one cut short, would colour and place cells wrongly.
+///
+/// # Errors
+/// The first identity the lineage does not know, or knows as not alive at `time`.
+pub(crate) fn check_lineage(
+    path: &Path,
+    ids: &[usize],
+    time: f64,
+    lineage: &[mechanics::division::LineageRecord],
+) -> Result<()> {
+    for &id in ids {
+        let alive = lineage
+            .binary_search_by_key(&id, |r| r.id)
+            .ok()
+            .map(|k| &lineage[k])
+            .filter(|r| r.id == id);
+        let reason = match alive {
+            None => format!("cell {id} of this frame is not in lineage.csv"),
+            Some(r) if r.birth > time + 1e-9 => format!(
+                "cell {id} of this frame (t = {time}) was born at t = {} by lineage.csv",
+                r.birth
+            ),
+            Some(r) if r.death.is_some_and(|(t, _)| t < time - 1e-9) => format!(
+                "cell {id} of this frame (t = {time}) is gone by t = {} in lineage.csv",
+                r.death.map_or(f64::NAN, |d| d.0)
+            ),
+            Some(_) => continue,
+        };
+        return Err(input(
+            path,
+            format!("{reason}: the frame and lineage.csv are not of the same run; restore the run's own lineage.csv beside its frames"),
+        ));
+    }
+    Ok(())
 }
 
 /// One frame's state, rebuilt as a tissue.
@@ -472,7 +525,9 @@ pub(crate) fn load_frame(
     // The terms act as they did in the run: from the end of the relaxation, with the state
     // the frame holds.
     tissue.set_active(time >= scene.file().run.relax_time * (1.0 - 1e-12));
-    let tissue = rundir::read_terms(path, tissue, false).map_err(|e| input(path, e.to_string()))?;
+    let ext = tissue.extensions().clone();
+    let tissue = rundir::read_extensions(path, tissue, ext, mechanics::extensions::Source::Frame)
+        .map_err(|e| input(path, e.to_string()))?;
     // The per-cell arrays must describe the cells of `phi`, in its order: each stored centre
     // must be the centre of mass of its field (to a tenth of a node: f32 storage rounds it by
     // about 1e-5), or pictures and ParaView files would put one cell's values on another.
@@ -661,6 +716,12 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     // of the divisions and extrusions to the defects (`cell_events.csv`).
     let lineage = rundir::read_lineage(run_dir)
         .map_err(|e| input(&run_dir.join("lineage.csv"), e.to_string()))?;
+    if lineage.is_none() && scene.file().division.is_some() {
+        return Err(input(
+            &run_dir.join("lineage.csv"),
+            "is missing, but the run's scene has [division]: cell_events.csv (the divisions and extrusions against the defects) and the check of each frame's cells need it; restore the run's lineage.csv (a run rewrites it with every frame)".to_string(),
+        ));
+    }
     let mut near: Vec<FrameDefects> = Vec::new();
     let mut prev_time: Option<f64> = None;
     let area = lattice.len() as f64;
@@ -674,6 +735,9 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         });
     for path in &selected {
         let frame = load_frame(path, &scene, &shape, lattice)?;
+        if let Some(lineage) = &lineage {
+            check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
+        }
         let (demix, polar) = mixing_and_order(&frame, &shape);
         // s1 = Σφ_i on the lattice: the tissue mask of the defects, a wound's gap and the
         // cover of the random points of `cell_events.csv`.

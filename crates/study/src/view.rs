@@ -273,12 +273,16 @@ impl Run {
     }
 
     fn load(&self, path: &Path) -> Result<LoadedFrame> {
-        Ok(load_frame(
+        let frame = load_frame(
             path,
             &self.scene,
             &self.scene.patch_shape(),
             self.scene.lattice(),
-        )?)
+        )?;
+        if let Some(lineage) = &self.lineage {
+            crate::analyze::check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
+        }
+        Ok(frame)
     }
 }
 

@@ -55,10 +55,10 @@ impl<T: Real> Tissue<T> {
         let new = self.cells.split(slot, self.centre[slot], dir, lambda);
         self.cell_id[slot] = a;
         self.cell_id.push(b);
-        let kind = self.populations.population(mother) as u16;
-        self.populations.add_cell(a, kind);
-        self.populations.add_cell(b, kind);
-        self.terms.extend_to(b + 1);
+        let kind = self.ext.populations.population(mother) as u16;
+        self.ext.populations.add_cell(a, kind);
+        self.ext.populations.add_cell(b, kind);
+        self.ext.terms.extend_to(b + 1);
         let com = ComTable::new(self.lattice());
         let ca = com.cell_centre(&self.cells, slot);
         let cb = com.cell_centre(&self.cells, new);
@@ -237,6 +237,38 @@ impl Proliferation {
             p.record(r);
         }
         Ok(p)
+    }
+
+    /// Replaces the lineage with `records` (a checkpoint's), keeping the parameters.
+    ///
+    /// # Errors
+    /// Two records of one identity.
+    pub fn replace_lineage(
+        &mut self,
+        records: impl IntoIterator<Item = LineageRecord>,
+    ) -> Result<(), String> {
+        let mut restored = Self::restore(self.t0, self.rate, self.seed, records)?;
+        std::mem::swap(&mut self.lineage, &mut restored.lineage);
+        Ok(())
+    }
+
+    /// Every setting of the clock (not its lineage), for comparisons: the cycle, the axis,
+    /// the cap, the gate, the extrusion rule, the death rate, the growth time and the seed.
+    pub fn settings(&self) -> String {
+        format!(
+            "{:?}",
+            (
+                self.t0,
+                self.rate,
+                self.axis,
+                self.max_cells,
+                self.pressure_gate,
+                self.extrusion,
+                self.death_rate,
+                self.growth_time,
+                self.seed,
+            )
+        )
     }
 
     /// A clock of cycle `T₀ + Exp(1/k)` with the default options and no cell in its
@@ -539,6 +571,10 @@ pub struct CellEvents {
     pub divisions: Vec<Division>,
     /// The identities of the cells removed, with why.
     pub removals: Vec<(usize, Ending)>,
+    /// The last cell, when it was due to be removed too (with why): a tissue cannot be
+    /// empty, so it stays, and [`crate::Simulation::run`] stops the run
+    /// ([`crate::SimulationError::Extinct`]).
+    pub spared: Option<(usize, Ending)>,
 }
 
 impl<T: Real> Tissue<T> {
@@ -546,21 +582,21 @@ impl<T: Real> Tissue<T> {
     /// [`Tissue::proliferate`] applies.
     pub fn with_proliferation(mut self, clock: Proliferation) -> Self {
         self.set_target_scale(&clock);
-        self.proliferation = Some(Box::new(clock));
+        self.ext.proliferation = Some(Box::new(clock));
         self
     }
 
     /// Sets each identity's target-area factor from `clock` (the growth phase) at the
     /// tissue's time.
     fn set_target_scale(&mut self, clock: &Proliferation) {
-        let mut scale = std::mem::take(&mut self.target_scale);
+        let mut scale = std::mem::take(&mut self.ext.target_scale);
         clock.fill_target_scale(self, &mut scale);
-        self.target_scale = scale;
+        self.ext.target_scale = scale;
     }
 
     /// The clock and the lineage, if cells divide.
     pub fn proliferation(&self) -> Option<&Proliferation> {
-        self.proliferation.as_deref()
+        self.ext.proliferation.as_deref()
     }
 
     /// Applies the clock after a step: the divisions that are due, then deaths at the death
@@ -572,12 +608,13 @@ impl<T: Real> Tissue<T> {
     /// Every decision is taken on the state the step left, before any event (the evaluation
     /// in `ws` is by slot, and a removal moves a slot): the cells to extrude, then the cells
     /// that die (not already extruded), then the divisions due among the rest; the removals
-    /// happen after the divisions. A tissue keeps at least one cell.
+    /// happen after the divisions. A tissue keeps at least one cell: when the last is due to go
+    /// too it stays, and [`CellEvents::spared`] says so.
     pub fn proliferate(&mut self, ws: &mut Workspace<T>) -> CellEvents {
         if !self.active {
             return CellEvents::default();
         }
-        let Some(mut clock) = self.proliferation.take() else {
+        let Some(mut clock) = self.ext.proliferation.take() else {
             return CellEvents::default();
         };
         let mut removals: Vec<(usize, Ending)> = clock
@@ -595,12 +632,13 @@ impl<T: Real> Tissue<T> {
         let mut skip: Vec<usize> = removals.iter().map(|&(id, _)| id).collect();
         skip.sort_unstable();
         let divisions = clock.divide_due_except(self, ws, &skip);
-        let removals = remove_cells(self, ws, removals, Some(&mut clock));
+        let (removals, spared) = remove_cells(self, ws, removals, Some(&mut clock));
         self.set_target_scale(&clock);
-        self.proliferation = Some(clock);
+        self.ext.proliferation = Some(clock);
         CellEvents {
             divisions,
             removals,
+            spared,
         }
     }
 }
@@ -656,6 +694,7 @@ pub fn remove_extruded<T: Real>(
         .map(|id| (id, Ending::Extrusion))
         .collect();
     remove_cells(tissue, ws, small, lineage)
+        .0
         .into_iter()
         .map(|(id, _)| id)
         .collect()
@@ -664,15 +703,21 @@ pub fn remove_extruded<T: Real>(
 /// Removes the cells `ids` in their order, each recorded in `lineage` (when given) as ending
 /// for its reason at the tissue's time and its centre, while more than one cell is left;
 /// fits `ws` when any went. Returns those removed.
+/// The cells [`remove_cells`] removed, and the last one it had to keep (see
+/// [`CellEvents::spared`]).
+type Removed = (Vec<(usize, Ending)>, Option<(usize, Ending)>);
+
 fn remove_cells<T: Real>(
     tissue: &mut Tissue<T>,
     ws: &mut Workspace<T>,
     mut ids: Vec<(usize, Ending)>,
     mut lineage: Option<&mut Proliferation>,
-) -> Vec<(usize, Ending)> {
+) -> Removed {
     let now = tissue.time();
+    let mut spared = None;
     ids.retain(|&(id, why)| {
         if tissue.n_cells() == 1 {
+            spared = Some((id, why));
             return false;
         }
         let slot = slot_of(tissue, id);
@@ -686,7 +731,7 @@ fn remove_cells<T: Real>(
     if !ids.is_empty() {
         ws.fit(tissue.cells());
     }
-    ids
+    (ids, spared)
 }
 
 /// The cells whose area in the evaluation `ws` is below `fraction` of their target area, in
@@ -696,12 +741,12 @@ fn extruded<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, fraction: f64) -> Ve
     let mut small: Vec<usize> = (0..tissue.n_cells())
         .map(|slot| (slot, tissue.cell_ids()[slot]))
         .filter(|&(slot, id)| {
-            let pops = &tissue.populations;
+            let pops = &tissue.ext.populations;
             let r = pops
                 .params(pops.population(id), &tissue.params)
                 .energy
                 .radius;
-            let scale = tissue.target_scale.get(id).copied().unwrap_or(1.0);
+            let scale = tissue.ext.target_scale.get(id).copied().unwrap_or(1.0);
             ws.cell(slot).area < fraction * scale * std::f64::consts::PI * r * r
         })
         .map(|(_, id)| id)

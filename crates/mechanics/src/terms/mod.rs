@@ -77,6 +77,23 @@ pub trait CellTerm: Send + Sync + fmt::Debug {
         &[]
     }
 
+    /// What state variable `variable` means, for the run's `run.json` (the default names it
+    /// as a physics term's per-cell state).
+    fn describe_state(&self, variable: &str) -> String {
+        format!(
+            "the per-cell state variable {}/{variable} of a physics term",
+            self.name()
+        )
+    }
+
+    /// Per-cell quantities derived from a cell's state `x` that frames write beside the state
+    /// (polarity: the unit vector of its angle), each as `(array name, meaning, values)`, the
+    /// same names and lengths for every cell; empty (the default) for none.
+    fn derived(&self, x: &[f64]) -> Vec<(&'static str, &'static str, Vec<f64>)> {
+        let _ = x;
+        Vec::new()
+    }
+
     /// The initial state of cell `id` into `out` (`state_names().len()` values); `keys(k)` is
     /// a distinct [`NoiseKey`] for each `k`, to draw from.
     fn initial_state(&self, id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {
@@ -96,6 +113,15 @@ pub trait CellTerm: Send + Sync + fmt::Debug {
     fn rate(&self, cell: &CellContext<'_>, x: &[f64], out: &mut [f64]) {
         let _ = (cell, x);
         out.fill(0.0);
+    }
+
+    /// How fast the deterministic rate relaxes the state `x` (the largest `|∂ rate/∂x|`, per
+    /// unit time): Heun's step of size `dt` is stable while `stiffness · dt ≤ 2`, and the step
+    /// refuses to go on beyond ([`crate::StepError::TermUnstable`]). The default, 0, is for a
+    /// term without a relaxing rate.
+    fn stiffness(&self, cell: &CellContext<'_>, x: &[f64]) -> f64 {
+        let _ = (cell, x);
+        0.0
     }
 
     /// The amplitude `b` of the additive noise `b dW` of each state variable into `out`
@@ -224,6 +250,52 @@ impl Terms {
         out
     }
 
+    /// The meaning of each state variable `term/variable` ([`CellTerm::describe_state`]).
+    pub fn meanings(&self) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for e in &self.entries {
+            for v in e.term.state_names() {
+                out.push((format!("{}/{v}", e.term.name()), e.term.describe_state(v)));
+            }
+        }
+        out
+    }
+
+    /// Every quantity the terms derive from their state ([`CellTerm::derived`]) as
+    /// `(array name, meaning, columns, values by identity)`.
+    pub fn derived(&self) -> Vec<(String, String, usize, Vec<f64>)> {
+        let mut out: Vec<(String, String, usize, Vec<f64>)> = Vec::new();
+        for e in &self.entries {
+            let first = out.len();
+            for id in 0..self.n {
+                let x = &e.x[id * e.len..(id + 1) * e.len];
+                for (k, (name, meaning, values)) in e.term.derived(x).into_iter().enumerate() {
+                    if id == 0 {
+                        out.push((
+                            name.to_string(),
+                            meaning.to_string(),
+                            values.len(),
+                            Vec::new(),
+                        ));
+                    }
+                    out[first + k].3.extend(values);
+                }
+            }
+            if self.n == 0 {
+                let x = vec![0.0; e.len];
+                for (name, meaning, values) in e.term.derived(&x) {
+                    out.push((
+                        name.to_string(),
+                        meaning.to_string(),
+                        values.len(),
+                        Vec::new(),
+                    ));
+                }
+            }
+        }
+        out
+    }
+
     /// Sets the state variable `term/variable` ([`Terms::variables`]' names) from values by
     /// identity, as a checkpoint kept them.
     ///
@@ -323,6 +395,25 @@ impl Terms {
             }
             *f = total;
         }
+    }
+
+    /// The stiffest cell of the stiffest term ([`CellTerm::stiffness`]) as `(term's name,
+    /// stiffness, cell identity)`, or `None` when no term relaxes its state. Allocates nothing.
+    pub(crate) fn stiffest(&self, view: &CellsView<'_>) -> Option<(&str, f64, usize)> {
+        let mut worst: Option<(&str, f64, usize)> = None;
+        for e in &self.entries {
+            let len = e.len;
+            for slot in 0..view.cells.len() {
+                let cell = view.context(slot);
+                let k = e
+                    .term
+                    .stiffness(&cell, &e.x[cell.id * len..(cell.id + 1) * len]);
+                if k > worst.as_ref().map_or(0.0, |w| w.1) || k.is_nan() {
+                    worst = Some((e.term.name(), k, cell.id));
+                }
+            }
+        }
+        worst
     }
 
     /// The start of a step from `view.iteration`: keeps the state, its rate and the step's

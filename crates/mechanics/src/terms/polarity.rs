@@ -172,6 +172,18 @@ impl CellTerm for Polarity {
         &["theta"]
     }
 
+    fn describe_state(&self, _variable: &str) -> String {
+        "each cell's polarity angle, radians counterclockwise from +x".into()
+    }
+
+    fn derived(&self, x: &[f64]) -> Vec<(&'static str, &'static str, Vec<f64>)> {
+        vec![(
+            "polarity",
+            "each cell's polarity (cos theta, sin theta)",
+            vec![x[0].cos(), x[0].sin()],
+        )]
+    }
+
     fn initial_state(&self, _id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {
         out[0] = match self.initial_angle {
             Some(theta) => theta,
@@ -208,6 +220,15 @@ impl CellTerm for Polarity {
         if norm > 0.0 {
             out[0] = -rate * norm * signed_angle(f, p);
         }
+    }
+
+    fn stiffness(&self, cell: &CellContext<'_>, x: &[f64]) -> f64 {
+        let [.., rate] = self.values(cell.population);
+        if !cell.active || self.align == Align::None || rate == 0.0 {
+            return 0.0;
+        }
+        // dθ/dt = −J|f| Δ(f, p): near alignment a relaxation at the rate J|f|.
+        rate * self.target(cell, direction(x[0])).norm()
     }
 
     fn noise(&self, cell: &CellContext<'_>, out: &mut [f64]) {

@@ -64,6 +64,16 @@ impl Walls {
         }
     }
 
+    /// Whether `other` is the same walls: the same coefficients and the same fields before
+    /// and after the activity switch (compared by value, so a wall rebuilt from the scene
+    /// equals the one it was built from before).
+    pub fn same_as(&self, other: &Walls) -> bool {
+        self.kappa == other.kappa
+            && self.omega == other.omega
+            && *self.relaxation == *other.relaxation
+            && self.active.as_deref() == other.active.as_deref()
+    }
+
     /// Bytes of heap memory held.
     pub fn heap_bytes(&self) -> usize {
         self.relaxation.heap_bytes()
