@@ -118,7 +118,7 @@ fn hostile_values_fail_validation_with_their_key() {
 }
 
 /// Keys of a scene file, and hostile and ordinary values for them (TOML literals).
-const KEYS: [&str; 53] = [
+const KEYS: [&str; 56] = [
     "domain.lx",
     "domain.ly",
     "cells.count",
@@ -157,6 +157,9 @@ const KEYS: [&str; 53] = [
     "polarity.contact_inhibition",
     "population.0.gamma",
     "population.1.zeta",
+    "population.0.radius",
+    "population.0.align_rate",
+    "integrator.backend",
     "walls.kind",
     "walls.kind",
     "walls.thickness",
@@ -173,7 +176,7 @@ const KEYS: [&str; 53] = [
     "division.death_rate",
     "division.pressure_gate",
 ];
-const VALUES: [&str; 42] = [
+const VALUES: [&str; 45] = [
     "0",
     "-1",
     "1",
@@ -216,6 +219,9 @@ const VALUES: [&str; 42] = [
     "\"box\"",
     "\"long\"",
     "0.3",
+    "\"gpu\"",
+    "\"cpu\"",
+    "1000",
 ];
 
 /// Stands for the path of a real frame of the base scene (`frame_path`) among [`VALUES`].

@@ -213,6 +213,9 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// No summary (notes on missing or skipped frames are still printed).
+        #[arg(long, short)]
+        quiet: bool,
     },
 }
 
@@ -594,10 +597,14 @@ fn real_main() -> Result<ExitCode> {
             run_dir,
             analysis,
             threads,
+            quiet,
         } => {
             let opts = analysis.options();
             let info = pool(threads)?.install(|| analyze(&run_dir, &opts))?;
             note_skipped(&info.notes, &run_dir);
+            if quiet {
+                return Ok(ExitCode::SUCCESS);
+            }
             if info.cell_events > 0 {
                 say!(
                     "{} divisions, extrusions and deaths, with their distances to the defects, in cell_events.csv",

@@ -985,8 +985,9 @@ fn reproduce_refuses_unknown_figures_and_scales() {
 /// Rewrites a frame with `change` applied to its arrays (all written back as float64, int64
 /// for the integer ones), as a damaged or foreign file would be.
 fn rewrite_frame(path: &Path, change: impl Fn(&str, &mut Vec<f64>)) {
-    const NAMES: [&str; 12] = [
+    const NAMES: [&str; 13] = [
         "format",
+        "id",
         "step",
         "time",
         "zeta",
@@ -1003,7 +1004,7 @@ fn rewrite_frame(path: &Path, change: impl Fn(&str, &mut Vec<f64>)) {
     let mut out = Vec::new();
     for (name, mut a) in NAMES.iter().zip(arrays) {
         change(name, &mut a.data);
-        let bytes = if ["format", "step", "lattice", "origin"].contains(name) {
+        let bytes = if ["format", "id", "step", "lattice", "origin"].contains(name) {
             rundir::npy(&a.shape, a.data.iter().map(|&v| v as i64))
         } else {
             rundir::npy(&a.shape, a.data.iter().copied())

@@ -7,6 +7,7 @@ mod division;
 mod docs;
 mod from_state;
 mod gpu;
+mod hostile;
 mod resume_all;
 mod signals;
 mod terms;

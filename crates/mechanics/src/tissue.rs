@@ -32,6 +32,8 @@ pub struct Tissue<T: Real = f64> {
     /// is the sort key. Only the step writes it.
     pub(crate) centre: Vec<[f64; 2]>,
     pub(crate) cell_id: Vec<usize>,
+    /// The identity the next new cell gets ([`Tissue::next_id`]).
+    pub(crate) next_id: usize,
     /// Whether activity is on (the relaxation switch; see [`Tissue::set_active`]).
     pub(crate) active: bool,
     /// Every part of the model beyond the paper's (terms, populations, walls, division).
@@ -79,6 +81,7 @@ impl<T: Real> Tissue<T> {
         );
         let mut t = Self {
             centre: vec![[0.0; 2]; n],
+            next_id: next_after(&cell_id),
             cell_id,
             cells,
             params,
@@ -125,6 +128,7 @@ impl<T: Real> Tissue<T> {
             time,
             iteration,
             centre,
+            next_id: next_after(&cell_id),
             cell_id,
             active: true,
             ext: Extensions::none(),
@@ -380,6 +384,11 @@ impl<T: Real> Tissue<T> {
             self.cells.recentre(i, self.centre[i]);
         }
     }
+}
+
+/// One more than the largest of `ids` (0 for none).
+fn next_after(ids: &[usize]) -> usize {
+    ids.iter().max().map_or(0, |&m| m + 1)
 }
 
 /// Whether no identity appears twice.

@@ -320,6 +320,23 @@ pub fn read_npz(path: &Path, names: &[&str]) -> Result<Vec<Array>> {
     Ok(out)
 }
 
+/// The names of the arrays of the NumPy archive `path`, in archive order.
+///
+/// # Errors
+/// A file that cannot be opened or is not a zip archive, naming it.
+pub fn npz_names(path: &Path) -> Result<Vec<String>> {
+    let f = File::open(path).map_err(|e| RunDirError::io("open", path, e))?;
+    let zip = zip::ZipArchive::new(BufReader::new(f)).map_err(|e| RunDirError::Archive {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    Ok(zip
+        .file_names()
+        .filter_map(|n| n.strip_suffix(".npy"))
+        .map(str::to_string)
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -525,23 +525,30 @@ impl SceneFile {
     /// # Errors
     /// [`SceneError::Parse`] on bad syntax, unknown keys, wrong types or bad overrides.
     pub fn parse(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
-        let mut table: toml::Table =
-            toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string()))?;
         // The arrays of tables: `[population]` (one table) where `[[population]]` (a list)
-        // is meant would otherwise get serde's "invalid type: map, expected a sequence".
+        // is meant would otherwise get serde's "invalid type: map, expected a sequence", or
+        // TOML's "duplicate key" when there are two.
         for section in ARRAYS_OF_TABLES {
-            if let Some(toml::Value::Table(_)) = table.get(section) {
+            let single = format!("[{section}]");
+            if let Some(k) = text.lines().position(|l| l.trim() == single) {
                 return Err(SceneError::Parse(format!(
-                    "[{section}] is written as one table, but {section}s are a list of tables: write [[{section}]] (two brackets) above each {section}"
+                    "line {}: [{section}] is written as one table, but {section}s are a list of tables: write [[{section}]] (two brackets) above each {section}",
+                    k + 1
                 )));
             }
         }
+        let mut table: toml::Table =
+            toml::from_str(text).map_err(|e| SceneError::Parse(e.to_string()))?;
         for o in overrides {
             apply_override(&mut table, o)?;
         }
-        let mut file: Self = table
-            .try_into()
-            .map_err(|e: toml::de::Error| SceneError::Parse(e.to_string()))?;
+        let mut file: Self = table.clone().try_into().map_err(|e: toml::de::Error| {
+            let msg = e.to_string();
+            match type_hint(&table, &msg) {
+                Some(hint) => SceneError::Parse(format!("{}: {hint}", msg.trim_end())),
+                None => SceneError::Parse(msg),
+            }
+        })?;
         if let Some(d) = &mut file.division {
             d.cycle_spread.get_or_insert(0.25 * d.cycle_time);
         }
@@ -626,6 +633,50 @@ impl SceneFile {
     pub fn step_params(&self) -> StepParams {
         StepParams::new(self.integrator.dt, self.integrator.npc)
     }
+}
+
+/// A fix for serde's message `msg` about a value of the wrong type ("invalid type: ...
+/// in `section.key`"), naming what the key takes: for a key of a fixed set of words, the
+/// words, found by asking serde itself (the same table with the key set to a word no key
+/// takes answers "unknown variant, expected one of ..."), so no list is kept by hand.
+fn type_hint(table: &toml::Table, msg: &str) -> Option<String> {
+    if !msg.contains("invalid type") {
+        return None;
+    }
+    let key = msg
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("in `")?.strip_suffix('`'))?;
+    let (section, name) = key.split_once('.')?;
+    let mut probe = table.clone();
+    let toml::Value::Table(sec) = probe.get_mut(section)? else {
+        return None;
+    };
+    sec.insert(name.into(), toml::Value::String("\u{1}".into()));
+    let answer = match probe.try_into::<SceneFile>() {
+        Err(e) => e.to_string(),
+        Ok(_) => return None,
+    };
+    let words = answer
+        .contains("unknown variant")
+        .then(|| answer.split("expected ").nth(1)?.lines().next())
+        .flatten()
+        .map(|w| w.trim_start_matches("one of "));
+    if let Some(words) = words {
+        let first = words.split('`').nth(1).unwrap_or("...");
+        return Some(format!(
+            "{key} takes one of {words}: write {name} = \"{first}\" (in quotes) in the scene file, or --set {key}={first}"
+        ));
+    }
+    let expected = msg.split("expected ").nth(1)?.lines().next()?;
+    let what = match expected {
+        "usize" | "u64" | "u32" | "i64" => "a whole number",
+        "f64" | "f32" => "a number",
+        "a boolean" | "bool" => "true or false",
+        other => other,
+    };
+    Some(format!(
+        "{key} takes {what} (the README's key table lists every key with its default)"
+    ))
 }
 
 /// The sections that are lists of tables (`[[population]]`).

@@ -33,9 +33,28 @@ pub struct Division {
 }
 
 impl<T: Real> Tissue<T> {
-    /// The identity the next new cell gets: one more than the largest so far.
+    /// The identity the next new cell gets: one more than the largest the tissue has ever
+    /// had, living or not, so that an identity is never given twice (the lineage, the terms'
+    /// state and the populations are by identity).
     pub fn next_id(&self) -> usize {
-        self.cell_id.iter().max().map_or(0, |&m| m + 1)
+        self.next_id
+    }
+
+    /// Sets [`Tissue::next_id`], as a checkpoint kept it (at least one more than every
+    /// living identity).
+    ///
+    /// # Errors
+    /// A message when `next` is not above every living identity.
+    pub fn set_next_id(&mut self, next: usize) -> Result<(), String> {
+        let living = self.cell_id.iter().max().map_or(0, |&m| m + 1);
+        if next < living {
+            return Err(format!(
+                "the next identity {next} is not above every living cell's (the largest is {})",
+                living - 1
+            ));
+        }
+        self.next_id = next;
+        Ok(())
     }
 
     /// Divides the cell in slot `slot` along the line through its centre normal to
@@ -51,6 +70,7 @@ impl<T: Real> Tissue<T> {
         let mother = self.cell_id[slot];
         let a = self.next_id();
         let b = a + 1;
+        self.next_id = b + 1;
         let lambda = self.params.energy.lambda;
         let new = self.cells.split(slot, self.centre[slot], dir, lambda);
         self.cell_id[slot] = a;

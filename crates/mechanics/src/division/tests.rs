@@ -460,3 +460,23 @@ fn deaths_follow_the_death_rate() {
         t.time()
     );
 }
+
+/// An identity is never given twice: after the cell with the largest identity is removed, the
+/// next division's daughters get new identities above it (they once took the removed cell's,
+/// so that its lineage record, term state and population were overwritten), and the terms'
+/// state of the removed cell stays as it was.
+#[test]
+fn a_removed_cells_identity_is_not_given_again() {
+    let (mut t, _ws) = relaxed_cell(64);
+    let d = t.divide(0, [1.0, 0.0]);
+    assert_eq!(d.daughters, [1, 2]);
+    let theta_2 = t.terms().state("polarity").unwrap()[2];
+    let slot_2 = t.cell_ids().iter().position(|&id| id == 2).unwrap();
+    assert_eq!(t.remove(slot_2), 2);
+    assert_eq!(t.next_id(), 3, "the removed identity 2 stays taken");
+    let d = t.divide(0, [0.0, 1.0]);
+    assert_eq!(d.mother, 1);
+    assert_eq!(d.daughters, [3, 4]);
+    assert_eq!(t.terms().state("polarity").unwrap()[2], theta_2);
+    assert!(t.set_next_id(2).is_err(), "below a living identity");
+}

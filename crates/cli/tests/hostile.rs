@@ -1,0 +1,257 @@
+//! The silent and unclear cases of the model's extensions (issue 38), each refused with a
+//! message that names the key or file and the fix, or made right: one test per class.
+
+use std::path::Path;
+use std::process::Output;
+
+use crate::common::{bin, scene_path, stderr};
+
+fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut c = bin();
+    c.arg("run").arg(scene).arg("--out").arg(out).arg("--quiet");
+    for e in extra {
+        c.args(["--set", e]);
+    }
+    c.output().expect("the binary runs")
+}
+
+/// Refused: a non-zero exit, every `says` in the message, no panic.
+fn refused(o: &Output, says: &[&str], what: &str) {
+    let e = stderr(o);
+    assert!(!o.status.success(), "{what}: refused");
+    assert!(!e.contains("panicked"), "{what}: {e}");
+    for s in says {
+        assert!(e.contains(s), "{what}: the message says {s:?}: {e}");
+    }
+}
+
+/// Scenes that would run and do something other than asked are refused before anything is
+/// written: a population whose radius does not fit the patch (its cells ended at a tenth of
+/// their area), a wound without a relaxation (no wound at all); and the three messages that
+/// were serde's name the fix.
+#[test]
+fn scenes_that_would_silently_differ_are_refused_by_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let mixture = scene_path("mixture.toml");
+    refused(
+        &run(&mixture, &out, &["population.0.radius=20"]),
+        &["population", "radius", "margin"],
+        "a population radius beyond the margin",
+    );
+    refused(
+        &run(&scene_path("wound.toml"), &out, &["run.relax_time=0"]),
+        &["relax_time", "wound"],
+        "a wound without relaxation",
+    );
+    refused(
+        &run(&scene_path("paper.toml"), &out, &["population.0.zeta=0.01"]),
+        &["no [[population]]", "population.0.zeta"],
+        "--set population.0 without populations",
+    );
+    refused(
+        &run(&scene_path("paper.toml"), &out, &["integrator.backend=1"]),
+        &["integrator.backend", "`cpu` or `gpu`"],
+        "a number for a word",
+    );
+    let single = dir.path().join("single.toml");
+    std::fs::write(
+        &single,
+        std::fs::read_to_string(&mixture)
+            .unwrap()
+            .replace("[[population]]", "[population]"),
+    )
+    .unwrap();
+    refused(
+        &run(&single, &out, &[]),
+        &["[population]", "[[population]] (two brackets)"],
+        "[population] for [[population]]",
+    );
+    assert!(!out.exists(), "nothing written");
+}
+
+/// Runs that went wrong without a word now stop and say why: an alignment rate far beyond
+/// what the time step can integrate (θ jumped by tens of radians between frames), and a death
+/// rate that kills every cell (one immortal cell was kept, by a rule written nowhere). The
+/// outputs up to the stop are kept.
+#[test]
+fn runs_that_would_silently_differ_stop_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("stiff");
+    refused(
+        &run(
+            &scene_path("polar.toml"),
+            &out,
+            &[
+                "polarity.align_rate=1000",
+                "run.time=20",
+                "run.relax_time=5",
+            ],
+        ),
+        &["polarity", "align_rate", "2/dt"],
+        "a stiff alignment",
+    );
+    assert!(out.join("series.csv").exists(), "outputs kept");
+    let out = dir.path().join("extinct");
+    refused(
+        &run(
+            &scene_path("colony.toml"),
+            &out,
+            &["division.death_rate=2", "run.time=50"],
+        ),
+        &["every cell is gone", "death_rate"],
+        "every cell dies",
+    );
+    assert!(out.join("lineage.csv").exists(), "outputs kept");
+}
+
+/// A dividing run's outputs that do not fit together are refused by analyze and render,
+/// naming the file: a frame whose `id` array was removed, a `lineage.csv` of another run, a
+/// NaN birth, a missing `lineage.csv`.
+#[test]
+fn damaged_outputs_of_a_dividing_run_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let colony = scene_path("colony.toml");
+    let args = [
+        "division.cycle_time=15",
+        "division.cycle_spread=5",
+        "division.growth_time=10",
+        "division.extrusion=0",
+        "run.time=60",
+        "run.output_every=10",
+    ];
+    let a = dir.path().join("a");
+    let o = run(&colony, &a, &args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let b = dir.path().join("b");
+    let o = run(&colony, &b, &[&args[..], &["run.seed=2"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lineage = std::fs::read_to_string(a.join("lineage.csv")).unwrap();
+    assert!(lineage.lines().count() > 4, "cells divided: {lineage}");
+    let tool = |what: &[&str], dir: &Path| {
+        let png = dir.join("png");
+        let mut c = bin();
+        c.args(what).arg(dir).arg("-q");
+        if what[0] == "render" {
+            c.arg("--out").arg(&png);
+        }
+        let o = c.output().unwrap();
+        let _ = std::fs::remove_dir_all(dir.join("analysis"));
+        o
+    };
+    let analyze: &[&str] = &["analyze"];
+    let render: &[&str] = &["render", "--colour", "generation"];
+    assert!(tool(analyze, &a).status.success());
+    // Another run's lineage (seed 2): its cells are born at other times.
+    std::fs::copy(b.join("lineage.csv"), a.join("lineage.csv")).unwrap();
+    for t in [analyze, render] {
+        refused(&tool(t, &a), &["lineage.csv", "not of the same run"], t[0]);
+    }
+    // A NaN birth.
+    let nan: String = lineage
+        .lines()
+        .enumerate()
+        .map(|(k, l)| {
+            if k == 1 {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f[2] = "NaN";
+                f.join(",") + "\n"
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    std::fs::write(a.join("lineage.csv"), nan).unwrap();
+    refused(
+        &tool(&["render", "--colour", "lineage"], &a),
+        &["lineage.csv", "line 2"],
+        "a NaN birth",
+    );
+    // No lineage.csv.
+    std::fs::remove_file(a.join("lineage.csv")).unwrap();
+    refused(
+        &tool(analyze, &a),
+        &["lineage.csv", "is missing", "[division]"],
+        "no lineage",
+    );
+    std::fs::write(a.join("lineage.csv"), &lineage).unwrap();
+    assert!(tool(analyze, &a).status.success(), "the run's own lineage");
+    // A frame without its `id` array.
+    let frame = std::fs::read_dir(a.join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .max()
+        .unwrap();
+    let names = rundir::npz_names(&frame).unwrap();
+    let keep: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|&n| n != "id")
+        .collect();
+    let arrays = rundir::read_npz(&frame, &keep).unwrap();
+    let out: Vec<(String, Vec<u8>)> = keep
+        .iter()
+        .zip(arrays)
+        .map(|(n, a)| {
+            (
+                n.to_string(),
+                rundir::npy(&a.shape, a.data.iter().copied()).unwrap(),
+            )
+        })
+        .collect();
+    rundir::write_npz(&frame, out).unwrap();
+    for t in [analyze, render] {
+        refused(&tool(t, &a), &["'id' is missing", "frame_"], t[0]);
+    }
+}
+
+/// `init = "frame"` from a two-population run carries each cell's population from the frame's
+/// `population` array, where it was dealt again by the new scene's seed.
+#[test]
+fn a_state_from_a_mixture_keeps_its_populations() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a");
+    let o = run(
+        &scene_path("mixture.toml"),
+        &a,
+        &["run.time=10", "run.output_every=10"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let frame = a.join("frames/frame_00000020.npz");
+    let want = rundir::read_npz(&frame, &["population"])
+        .unwrap()
+        .remove(0)
+        .data;
+    let b = dir.path().join("b");
+    let from = format!("cells.from=\"{}\"", frame.display());
+    let o = run(
+        &scene_path("mixture.toml"),
+        &b,
+        &[
+            "cells.init=frame",
+            &from,
+            "run.seed=9",
+            "run.time=10",
+            "run.output_every=10",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let got = rundir::read_npz(&b.join("frames/frame_00000000.npz"), &["population"])
+        .unwrap()
+        .remove(0)
+        .data;
+    assert_eq!(got, want, "the frame's populations, not a new deal");
+    // The deal of seed 9 differs, so the check can fail.
+    let c = dir.path().join("c");
+    let o = run(
+        &scene_path("mixture.toml"),
+        &c,
+        &["run.seed=9", "run.time=0", "run.output_every=10"],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let dealt = rundir::read_npz(&c.join("frames/frame_00000000.npz"), &["population"])
+        .unwrap()
+        .remove(0)
+        .data;
+    assert_ne!(dealt, want);
+}
