@@ -130,6 +130,12 @@ fn small_scenes(dir: &Path) {
 }
 
 fn run_doc(name: &str) {
+    run_doc_with(name, true);
+}
+
+/// [`run_doc`]; a page whose blocks are all synopses and named scripts has nothing to run
+/// (`must_run` false).
+fn run_doc_with(name: &str, must_run: bool) {
     let bin = PathBuf::from(env!("CARGO_BIN_EXE_monolayer"));
     let dir = tempfile::tempdir().unwrap();
     small_scenes(dir.path());
@@ -167,7 +173,7 @@ fn run_doc(name: &str) {
             }
         }
     }
-    assert!(ran > 0, "{name} has no command to run");
+    assert!(ran > 0 || !must_run, "{name} has no command to run");
     let path = format!(
         "{}:{}",
         bin_dir.display(),
@@ -197,6 +203,63 @@ fn the_gallery_commands_run() {
     run_doc("docs/gallery.md");
 }
 
+/// The reference pages the README links to: their commands run and their synopses are
+/// the binary's.
+#[test]
+fn the_reference_pages_commands_run() {
+    for page in ["docs/scenes.md", "docs/running.md", "docs/outputs.md"] {
+        run_doc_with(page, false);
+    }
+}
+
+/// Every array a frame can hold is a row of docs/outputs.md's frame table: a frame of a
+/// scene with every extension (polarity, populations, adhesion, walls, division) names no
+/// array the table lacks.
+#[test]
+fn every_frame_array_is_documented_in_docs_outputs_md() {
+    let doc = std::fs::read_to_string(root().join("docs/outputs.md")).unwrap();
+    let documented: Vec<String> = doc
+        .lines()
+        .filter_map(|l| l.strip_prefix("| `"))
+        .filter_map(|l| l.split(" | ").next())
+        .flat_map(|cell| {
+            cell.split('`')
+                .filter(|w| !w.is_empty() && !w.starts_with(','))
+                .map(|w| w.trim_matches(|c| c == ',' || c == ' ').to_string())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("all.toml");
+    std::fs::write(
+        &scene,
+        "[domain]\nlx = 64\nly = 64\n[cells]\ncount = 6\nradius = 6.0\n\
+         [polarity]\nalpha = 0.02\n[adhesion]\nomega = 0.002\n\
+         [[population]]\ncount = 3\ngamma = 0.02\n[[population]]\ncount = 3\n\
+         [walls]\nkind = \"disc\"\n[division]\ncycle_time = 4.0\n\
+         [integrator]\nmargin = 12\n[run]\nrelax_time = 2.0\ntime = 4.0\noutput_every = 2.0\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_monolayer"))
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let frame = out.join("frames/frame_00000012.npz");
+    let names = rundir::npz_names(&frame).unwrap();
+    assert!(names.len() >= 15, "{names:?}");
+    let missing: Vec<&String> = names.iter().filter(|n| !documented.contains(n)).collect();
+    assert!(
+        missing.is_empty(),
+        "frame arrays without a row in docs/outputs.md: {missing:?}"
+    );
+}
+
 /// No tracked text file points into `../shared` (or any path above the repository): a clone
 /// must be complete.
 #[test]
@@ -224,5 +287,71 @@ fn nothing_links_outside_the_repository() {
         bad.is_empty(),
         "links outside the repository:\n{}",
         bad.join("\n")
+    );
+}
+
+/// The keys serde accepts in `section` (every field of its table), read from its own
+/// "unknown field" message for a key no table has, so that no list is kept by hand; the
+/// sections themselves for `section = None`.
+fn scene_keys(section: Option<&str>) -> Vec<String> {
+    let base = "[domain]\nlx = 64\nly = 64\n[cells]\ncount = 1\n[[population]]\ncount = 1\n";
+    let set = match section {
+        None => "zz_no_such_section.k=1".to_string(),
+        Some("population") => "population.0.zz_no_such_key=1".to_string(),
+        Some(s) => format!("{s}.zz_no_such_key=1"),
+    };
+    let err = scene::Scene::parse(base, &[set])
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    let expected = err
+        .split("unknown field")
+        .nth(1)
+        .and_then(|r| r.split("expected").nth(1))
+        .unwrap_or_else(|| panic!("{section:?}: no list of fields in {err:?}"));
+    let expected = expected.lines().next().unwrap();
+    expected
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+/// Every key of every scene table is in docs/scenes.md's key table: a row whose first cell
+/// names the table (`[section]` or `[[section]]`) and the key, so a key added to the scene
+/// types without a line of documentation fails here.
+#[test]
+fn every_scene_key_is_documented_in_docs_scenes_md() {
+    let doc = std::fs::read_to_string(root().join("docs/scenes.md")).unwrap();
+    let first_cells: Vec<&str> = doc
+        .lines()
+        .filter_map(|l| l.strip_prefix("| `"))
+        .filter_map(|l| l.split(" | ").next())
+        .collect();
+    let sections = scene_keys(None);
+    assert!(sections.len() >= 9, "{sections:?}");
+    let mut missing = Vec::new();
+    for section in &sections {
+        let keys = scene_keys(Some(section));
+        assert!(!keys.is_empty(), "{section}");
+        for key in keys {
+            let table = [format!("[{section}]"), format!("[[{section}]]")];
+            let found = first_cells.iter().any(|cell| {
+                let (head, rest) = cell.split_once(' ').unwrap_or((cell, ""));
+                let head = head.trim_matches('`');
+                table.iter().any(|t| t == head)
+                    && rest
+                        .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                        .any(|w| w == key)
+            });
+            if !found {
+                missing.push(format!("[{section}] {key}"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "keys without a row in docs/scenes.md: {missing:?}"
     );
 }

@@ -675,7 +675,7 @@ fn type_hint(table: &toml::Table, msg: &str) -> Option<String> {
         other => other,
     };
     Some(format!(
-        "{key} takes {what} (the README's key table lists every key with its default)"
+        "{key} takes {what} (docs/scenes.md lists every key with its default)"
     ))
 }
 
@@ -710,7 +710,7 @@ fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
     // An array of tables (`[[population]]`): `section.K.key` sets the key of its K-th table.
     if ARRAYS_OF_TABLES.contains(&section) && !table.contains_key(section) {
         return Err(bad(&format!(
-            "the scene has no [[{section}]] tables, and --set changes a key of one that is there; add [[{section}]] tables to the scene file (the README lists their keys)"
+            "the scene has no [[{section}]] tables, and --set changes a key of one that is there; add [[{section}]] tables to the scene file (docs/scenes.md lists their keys)"
         )));
     }
     if let Some(toml::Value::Array(items)) = table.get_mut(section) {
