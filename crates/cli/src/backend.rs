@@ -39,12 +39,50 @@ pub fn open(scene: &Scene) -> Result<Opened> {
             #[cfg(feature = "gpu")]
             device: None,
         }),
-        ComputeBackend::Gpu => open_gpu(),
+        ComputeBackend::Gpu => open_gpu(scene),
     }
 }
 
+/// Refuses what `scene`'s backend cannot run, before anything is opened or written: for the
+/// GPU, the parts of the model it does not declare (`gpu::SUPPORTED`), or a binary built
+/// without it.
+///
+/// # Errors
+/// Naming each part with its scene table, and the fix.
+pub fn check(scene: &Scene) -> Result<()> {
+    match scene.backend() {
+        ComputeBackend::Cpu => Ok(()),
+        ComputeBackend::Gpu => check_gpu(scene),
+    }
+}
+
+#[cfg(not(feature = "gpu"))]
+fn check_gpu(scene: &Scene) -> Result<()> {
+    open_gpu(scene).map(|_| ())
+}
+
 #[cfg(feature = "gpu")]
-fn open_gpu() -> Result<Opened> {
+fn check_gpu(scene: &Scene) -> Result<()> {
+    let unsupported: Vec<mechanics::Part> = scene
+        .parts()
+        .into_iter()
+        .filter(|p| !gpu::SUPPORTED.contains(p))
+        .collect();
+    if !unsupported.is_empty() {
+        let named: Vec<String> = unsupported.iter().map(|p| p.describe()).collect();
+        let tables: Vec<&str> = unsupported.iter().map(|p| p.scene_table()).collect();
+        anyhow::bail!(
+            "[integrator] backend = \"gpu\": the GPU backend does not run {} yet; remove {} to run on the GPU, or set backend = \"cpu\"",
+            named.join(", "),
+            tables.join(", ")
+        );
+    }
+    Ok(())
+}
+
+#[cfg(feature = "gpu")]
+fn open_gpu(scene: &Scene) -> Result<Opened> {
+    check_gpu(scene)?;
     let device =
         gpu::Device::open().map_err(|e| anyhow::anyhow!("[integrator] backend = \"gpu\": {e}"))?;
     Ok(Opened {
@@ -53,7 +91,7 @@ fn open_gpu() -> Result<Opened> {
 }
 
 #[cfg(not(feature = "gpu"))]
-fn open_gpu() -> Result<Opened> {
+fn open_gpu(_scene: &Scene) -> Result<Opened> {
     anyhow::bail!(
         "[integrator] backend = \"gpu\": this monolayer binary was built without the GPU backend; \
          build one with `cargo build --release -p monolayer-cli --features gpu` (it needs a Vulkan \

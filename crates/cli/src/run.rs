@@ -101,6 +101,13 @@ pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Ve
 /// No usable checkpoint, a checkpoint of another run, an override other than `run.time`, a
 /// run already at its end, or what [`run`] can fail with.
 pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<RunInfo> {
+    // A move to a backend that cannot run the scene is refused before the directory is
+    // touched (resuming rewrites its scene.toml and removes its analysis).
+    if let Ok(text) = std::fs::read_to_string(dir.join("scene.toml")) {
+        if let Ok(scene) = Scene::parse(&text, set) {
+            crate::backend::check(&scene)?;
+        }
+    }
     let run = RunDir::resume(dir, set, Interrupt::install()?)?;
     if !quiet {
         for s in run.skipped() {

@@ -60,10 +60,7 @@ fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
             "(N, 2): the physics terms' whole-cell force on each cell (force units), beside the interface force 'force'".into(),
         );
     }
-    let ext = mechanics::Extensions::none()
-        .with_terms(terms)
-        .with_populations(scene.populations());
-    for array in ext.frame_arrays() {
+    for array in scene.configured_extensions().frame_arrays() {
         let shape = if array.columns == 1 {
             "(N,)".to_string()
         } else {

@@ -33,6 +33,7 @@
 //! ```
 #![deny(missing_docs)]
 
+mod check;
 mod division;
 mod file;
 mod validate;
@@ -318,6 +319,34 @@ impl Scene {
     fn dressed<T: Real>(&self, tissue: Tissue<T>) -> Tissue<T> {
         let ext = self.extensions(&tissue);
         tissue.with_extensions(ext)
+    }
+
+    /// Every extension the scene configures, before there is a tissue: the clock has no
+    /// founders yet. What the parts are ([`Scene::parts`]) and which arrays they write follow
+    /// from it; a run uses [`Scene::extensions`].
+    pub fn configured_extensions(&self) -> mechanics::Extensions {
+        mechanics::Extensions::none()
+            .with_terms(self.file.terms())
+            .with_populations(self.file.populations())
+            .with_walls(self.walls())
+            .with_proliferation(self.file.division.as_ref().map(|spec| {
+                let (t0, rate) = spec.cycle();
+                let clock =
+                    mechanics::division::Proliferation::restore(t0, rate, self.file.run.seed, [])
+                        .expect("an empty lineage has no cell twice");
+                division::configure(clock, spec, &self.file)
+            }))
+    }
+
+    /// The parts beyond the paper's model the scene has, in [`mechanics::Part::ALL`]'s
+    /// order (what a backend must support to run it).
+    pub fn parts(&self) -> Vec<mechanics::Part> {
+        let ext = self.configured_extensions();
+        let params = self.model_params(self.zeta());
+        mechanics::Part::ALL
+            .into_iter()
+            .filter(|&p| ext.has(p, &params))
+            .collect()
     }
 
     /// Every extension of the paper's model the scene configures, for `tissue` (its
