@@ -281,7 +281,7 @@ fn fuzz_one(overrides: &[String], tally: &mut Tally) -> Result<(), String> {
         tally.too_big += 1;
         return Ok(());
     }
-    let stepped = std::panic::catch_unwind(|| {
+    let stepped = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         // A saved state that cannot be read or does not fit is a clean error too.
         let mut t = rundir::initial_tissue::<f32>(&s).map_err(|e| e.to_string())?;
         let mut ws = Workspace::new(t.cells());
@@ -297,7 +297,7 @@ fn fuzz_one(overrides: &[String], tally: &mut Tally) -> Result<(), String> {
                     .map(|_| ())
             }
         }))
-    })
+    }))
     .map_err(|_| format!("{overrides:?}: building or stepping the valid scene panicked"))?;
     match stepped {
         Err(msg) if msg.contains("[cells] from") || msg.contains(".npz") => tally.errors += 1,

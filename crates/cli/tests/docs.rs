@@ -333,6 +333,13 @@ fn every_scene_key_is_documented_in_docs_scenes_md() {
     assert!(sections.len() >= 9, "{sections:?}");
     let mut missing = Vec::new();
     for section in &sections {
+        if section == "terms" {
+            // `[terms.NAME]`: a user's term, whose keys are its own.
+            if !first_cells.iter().any(|c| c.starts_with("[terms.NAME]")) {
+                missing.push("[terms.NAME]".into());
+            }
+            continue;
+        }
         let keys = scene_keys(Some(section));
         assert!(!keys.is_empty(), "{section}");
         for key in keys {

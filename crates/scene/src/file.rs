@@ -6,6 +6,7 @@ use mechanics::terms::{Align, Polarity, Population, Populations, Propulsion, Ter
 use mechanics::{ModelParams, Precision, PressureKind, StepParams};
 use phasefield::PatchShape;
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 use crate::validate::SceneError;
 
@@ -517,6 +518,10 @@ pub struct SceneFile {
     /// `[division]`, when cells divide.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub division: Option<DivisionSpec>,
+    /// `[terms.NAME]`: the tables of terms from a user's crate, each handed to the builder
+    /// registered under its name ([`crate::register_term`]).
+    #[serde(default, rename = "terms", skip_serializing_if = "BTreeMap::is_empty")]
+    pub user_terms: BTreeMap<String, toml::Table>,
 }
 
 impl SceneFile {
@@ -733,6 +738,27 @@ fn apply_override(table: &mut toml::Table, o: &str) -> Result<(), SceneError> {
             return Err(bad("that entry is not a table"));
         };
         item.insert(key.to_string(), value);
+        return Ok(());
+    }
+    // A term's table (`[terms.NAME]`): `terms.NAME.key`.
+    if section == "terms" {
+        let Some((name, key)) = key.split_once('.') else {
+            return Err(bad(&format!(
+                "a term's key is named with its table: --set terms.{key}.KEY=..."
+            )));
+        };
+        let terms = table
+            .entry("terms")
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        let toml::Value::Table(terms) = terms else {
+            return Err(bad("[terms] is not a table of term tables"));
+        };
+        let Some(toml::Value::Table(term)) = terms.get_mut(name) else {
+            return Err(bad(&format!(
+                "the scene has no [terms.{name}] table; add it to the scene file to switch the term on"
+            )));
+        };
+        term.insert(key.to_string(), value);
         return Ok(());
     }
     let sec = table

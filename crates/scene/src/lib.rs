@@ -36,6 +36,7 @@
 mod check;
 mod division;
 mod file;
+mod registry;
 mod validate;
 mod walls;
 
@@ -43,6 +44,7 @@ pub use file::{
     AdhesionSpec, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain, InitKind,
     Integrator, Model, PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
 };
+pub use registry::{register_term, registered_terms, TermBuilder, TermError};
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
 use mechanics::{
@@ -59,6 +61,9 @@ pub struct Scene {
     pub(crate) centres: Vec<[f64; 2]>,
     /// The walls of `[walls]`, built once by the validation (their fields are shared).
     pub(crate) walls: Option<mechanics::walls::Walls>,
+    /// The terms of the `[terms.NAME]` tables, built once by the validation
+    /// ([`register_term`]).
+    pub(crate) user_terms: Vec<std::sync::Arc<dyn mechanics::terms::CellTerm>>,
 }
 
 /// When the writers of a run directory fire ([`Scene::output_schedules`]).
@@ -326,7 +331,7 @@ impl Scene {
     /// from it; a run uses [`Scene::extensions`].
     pub fn configured_extensions(&self) -> mechanics::Extensions {
         mechanics::Extensions::none()
-            .with_terms(self.file.terms())
+            .with_terms(self.terms())
             .with_populations(self.file.populations())
             .with_walls(self.walls())
             .with_proliferation(self.file.division.as_ref().map(|spec| {
@@ -356,7 +361,7 @@ impl Scene {
     /// [`mechanics::Extensions::restore_arrays`]).
     pub fn extensions<T: Real>(&self, tissue: &Tissue<T>) -> mechanics::Extensions {
         mechanics::Extensions::none()
-            .with_terms(self.file.terms())
+            .with_terms(self.terms())
             .with_populations(self.file.populations())
             .with_walls(self.walls())
             .with_proliferation(
@@ -400,7 +405,11 @@ impl Scene {
 
     /// The physics terms beyond the minimal model (`[polarity]`), with the run's seed.
     pub fn terms(&self) -> mechanics::terms::Terms {
-        self.file.terms()
+        let mut terms = self.file.terms();
+        for term in &self.user_terms {
+            terms.add(term.clone());
+        }
+        terms
     }
 
     /// The initial tissue from a saved state `state` (the fields of a frame or a checkpoint,

@@ -27,6 +27,19 @@ pub enum SceneError {
         /// What to do.
         fix: String,
     },
+    /// A `[terms.NAME]` table of a term from a user's crate ([`crate::register_term`]): no
+    /// such term is registered, or its builder refused a key.
+    #[error("[terms.{name}]{}: {problem}; {fix}", if key.is_empty() { String::new() } else { format!(" {key}") })]
+    Term {
+        /// The term's name.
+        name: String,
+        /// The key of its table (empty for the table as a whole).
+        key: String,
+        /// What is wrong.
+        problem: String,
+        /// What to do.
+        fix: String,
+    },
     /// A saved state does not fit the scene (`init = "frame"`), or the scene was asked to
     /// build its tissue without the state it starts from.
     #[error("[cells] from = {from:?}: {problem}; {fix}")]
@@ -106,6 +119,12 @@ impl SceneFile {
             crate::division::check(spec, &self)?;
         }
         crate::check::walls(&self)?;
+        // The terms of `[terms.NAME]` tables, built once by their registered builders.
+        let user_terms = self
+            .user_terms
+            .iter()
+            .map(|(name, table)| crate::registry::build(name, table))
+            .collect::<Result<Vec<_>, _>>()?;
         let (d, c) = (&self.domain, &self.cells);
         let r0 = self.init_radius();
         let lattice = Lattice::new(d.lx, d.ly);
@@ -123,6 +142,7 @@ impl SceneFile {
                 file: self,
                 centres: Vec::new(),
                 walls,
+                user_terms,
             });
         };
         let centres = match init::positions_clear_of(
@@ -160,6 +180,7 @@ impl SceneFile {
             file: self,
             centres,
             walls,
+            user_terms,
         })
     }
 
