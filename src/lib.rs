@@ -4,12 +4,19 @@
 #![doc = include_str!("../README.md")]
 
 pub use analysis;
+#[cfg(feature = "gpu")]
+pub use gpu;
 pub use mechanics;
 pub use phasefield;
+#[cfg(feature = "render")]
 pub use render;
+#[cfg(feature = "reproduce")]
+pub use reproduce;
 pub use rundir;
 pub use scene;
+#[cfg(feature = "stability")]
 pub use stability;
+#[cfg(feature = "study")]
 pub use study;
 
 /// Everything a whole run needs, from a scene or by hand, in one `use monolayer::prelude::*;`:

@@ -149,7 +149,10 @@ enum Command {
         /// `all`, or steps such as `0,500,1000` (the numbers in frames/frame_STEP.npz).
         #[arg(long, default_value = "all")]
         frames: String,
-        /// What fills the cells: none, velocity, pressure, area, deformation, id or population.
+        /// What fills the cells: none, velocity (|v_i|), pressure (the cell's mean P), area,
+        /// deformation (|S_i|), id (a colour per cell), population ([[population]], a colour
+        /// each, named in a legend), generation and lineage (with [division]: a colour per
+        /// generation, named in a legend, or per founder).
         #[arg(long, default_value = "none")]
         colour: String,
         /// The director of the smoothed Q, as short segments.

@@ -1,4 +1,4 @@
-//! `monolayer reproduce FIGURE`: the `study::reproduce` figures, with a progress bar per
+//! `monolayer reproduce FIGURE`: the `reproduce` figures, with a progress bar per
 //! sweep and the verdicts printed at the end.
 
 use std::io::IsTerminal;
@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::Result;
 use indicatif::{ProgressBar, ProgressStyle};
-use study::reproduce::{reproduce, Figure, FigureReport, Reporter, ReproduceParams, Scale};
+use reproduce::{reproduce, Figure, FigureReport, Reporter, ReproduceParams, Scale};
 use study::SweepParams;
 
 /// Shows a reproduction's progress on stderr: a bar per sweep on a terminal, a line every

@@ -71,8 +71,8 @@ pub use movie::{Movie, MovieKind};
 pub use plot::{LegendAt, Plot, Series};
 pub use raster::Picture;
 pub use tissue::{
-    CellArrows, CellAxes, EventKind, EventMark, Fill, LatticeVectors, Patches, TissuePicture,
-    MINUS, PLUS,
+    category_colour, CellArrows, CellAxes, EventKind, EventMark, Fill, LatticeVectors, Patches,
+    TissuePicture, MINUS, PLUS,
 };
 
 /// What stops a picture from being drawn, naming the file.

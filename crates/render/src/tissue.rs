@@ -51,6 +51,14 @@ pub enum Fill {
     /// a cell keeps its colour from picture to picture (keys: identities, or each cell's
     /// founder for a lineage).
     Keys(Vec<usize>),
+    /// Each cell the colour of its category (a population, a generation), from a palette of
+    /// distinct colours, with the categories' names in a legend right of the field.
+    Categories {
+        /// Each cell's category, an index into `names`.
+        of_cell: Vec<usize>,
+        /// The categories' names, for the legend.
+        names: Vec<String>,
+    },
     /// One value per cell, on a colour bar.
     Values {
         /// The values, one per cell.
@@ -246,6 +254,17 @@ impl TissuePicture {
                 return Err(format!("{} fill values for {n} cells", values.len()));
             }
         }
+        if let Fill::Categories { of_cell, names } = &self.fill {
+            if of_cell.len() != n {
+                return Err(format!("{} categories for {n} cells", of_cell.len()));
+            }
+            if let Some(&k) = of_cell.iter().find(|&&k| k >= names.len()) {
+                return Err(format!(
+                    "category {k} of a cell, but {} names in the legend",
+                    names.len()
+                ));
+            }
+        }
         let len = self.lx * self.ly;
         if let Some(w) = &self.walls {
             if w.len() != len {
@@ -323,7 +342,14 @@ impl TissuePicture {
         self.check().map_err(data)?;
         let (fw, fh) = (self.size, self.field_height());
         let bar = self.bar_range();
-        let width = PAD_PX + fw + if bar.is_some() { BAR_PX } else { PAD_PX };
+        let legend = matches!(self.fill, Fill::Categories { .. });
+        let width = PAD_PX
+            + fw
+            + if bar.is_some() || legend {
+                BAR_PX
+            } else {
+                PAD_PX
+            };
         let height = TITLE_PX + fh + PAD_PX;
         let mut pic = Picture::filled(width, height, EMPTY);
         self.draw_cells(&mut pic, bar);
@@ -342,6 +368,7 @@ impl TissuePicture {
         if let Some(range) = bar {
             self.draw_bar_colours(&mut pic, range);
         }
+        self.draw_legend_swatches(&mut pic);
         self.draw_text(&mut pic, bar)
             .map_err(|why| RenderError::Draw {
                 path: Default::default(),
@@ -398,6 +425,9 @@ impl TissuePicture {
             (Fill::Plain, _) => vec![PLAIN; p.origins.len()],
             (Fill::Id, _) => (0..p.origins.len()).map(id_colour).collect(),
             (Fill::Keys(keys), _) => keys.iter().map(|&k| id_colour(k)).collect(),
+            (Fill::Categories { of_cell, .. }, _) => {
+                of_cell.iter().map(|&k| category_colour(k)).collect()
+            }
             (Fill::Values { values, signed, .. }, Some((lo, hi))) => values
                 .iter()
                 .map(|&v| self.colour_of((v - lo) / (hi - lo), *signed))
@@ -635,6 +665,30 @@ impl TissuePicture {
         }
     }
 
+    /// The legend's colour swatches, one row per category, right of the field (as many as
+    /// fit; [`LEGEND_ROW`] pixels apart).
+    fn draw_legend_swatches(&self, pic: &mut Picture) {
+        let Fill::Categories { names, .. } = &self.fill else {
+            return;
+        };
+        let x0 = PAD_PX + self.size + 10;
+        for k in 0..self.legend_rows(names.len()) {
+            let y0 = TITLE_PX + 10 + LEGEND_ROW * k as u32;
+            let c = category_colour(k);
+            for y in y0..y0 + 12 {
+                for x in x0..x0 + 12 {
+                    let i = 3 * (y as usize * pic.width as usize + x as usize);
+                    pic.rgb[i..i + 3].copy_from_slice(&c);
+                }
+            }
+        }
+    }
+
+    /// How many of `n` categories the legend has room for.
+    fn legend_rows(&self, n: usize) -> usize {
+        n.min(((self.field_height().saturating_sub(20)) / LEGEND_ROW) as usize)
+    }
+
     /// Title, colour-bar ticks and label, through plotters with the bundled font.
     fn draw_text(&self, pic: &mut Picture, bar: Option<(f64, f64)>) -> Result<(), String> {
         font()?;
@@ -661,8 +715,41 @@ impl TissuePicture {
             )
             .map_err(e)?;
         }
+        if let Fill::Categories { names, .. } = &self.fill {
+            let small = TextStyle::from((FONT, 13).into_font()).color(&BLACK);
+            let x = (PAD_PX + self.size + 26) as i32;
+            let rows = self.legend_rows(names.len());
+            for (k, name) in names.iter().take(rows).enumerate() {
+                let y = (TITLE_PX + 9 + LEGEND_ROW * k as u32) as i32;
+                let text = if k + 1 == rows && rows < names.len() {
+                    format!("… {} more", names.len() - k)
+                } else {
+                    name.clone()
+                };
+                root.draw_text(&text, &small, (x, y)).map_err(e)?;
+            }
+        }
         root.present().map_err(|e| e.to_string())
     }
+}
+
+/// Pixels between the rows of a legend.
+const LEGEND_ROW: u32 = 18;
+
+/// The colour of category `k`: Okabe and Ito's eight colours, distinct to readers with any
+/// common colour-vision deficiency, repeated beyond eight.
+pub fn category_colour(k: usize) -> [u8; 3] {
+    const PALETTE: [[u8; 3]; 8] = [
+        [230, 159, 0],
+        [86, 180, 233],
+        [0, 158, 115],
+        [240, 228, 66],
+        [0, 114, 178],
+        [213, 94, 0],
+        [204, 121, 167],
+        [153, 153, 153],
+    ];
+    PALETTE[k % PALETTE.len()]
 }
 
 /// An arrow from the pixel `from` along the lattice vector `(a, b)` in pixels (y up), with a

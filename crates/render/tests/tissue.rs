@@ -266,3 +266,47 @@ fn movies_hold_every_frame() {
         assert!(e.to_string().contains("ffmpeg on the PATH"), "{e}");
     }
 }
+
+/// Categories fill the cells with distinct colours and name them in a legend: two cells of
+/// categories 0 and 1 get the palette's first two colours, the legend's swatches show them in
+/// order right of the field, and a category without a name is refused.
+#[test]
+fn categories_fill_cells_with_distinct_colours_and_a_legend() {
+    let lattice = Lattice::new(64, 32);
+    let a = disc(lattice, 16.0, 16.0, 8.0, 24);
+    let b = disc(lattice, 48.0, 16.0, 8.0, 24);
+    let mut p = TissuePicture::new(64, 32, 256);
+    p.patches = Patches {
+        nx: 24,
+        ny: 24,
+        origins: vec![a.origins[0], b.origins[0]],
+        phi: [a.phi, b.phi].concat(),
+    };
+    p.fill = Fill::Categories {
+        of_cell: vec![1, 0],
+        names: vec!["soft".into(), "stiff".into()],
+    };
+    let pic = p.draw().unwrap();
+    let at = |x: f64, y: f64| {
+        let (i, j) = p.to_pixel(x, y);
+        pic.pixel(i as u32, j as u32)
+    };
+    let (c0, c1) = (render::category_colour(0), render::category_colour(1));
+    assert_ne!(c0, c1);
+    assert_eq!(at(16.0, 16.0), c1);
+    assert_eq!(at(48.0, 16.0), c0);
+    assert!(pic.width > p.size + 50, "room for the legend");
+    // The swatches: 12 px squares from 10 px right of the field, 18 px apart.
+    let (x, y) = (p.size + 16, 56 + 16);
+    let first = (0..pic.height).find(|&y| pic.pixel(x, y) == c0);
+    let second = (0..pic.height).find(|&y| pic.pixel(x, y) == c1);
+    assert!(
+        matches!((first, second), (Some(f), Some(s)) if s == f + 18),
+        "swatches at {first:?} and {second:?} (field top near {y})"
+    );
+    p.fill = Fill::Categories {
+        of_cell: vec![2, 0],
+        names: vec!["soft".into(), "stiff".into()],
+    };
+    assert!(p.draw().unwrap_err().to_string().contains("category 2"));
+}

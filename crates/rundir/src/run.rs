@@ -585,11 +585,11 @@ fn lock(dir: &Path) -> Result<File> {
     }
     let args: Vec<String> = std::env::args().collect();
     let line = format!(
-        "pid {} since {} s after the Unix epoch: {}\n",
+        "pid {} since {}: {}\n",
         std::process::id(),
-        std::time::SystemTime::now()
+        utc(std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
-            .map_or(0, |d| d.as_secs()),
+            .map_or(0, |d| d.as_secs())),
         args.join(" ")
     );
     let written = f
@@ -626,8 +626,40 @@ impl<T: Real> Callback<T> for StopOnSignal {
     }
 }
 
+/// `secs` after the Unix epoch as a UTC date and time, `2026-12-05 08:45:12 UTC` (the civil
+/// calendar from a day count, H. Hinnant's `civil_from_days`).
+pub(crate) fn utc(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02} UTC",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
 #[cfg(test)]
 mod tests {
+    /// The lock's date against dates known by other means: the epoch, a leap day, the end of
+    /// a century year that is not a leap year, and one checked with `date -u -d @1764923112`.
+    #[test]
+    fn lock_dates_are_utc_calendar_dates() {
+        assert_eq!(super::utc(0), "1970-01-01 00:00:00 UTC");
+        assert_eq!(super::utc(951_782_400), "2000-02-29 00:00:00 UTC");
+        assert_eq!(super::utc(4_107_542_399), "2100-02-28 23:59:59 UTC");
+        assert_eq!(super::utc(1_764_923_112), "2025-12-05 08:25:12 UTC");
+    }
+
     use super::scene_diff;
 
     /// Each table of an array of tables is compared with its own: two `[[population]]`

@@ -43,7 +43,6 @@
 
 pub mod analyze;
 mod plan;
-pub mod reproduce;
 mod slurm;
 mod spec;
 pub mod summary;
@@ -172,7 +171,7 @@ pub enum SweepError {
 impl SweepError {
     /// A file of the sweep (`what`: the point or the record it belongs to) could not be
     /// written.
-    pub(crate) fn write(what: &str, path: &std::path::Path, source: std::io::Error) -> Self {
+    pub fn write(what: &str, path: &std::path::Path, source: std::io::Error) -> Self {
         Self::RunDir {
             point: what.to_string(),
             source: rundir::RunDirError::Io {

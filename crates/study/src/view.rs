@@ -410,26 +410,14 @@ fn picture(
     let f: Option<TissueFields> = need_fields.then(|| frame.tissue.fields(ws));
     let signed = opts.colour == Colour::Pressure;
     let values: Option<(Vec<f64>, &str)> = match opts.colour {
-        Colour::None | Colour::Id | Colour::Lineage => None,
-        Colour::Generation => Some((
-            frame
-                .ids
-                .iter()
-                .map(|&id| lineage_of(run, id).map_or(0.0, |r| f64::from(r.generation)))
-                .collect(),
-            "generation",
-        )),
+        Colour::None | Colour::Id | Colour::Lineage | Colour::Generation | Colour::Population => {
+            None
+        }
         Colour::Velocity => Some((
             frame.velocities.iter().map(|v| v[0].hypot(v[1])).collect(),
             "|v|",
         )),
         Colour::Area => Some((frame.areas.clone(), "area Σφ²")),
-        Colour::Population => Some((
-            (0..frame.tissue.n_cells())
-                .map(|id| frame.tissue.populations().population(id) as f64)
-                .collect(),
-            "population",
-        )),
         Colour::Deformation => Some((
             frame.shapes.iter().map(|s| s[0].hypot(s[1])).collect(),
             "|S|",
@@ -446,6 +434,36 @@ fn picture(
     };
     p.fill = match (opts.colour, values) {
         (Colour::Id, _) => Fill::Keys(frame.ids.clone()),
+        // Categories, in a legend: each population by its name, each generation by number.
+        (Colour::Population, _) => {
+            let pops = frame.tissue.populations();
+            Fill::Categories {
+                of_cell: (0..frame.tissue.n_cells())
+                    .map(|id| pops.population(id))
+                    .collect(),
+                names: (0..pops.kinds().len().max(1))
+                    .map(|k| {
+                        run.scene
+                            .file()
+                            .population
+                            .get(k)
+                            .map_or_else(|| "all cells".to_string(), |p| p.name(k))
+                    })
+                    .collect(),
+            }
+        }
+        (Colour::Generation, _) => {
+            let of_cell: Vec<usize> = frame
+                .ids
+                .iter()
+                .map(|&id| lineage_of(run, id).map_or(0, |r| r.generation as usize))
+                .collect();
+            let top = of_cell.iter().copied().max().unwrap_or(0);
+            Fill::Categories {
+                of_cell,
+                names: (0..=top).map(|g| format!("generation {g}")).collect(),
+            }
+        }
         (Colour::Lineage, _) => Fill::Keys(
             frame
                 .ids

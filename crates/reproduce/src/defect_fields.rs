@@ -9,8 +9,8 @@ use render::{save_heatmaps, Heatmap};
 use super::{
     drawn, g, mean_se, mean_std, pm, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict,
 };
-use crate::analyze::AnalyzeOptions;
-use crate::SweepError;
+use study::analyze::AnalyzeOptions;
+use study::SweepError;
 
 /// Side of the crops: ±30 nodes, about four cell radii.
 const CROP: usize = 61;

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::SweepError;
+use study::SweepError;
 
 /// The key values of a group of rows and the values of a column in them.
 pub type Group = (Vec<String>, Vec<f64>);

@@ -9,7 +9,7 @@ use super::column_stats;
 use super::{
     drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict,
 };
-use crate::SweepError;
+use study::SweepError;
 
 const ZETAS: [&str; 3] = ["-0.0018", "0", "0.005"];
 

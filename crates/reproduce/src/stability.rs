@@ -21,7 +21,7 @@ use stability::{
 
 use super::rules::{rule_agree, rule_box, rule_continuum, rule_linear, rule_proportional};
 use super::{drawn, g, write_text, Claim, ReproduceParams, Scale, Verdict};
-use crate::SweepError;
+use study::SweepError;
 
 /// The γ of the study: five values, so that a line and its curvature can be told apart.
 const GAMMAS: [f64; 5] = [0.006, 0.008, 0.01, 0.012, 0.014];

@@ -2,7 +2,7 @@
 //! data (CSV), its pictures (PNG, drawn by the `render` crate) and a verdict on every claim
 //! of docs/model.md §9 that it tests (`verdict.md`).
 //!
-//! Every figure is one or more sweeps ([`crate::run_points`]) in `OUT/sweeps/NAME/`, so an
+//! Every figure is one or more sweeps ([`study::run_points`]) in `OUT/sweeps/NAME/`, so an
 //! interrupted `reproduce` resumes where it stopped and figures that share a sweep run it
 //! once; the figure's own files go to `OUT/FIGURE/`. Two scales:
 //! - [`Scale::Quick`]: 3 seeds, short runs, the default integrator (dt 0.5, margin 16, f32):
@@ -29,8 +29,8 @@ use std::str::FromStr;
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::analyze::AnalyzeOptions;
-use crate::{
+use study::analyze::AnalyzeOptions;
+use study::{
     analyze_points, run_points, write_summary, Seeds, SweepError, SweepParams, SweepSpec, Vary,
 };
 
@@ -339,14 +339,14 @@ pub(crate) struct SweepJob {
     /// Analyse every run, with these options.
     pub analyze: Option<AnalyzeOptions>,
     /// The seeds, when not the scale's.
-    pub seeds: Option<crate::Seeds>,
+    pub seeds: Option<study::Seeds>,
 }
 
 /// A finished sweep: its directory and summary.
 pub(crate) struct SweepResult {
     pub dir: PathBuf,
     pub summary: Table,
-    pub points: Vec<crate::Point>,
+    pub points: Vec<study::Point>,
 }
 
 /// Runs (or resumes) a sweep of the figure and reads its summary.
@@ -365,7 +365,7 @@ pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, S
     let points = spec.plan()?;
     std::fs::create_dir_all(&dir).map_err(|e| SweepError::write(&job.name, &dir, e))?;
     spec.save(&dir)?;
-    let (todo, steps) = crate::pending(&dir, &points);
+    let (todo, steps) = study::pending(&dir, &points);
     p.reporter.sweep(&job.name, todo.len(), steps);
     let rep = p.reporter.clone();
     run_points(
@@ -522,7 +522,7 @@ pub(crate) struct Rec {
     pub values: Vec<String>,
     pub seed: u64,
     pub run: PathBuf,
-    pub summary: crate::summary::RunSummary,
+    pub summary: study::summary::RunSummary,
 }
 
 impl SweepResult {
@@ -534,10 +534,10 @@ impl SweepResult {
             .iter()
             .map(|pt| {
                 let r = &pt.scene.file().run;
-                let run = crate::run_dir(&self.dir, pt);
-                let summary = crate::summary::summarise(
+                let run = study::run_dir(&self.dir, pt);
+                let summary = study::summary::summarise(
                     &run,
-                    crate::summary::window(r.relax_time, time.unwrap_or(r.time).min(r.time)),
+                    study::summary::window(r.relax_time, time.unwrap_or(r.time).min(r.time)),
                 )?;
                 Ok(Rec {
                     values: pt.values.clone(),

@@ -1,6 +1,6 @@
 //! `reproduce threshold`: Fig. 2a (v_rms and S_rms − S_rms(0) against ζ) and Fig. 2b (ζ_cr
 //! against γ for two box sizes), for both pressure forms, with the protocol of
-//! [`crate::threshold`], its dependence on the run length, and (quick scale) the paper's
+//! [`study::threshold`], its dependence on the run length, and (quick scale) the paper's
 //! integrator on one box.
 
 use std::path::Path;
@@ -12,8 +12,8 @@ use super::{
     drawn, g, mean_se, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob,
     Verdict,
 };
-use crate::threshold::{csv_fields, growth_threshold, threshold, RatePoint, Threshold};
-use crate::SweepError;
+use study::threshold::{csv_fields, growth_threshold, threshold, RatePoint, Threshold};
+use study::SweepError;
 
 const ZETAS: &str = "0,0.001,0.0015,0.002,0.0025,0.003,0.004,0.006,0.008";
 const GAMMAS: [f64; 3] = [0.006, 0.01, 0.014];
@@ -170,6 +170,7 @@ fn bracket(t: Threshold) -> (f64, f64, f64) {
         Threshold::Bracketed { zeta_cr, lo, hi } => (zeta_cr, lo, hi),
         Threshold::Below { hi } => (f64::NAN, f64::NAN, hi),
         Threshold::Above { lo } => (f64::NAN, lo, f64::NAN),
+        _ => (f64::NAN, f64::NAN, f64::NAN),
     }
 }
 
@@ -424,6 +425,7 @@ fn describe(t: Threshold) -> String {
         Threshold::Bracketed { zeta_cr, lo, hi } => format!("{} [{lo}, {hi}]", g(zeta_cr)),
         Threshold::Below { hi } => format!("< {hi}"),
         Threshold::Above { lo } => format!("> {lo}"),
+        other => format!("{other:?}"),
     }
 }
 
@@ -679,7 +681,7 @@ fn combine(v: &[(Verdict, String)]) -> Verdict {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::summary::RunSummary;
+    use study::summary::RunSummary;
 
     /// Synthetic runs whose late growth rate is `r = 1.5 (ζ − ζ_cr(γ))` plus a seed offset that
     /// cancels in the mean, on both boxes and forms.

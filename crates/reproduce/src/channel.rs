@@ -17,7 +17,7 @@ use std::path::Path;
 use render::{Plot, Series};
 
 use super::{drawn, g, mean_se, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict};
-use crate::SweepError;
+use study::SweepError;
 
 /// The activities; ζ = 0 is the baseline.
 const ZETAS: [&str; 5] = ["0", "0.001", "0.0025", "0.005", "0.01"];

@@ -13,7 +13,7 @@ use std::path::Path;
 use render::{Plot, Series};
 
 use super::{drawn, g, mean_std, write_text, Claim, ReproduceParams, Scale, Verdict, PAPER_SCENE};
-use crate::SweepError;
+use study::SweepError;
 
 /// Timings per point.
 const REPEATS: usize = 3;
@@ -149,7 +149,7 @@ fn rule(kt: &[f64], km: f64, lo: f64, hi: f64) -> (Verdict, String) {
 fn exponent(x: &[f64], y: &[f64]) -> f64 {
     let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
     let ly: Vec<f64> = y.iter().map(|v| v.ln()).collect();
-    crate::summary::slope(&lx, &ly)
+    study::summary::slope(&lx, &ly)
 }
 
 pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {

@@ -11,8 +11,8 @@ use super::{
     drawn, g, mean_std, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, SweepResult,
     Verdict,
 };
-use crate::analyze::AnalyzeOptions;
-use crate::SweepError;
+use study::analyze::AnalyzeOptions;
+use study::SweepError;
 
 /// The activities of the ζ sweep (γ = 0.01).
 pub(super) const ZETAS: [&str; 6] = ["0", "0.002", "0.004", "0.006", "0.008", "0.012"];
@@ -126,7 +126,7 @@ pub(super) fn trend(pts: &[AtValue], sign: f64) -> (Verdict, String) {
     let err = (se(a).powi(2) + se(b).powi(2)).sqrt();
     let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
     let y: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
-    let slope = crate::summary::slope(&x, &y);
+    let slope = study::summary::slope(&x, &y);
     let text = format!(
         "from {} at {} to {} at {} (change {} ± {} s.e.; slope {})",
         g(a.1 .0),

@@ -13,8 +13,8 @@ use std::path::Path;
 use render::{Plot, Series};
 
 use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
-use crate::threshold::{growth_threshold, RatePoint, Threshold};
-use crate::SweepError;
+use study::threshold::{growth_threshold, RatePoint, Threshold};
+use study::SweepError;
 
 /// The activities: few, around the brackets of every T (ζ_cr is near 0.004 at T = 100 and has
 /// fallen below 0.001 by T = 800).
@@ -27,10 +27,10 @@ const PRESSURES: [&str; 2] = ["paper", "interaction"];
 
 /// More seeds than the other figures' (the per-seed spread of ζ_cr is as large as the effects
 /// it is compared with): 6 at the quick scale, 10 at the paper scale.
-fn seeds_of(scale: Scale) -> crate::Seeds {
+fn seeds_of(scale: Scale) -> study::Seeds {
     match scale {
-        Scale::Quick => crate::Seeds { first: 1, last: 6 },
-        Scale::Paper => crate::Seeds { first: 1, last: 10 },
+        Scale::Quick => study::Seeds { first: 1, last: 6 },
+        Scale::Paper => study::Seeds { first: 1, last: 10 },
     }
 }
 

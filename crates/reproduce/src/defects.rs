@@ -10,7 +10,7 @@ use super::{
     drawn, g, mean_se, mean_std, write_text, AtValue, Claim, Rec, ReproduceParams, SweepResult,
     Table, Verdict,
 };
-use crate::SweepError;
+use study::SweepError;
 
 /// Bins per side of the creation-position test.
 const BINS: usize = 4;
