@@ -14,7 +14,7 @@ for line in sys.stdin:
         continue
     pkg = m["package_id"]
     name = m["target"]["name"]
-    if ("/crates/gpu#" in pkg and name in ("agreement", "equations")) or ("/crates/cli#" in pkg and name == "main"):
+    if ("/crates/gpu#" in pkg and name in ("agreement", "equations")) or ("/crates/cli#" in pkg and name == "integration"):
         print(name + " " + m["executable"])
 ')
 [ "${#exes[@]}" -eq 3 ] || { echo "expected the gpu tests' 2 executables and the CLI's: ${exes[*]}"; exit 1; }
@@ -23,8 +23,8 @@ for e in "${exes[@]}"; do
     name=${e%% *}
     exe=${e#* }
     filter=()
-    [ "$name" = main ] && filter=(gpu::)
-    (cd "crates/$([ "$name" = main ] && echo cli || echo gpu)" &&
+    [ "$name" = integration ] && filter=(gpu::)
+    (cd "crates/$([ "$name" = integration ] && echo cli || echo gpu)" &&
         env -u MONOLAYER_GPU_REQUIRED VK_ICD_FILENAMES=/nonexistent.json VK_DRIVER_FILES=/nonexistent.json \
             XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}" "$exe" "${filter[@]}" --test-threads 1 --nocapture) >>"$log" 2>&1 ||
         { cat "$log"; echo "FAILED without an adapter: $name"; exit 1; }

@@ -179,7 +179,10 @@ fn stopped(out: &Path, step: u64, error: &mechanics::SimulationError) -> String 
                 "; once the cause is fixed, monolayer run --resume {} continues from the checkpoint at step {c}",
                 out.display()
             )),
-            None => msg.push_str("; there is no checkpoint to resume from"),
+            None => msg.push_str(&format!(
+                "; it wrote no checkpoint before it stopped (the first is due after a minute of wall time, and the final one failed too), so it cannot be resumed: once the cause is fixed (space freed on a full disk), start it again with monolayer run {0}/scene.toml --out {0} --overwrite",
+                out.display()
+            )),
         }
     }
     msg

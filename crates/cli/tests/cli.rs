@@ -1200,7 +1200,7 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
         &["--set", "model.zeta=0.01"],
         "only --set run.time=T",
     );
-    refuse(dir.path(), &[], "has no checkpoints/ to resume from");
+    refuse(dir.path(), &[], "has no checkpoint to resume from");
 }
 
 /// A local sweep checks memory for its largest point times `--jobs` before anything runs,
@@ -1339,6 +1339,45 @@ fn a_full_disk_stops_the_run_cleanly_and_it_resumes_bit_for_bit() {
     for (g, w) in got.iter().zip(&want) {
         assert!(g == w, "{} differs", w.0);
     }
+    // Full in the first minute, with the default checkpoints (the first a minute of wall
+    // time in): no checkpoint at all. The message says so and how to start again, and that
+    // command, once there is room, runs.
+    std::fs::remove_dir_all(&out).unwrap();
+    assert!(mount("remount,size=200k"), "cannot shrink the tmpfs");
+    let first = small.join("first");
+    let default_ckpt: Vec<&str> = args[..6].to_vec();
+    let o = run(&scene_path("paper.toml"), &first, &default_ckpt);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "the run fitted in 200 KiB: {e}");
+    assert!(rundir::checkpoint::checkpoints(&first).is_empty(), "{e}");
+    let again = format!(
+        "monolayer run {0}/scene.toml --out {0} --overwrite",
+        first.display()
+    );
+    assert!(
+        e.contains("it wrote no checkpoint") && e.contains(&again),
+        "{e}"
+    );
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&first)
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert!(
+        !o.status.success() && e.contains("no checkpoint to resume from") && e.contains(&again),
+        "{e}"
+    );
+    assert!(mount("remount,size=32m"), "cannot enlarge the tmpfs");
+    let o = bin()
+        .arg("run")
+        .arg(first.join("scene.toml"))
+        .arg("--out")
+        .arg(&first)
+        .args(["--overwrite", "--quiet"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// Issue 25's cases, each a regression test: every one ends in a clear error that names the

@@ -57,7 +57,7 @@ pub enum RunError {
         holder: String,
     },
     /// Nothing to resume from.
-    #[error("{} has no checkpoints/ to resume from (runs write one at the end, on a signal, and on [run] checkpoint_every; this one was killed before the first, or was not run by monolayer run)", dir.display())]
+    #[error("{0} has no checkpoint to resume from: a run writes one at the end, on a signal, on [run] checkpoint_every and after each 10 minutes of wall time (the first at least a minute in), and this one stopped before its first (it was killed, or a write failed, as on a full disk) or was not written by monolayer run; start it again with monolayer run {0}/scene.toml --out {0} --overwrite", dir.display())]
     NoCheckpoint {
         /// The directory.
         dir: PathBuf,
