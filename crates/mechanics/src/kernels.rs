@@ -119,23 +119,45 @@ fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mu
     st.area = area.iter().sum();
     st.phi_max = hi.into_iter().fold(f64::NEG_INFINITY, f64::max);
     st.phi_min = -neg_lo.into_iter().fold(f64::NEG_INFINITY, f64::max);
-    let mut acc = [[0.0; LANES]; 2];
-    if SHAPE {
+    // The accumulators live inside the closure and come back by value: when they were a local
+    // of this function borrowed into it, and `LocalKey::with` was not inlined here (as after
+    // the physics terms grew `evaluate`), LLVM kept them in memory and stored all of them at
+    // every chunk of 8 nodes: 118 instructions a chunk where this loop takes 32 (issue 38,
+    // 11.6 of the 17 instructions per node-update the minimal model had gained).
+    let acc = if SHAPE {
         PADDED.with_borrow_mut(|padded| {
             padded.fill(cell, shape);
             let PaddedParts { run, mask, .. } = padded.parts();
-            // The density is quadratic in the gradient: fed the undivided differences
-            // (`Stencil::diff_x`, twice the gradient) it gives 4× its value, which the sum
-            // takes back by ¼, exactly, where the ½ of each difference cost a multiplication
-            // per node.
-            let value = move |s: Stencil, [w]: [f64; 1]| {
-                let [sxx, sxy] = shape_tensor_density([s.diff_x(), s.diff_y()]);
-                [w * sxx, w * sxy]
-            };
-            run.sum_into([mask], value, &mut acc);
-        });
-    }
+            shape_sum(&run, mask)
+        })
+    } else {
+        [[0.0; LANES]; 2]
+    };
     st.shape = TracelessTensor::from(add_lanes(&acc).map(|s| 0.25 * s));
+}
+
+/// The deformation tensor's sum over the padded patch `run` (`mask` weighting its nodes), in
+/// `LANES` partial sums of each
+/// component (four times `S_i`: see below). A function of its own, never inlined, so that its
+/// chunk loop is compiled alone with its accumulators in registers: inlined into the
+/// thread-local access of a larger `evaluate`, LLVM split the loop into scalar and 128-bit
+/// pieces (85–118 instructions a chunk of 8 nodes where this takes 32; issue 38).
+#[inline(never)]
+fn shape_sum(run: &phasefield::kernel::StencilRun<'_, f64>, mask: &[f64]) -> [[f64; LANES]; 2] {
+    // The density is quadratic in the gradient: fed the undivided differences
+    // (`Stencil::diff_x`, twice the gradient) it gives 4× its value, which the sum takes back
+    // by ¼, exactly, where the ½ of each difference cost a multiplication per node.
+    let value = move |s: Stencil, [w]: [f64; 1]| {
+        let [sxx, sxy] = shape_tensor_density([s.diff_x(), s.diff_y()]);
+        [w * sxx, w * sxy]
+    };
+    // The five neighbour slices through an optimisation barrier: seen as one buffer at fixed
+    // offsets, LLVM loaded each vector once and shuffled it into its neighbours (53
+    // instructions a chunk where five plain loads take 32).
+    let run = std::hint::black_box(*run);
+    let mut acc = [[0.0; LANES]; 2];
+    run.sum_into([mask], value, &mut acc);
+    acc
 }
 
 /// What the last pass of [`evaluate`] does with each cell's right-hand side `k` once it has it,
