@@ -19,23 +19,22 @@ use std::cell::RefCell;
 
 use nalgebra::Vector2;
 use phasefield::kernel::{add_lanes, PaddedParts, PaddedPatch, LANES};
-use phasefield::{Cells, ComTable, PatchShape, Real, Stencil, WallField};
+use phasefield::{Cells, ComTable, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
 use crate::equations::{
-    adhesion_coefficient, adhesion_derivative, adhesion_pressure, adhesion_pressure_cell_part,
-    force_density, heun_corrector, heun_predictor, nematic_density, pressure, pressure_cell_part,
-    pressure_self_coefficient, pressure_self_part_with, rhs, shape_tensor_density, velocity,
-    wall_derivative, wall_pressure,
+    adhesion_derivative, adhesion_pressure_cell_part, force_density, heun_corrector,
+    heun_predictor, nematic_density, pressure, pressure_cell_part, pressure_self_coefficient,
+    pressure_self_part_with, rhs, shape_tensor_density, velocity,
 };
 use crate::geometry::TracelessTensor;
+use crate::node_terms::NodeTerm;
 use crate::params::{ModelParams, PressureKind};
 use crate::scatter::{scatter, LatticeSums};
 use crate::terms::{CellConstants, Populations};
 use crate::workspace::{CellState, SumField, N_SUMS};
 
 // Where each lattice sum is stored.
-const I_S1: usize = SumField::S1.index();
 const I_S2: usize = SumField::S2.index();
 const I_QXX: usize = SumField::Qxx.index();
 const I_QXY: usize = SumField::Qxy.index();
@@ -160,6 +159,35 @@ fn shape_sum(run: &phasefield::kernel::StencilRun<'_, f64>, mask: &[f64]) -> [[f
     acc
 }
 
+/// What one evaluation reads: the state, the parameters, the terms' whole-cell forces, each
+/// slot's identity with the per-identity constants (populations, the growth factors), and the
+/// node terms ([`crate::node_terms`], `None` for one that is absent).
+#[derive(Clone, Copy)]
+pub(crate) struct EvalInput<'a, T: Real> {
+    pub params: &'a ModelParams,
+    pub cells: &'a Cells<T>,
+    pub phi: &'a [T],
+    /// Whether to compute the deformation tensors and `Q` (see [`evaluate`]).
+    pub shapes: bool,
+    pub cell_force: Option<&'a [[f64; 2]]>,
+    pub populations: &'a Populations,
+    pub ids: &'a [usize],
+    pub active: bool,
+    pub growth: &'a [f64],
+    pub node_terms: &'a [Option<&'a dyn NodeTerm>],
+}
+
+/// Where one evaluation writes what it computes on the way (all of it left for inspection).
+pub(crate) struct EvalScratch<'a> {
+    pub sums: &'a mut LatticeSums<N_SUMS>,
+    pub cell_state: &'a mut [CellState],
+    /// One lattice field for the node terms ([`NodeTerm::add_pressure`]).
+    pub node_scratch: &'a mut [f64],
+    /// Two lattice fields, the node terms' `a` and `b`.
+    pub node_coefficients: &'a mut [f64],
+    pub kind_constants: &'a mut Vec<CellConstants>,
+}
+
 /// What the last pass of [`evaluate`] does with each cell's right-hand side `k` once it has it,
 /// while the cell's fields are in cache: a Heun update that would otherwise be a sweep of its
 /// own over every field, and a parallel loop of its own. The values are those of the separate
@@ -215,24 +243,31 @@ enum CellPost<'c, T> {
 /// rearrangements of this function that only renamed or regrouped its locals: its speed
 /// depends on how LLVM inlines the closures, so time it after any change, with the whole-run
 /// command in `docs/performance.md`.)
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn evaluate<T: Real>(
-    params: &ModelParams,
-    cells: &Cells<T>,
-    phi: &[T],
-    shapes: bool,
+    input: &EvalInput<'_, T>,
     rhs_out: &mut [T],
-    global: &mut LatticeSums<N_SUMS>,
-    cell_state: &mut [CellState],
-    cell_force: Option<&[[f64; 2]]>,
-    lap_s1: &mut [f64],
-    node_buf: &mut [f64],
-    cells_of: (&Populations, &[usize], bool, &[f64]),
-    kind_constants: &mut Vec<CellConstants>,
-    walls: Option<WallTerm<'_>>,
+    scratch: EvalScratch<'_>,
     post: Post<'_, T>,
 ) {
-    let (pops, ids, active, growth) = cells_of;
+    let EvalInput {
+        params,
+        cells,
+        phi,
+        shapes,
+        cell_force,
+        populations: pops,
+        ids,
+        active,
+        growth,
+        node_terms: terms,
+    } = *input;
+    let EvalScratch {
+        sums: global,
+        cell_state,
+        node_scratch,
+        node_coefficients: node_buf,
+        kind_constants,
+    } = scratch;
     let shape = cells.shape();
     let plen = shape.len();
     let energy = params.energy;
@@ -269,7 +304,12 @@ pub(crate) fn evaluate<T: Real>(
     // 2. Lattice sums.
     let coef = energy.coefficients();
     let kind = params.pressure;
-    let c_adh = adhesion_coefficient(params.omega, energy.lambda);
+    // The node terms' single-cell pressure `k φ ∇²φ` (adhesion's), summed.
+    let c_adh: f64 = terms
+        .iter()
+        .flatten()
+        .map(|t| t.cell_pressure_coefficient())
+        .sum();
     {
         let cs: &[CellState] = cell_state;
         scatter::<N_SUMS, T, _, _>(
@@ -342,19 +382,23 @@ pub(crate) fn evaluate<T: Real>(
         );
     }
 
-    // Adhesion: the lattice Laplacian of s1, and its cross term in the pressure.
-    if c_adh != 0.0 {
-        add_adhesion_pressure(c_adh, global, lap_s1);
+    // The node terms' lattice parts of the pressure, then their coefficients, gathered by
+    // the force pass.
+    for t in terms.iter().flatten() {
+        t.add_pressure(global, node_scratch);
     }
-    // Walls: their part of the pressure.
-    if let Some(walls) = walls {
-        add_wall_pressure(walls, global);
-    }
-    // The node terms' per-node coefficients, gathered by the force pass.
-    let node_terms = (c_adh != 0.0 || walls.is_some()).then(|| {
-        fill_node_terms(c_adh, lap_s1, walls, node_buf);
+    let node_terms = terms.iter().any(Option::is_some).then(|| {
+        fill_node_terms(terms, node_scratch, node_buf);
         let (a, b) = node_buf.split_at(node_buf.len() / 2);
-        NodeTerms { a, b, c_adh }
+        NodeTerms {
+            a,
+            b,
+            c_lap: terms
+                .iter()
+                .flatten()
+                .map(|t| t.laplacian_coefficient())
+                .sum(),
+        }
     });
 
     // 3. Forces, velocities and the right-hand side.
@@ -418,7 +462,7 @@ pub(crate) fn evaluate<T: Real>(
                 ),
                 // Adhesion and walls: their derivative `a φ + b + c ∇²φ` (see `NodeTerms`),
                 // with `a` and `b` gathered beside the patch (a branch outside the node loops).
-                Some(NodeTerms { a, b, c_adh }) => NODE_TERMS.with_borrow_mut(|extra| {
+                Some(NodeTerms { a, b, c_lap }) => NODE_TERMS.with_borrow_mut(|extra| {
                     extra.prepare(shape);
                     extra.gather(xs, g.cell_runs(i), |x| {
                         [&a[x * ly..(x + 1) * ly], &b[x * ly..(x + 1) * ly]]
@@ -430,7 +474,7 @@ pub(crate) fn evaluate<T: Real>(
                             let others = s2 - s.c * s.c;
                             let lap = s.laplacian();
                             let dfdphi = coef.free_energy_derivative(s.c, lap, area_factor, others)
-                                + node_derivative(ea, eb, c_adh, s.c, lap);
+                                + node_derivative(ea, eb, c_lap, s.c, lap);
                             [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
                         },
                         [flat],
@@ -515,114 +559,36 @@ pub(crate) fn evaluate<T: Real>(
     }
 }
 
-/// The walls of an evaluation: the field in effect and its coefficients
-/// ([`crate::equations::wall_coefficients`]).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct WallTerm<'a> {
-    pub field: &'a WallField,
-    pub coefficients: [f64; 2],
-}
-
-/// The walls' part of the pressure, [`wall_pressure`], added node by node once the scatter
-/// has completed the sums.
-fn add_wall_pressure(walls: WallTerm<'_>, sums: &mut LatticeSums<N_SUMS>) {
-    let lattice = sums.lattice();
-    let ly = lattice.ly;
-    let (w, lap) = (walls.field.w(), walls.field.laplacian());
-    for x in 0..lattice.lx {
-        let ([s1, s2], p) = sums.columns_read_write([I_S1, I_S2], I_P, x);
-        let range = x * ly..(x + 1) * ly;
-        for (((p, &s2), &s1), (&w, &lap)) in p
-            .iter_mut()
-            .zip(s2)
-            .zip(s1)
-            .zip(w[range.clone()].iter().zip(&lap[range]))
-        {
-            *p += wall_pressure(walls.coefficients, s1, s2, w, lap);
-        }
-    }
-}
-
-/// The lattice Laplacian of `s1` into `lap_s1` (index `x * ly + y`), and the adhesion's cross
-/// term `−c s1 ∇²s1` ([`adhesion_pressure`]) added to the pressure, once the scatter has
-/// completed the sums.
-fn add_adhesion_pressure(c: f64, sums: &mut LatticeSums<N_SUMS>, lap_s1: &mut [f64]) {
-    let lattice = sums.lattice();
-    let (lx, ly) = (lattice.lx, lattice.ly);
-    assert_eq!(
-        lap_s1.len(),
-        lx * ly,
-        "the Laplacian buffer holds the lattice"
-    );
-    lap_s1.par_chunks_mut(ly).enumerate().for_each(|(x, out)| {
-        let (xm, xp) = ((x + lx - 1) % lx, (x + 1) % lx);
-        let (c0, cm, cp) = (
-            sums.column(I_S1, x),
-            sums.column(I_S1, xm),
-            sums.column(I_S1, xp),
-        );
-        for y in 0..ly {
-            let (ym, yp) = (
-                if y == 0 { ly - 1 } else { y - 1 },
-                if y + 1 == ly { 0 } else { y + 1 },
-            );
-            out[y] = cm[y] + cp[y] + c0[ym] + c0[yp] - 4.0 * c0[y];
-        }
-    });
-    for x in 0..lx {
-        let ([s1], p) = sums.columns_read_write([I_S1], I_P, x);
-        for ((p, &s1), &lap) in p.iter_mut().zip(s1).zip(&lap_s1[x * ly..(x + 1) * ly]) {
-            *p += adhesion_pressure(c, s1, lap);
-        }
-    }
-}
-
-/// The node terms' coefficients of an evaluation: their derivative is linear in `φ_i`,
-/// `δF_node/δφ_i = a φ_i + b + c_adh ∇²φ_i`, with the lattice fields
-/// `a = (2κ_w/λ) w²` and `b = −2ω_wλ ∇²w − c_adh ∇²s1` (index `x * ly + y`): the walls'
-/// [`wall_derivative`] and the adhesion's [`adhesion_derivative`] split by linearity.
+/// The node terms' coefficients of an evaluation, summed over its terms
+/// ([`crate::node_terms`]): `δF_node/δφ_i = a φ_i + b + c ∇²φ_i`, with the lattice fields `a`
+/// and `b` (index `x * ly + y`) and the constant `c`.
 #[derive(Debug, Clone, Copy)]
 struct NodeTerms<'a> {
     a: &'a [f64],
     b: &'a [f64],
-    c_adh: f64,
+    c_lap: f64,
 }
 
-/// [`NodeTerms`]' `a` and `b` into the two halves of `out` (two lattice fields).
-fn fill_node_terms(c_adh: f64, lap_s1: &[f64], walls: Option<WallTerm<'_>>, out: &mut [f64]) {
+/// The terms' `a` and `b` into the two halves of `out` (two lattice fields), each term adding
+/// its own in the order of `terms`.
+fn fill_node_terms(terms: &[Option<&dyn NodeTerm>], scratch: &[f64], out: &mut [f64]) {
     let (a, b) = out.split_at_mut(out.len() / 2);
     const CHUNK: usize = 4096;
     a.par_chunks_mut(CHUNK)
         .zip(b.par_chunks_mut(CHUNK))
         .enumerate()
         .for_each(|(c, (a, b))| {
-            let k0 = c * CHUNK;
-            match walls {
-                Some(WallTerm {
-                    field,
-                    coefficients,
-                }) => {
-                    let (w, lap_w) = (&field.w()[k0..], &field.laplacian()[k0..]);
-                    for (k, (a, b)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
-                        *a = wall_derivative(coefficients, 1.0, w[k], 0.0);
-                        *b = wall_derivative(coefficients, 0.0, w[k], lap_w[k]);
-                    }
-                }
-                None => {
-                    a.fill(0.0);
-                    b.fill(0.0);
-                }
-            }
-            if c_adh != 0.0 {
-                for (b, &lap) in b.iter_mut().zip(&lap_s1[k0..]) {
-                    *b += adhesion_derivative(c_adh, lap, 0.0);
-                }
+            a.fill(0.0);
+            b.fill(0.0);
+            for t in terms.iter().flatten() {
+                t.add_coefficients(scratch, c * CHUNK, a, b);
             }
         });
 }
 
-/// The node terms' derivative at a node, `a φ + b + c_adh ∇²φ` ([`NodeTerms`]).
+/// The node terms' derivative at a node, `a φ + b + c ∇²φ` ([`NodeTerms`]; the Laplacian
+/// part in the form of adhesion's, `equations::adhesion_derivative`, which it was first).
 #[inline(always)]
-fn node_derivative(a: f64, b: f64, c_adh: f64, phi: f64, laplacian: f64) -> f64 {
-    a * phi + b + adhesion_derivative(c_adh, 0.0, laplacian)
+fn node_derivative(a: f64, b: f64, c_lap: f64, phi: f64, laplacian: f64) -> f64 {
+    a * phi + b + adhesion_derivative(c_lap, 0.0, laplacian)
 }

@@ -61,6 +61,7 @@ pub mod extensions;
 mod fields;
 mod geometry;
 mod kernels;
+mod node_terms;
 mod observables;
 mod params;
 mod scatter;

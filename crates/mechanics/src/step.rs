@@ -4,8 +4,9 @@
 use phasefield::Real;
 use rayon::prelude::*;
 
-use crate::equations::{heun_corrector, heun_predictor, wall_coefficients};
-use crate::kernels::{evaluate, Post, WallTerm};
+use crate::equations::{adhesion_coefficient, heun_corrector, heun_predictor, wall_coefficients};
+use crate::kernels::{evaluate, EvalInput, EvalScratch, Post};
+use crate::node_terms::{Adhesion, NodeTerm, WallTerm};
 use crate::params::StepParams;
 use crate::scatter::LatticeSums;
 use crate::terms::CellsView;
@@ -357,12 +358,22 @@ impl<T: Real> Tissue<T> {
         let TermScratch {
             cell_force,
             lap_s1,
-            node_terms,
+            node_terms: node_terms_buf,
             kind_constants,
         } = scratch;
-        // The lattice buffer of adhesion, made on its first use (the one allocation of a run
-        // with adhesion).
-        let n = if self.params.omega != 0.0 {
+        // The node terms of this evaluation, in a fixed order (adhesion, then walls: the
+        // order their pressures and coefficients are added in).
+        let adhesion = (self.params.omega != 0.0).then(|| Adhesion {
+            c: adhesion_coefficient(self.params.omega, self.params.energy.lambda),
+        });
+        let walls = self.wall_term();
+        let node_terms: [Option<&dyn NodeTerm>; 2] = [
+            adhesion.as_ref().map(|t| t as &dyn NodeTerm),
+            walls.as_ref().map(|t| t as &dyn NodeTerm),
+        ];
+        // Their lattice scratch, made on its first use (the one allocation of a run with
+        // adhesion).
+        let n = if node_terms.iter().flatten().any(|t| t.needs_scratch()) {
             self.lattice().len()
         } else {
             0
@@ -370,14 +381,14 @@ impl<T: Real> Tissue<T> {
         if lap_s1.len() != n {
             lap_s1.resize(n, 0.0);
         }
-        // The node terms' coefficients, with adhesion or walls (made on first use too).
-        let m = if self.params.omega != 0.0 || self.wall_field().is_some() {
+        // Their coefficients (made on first use too).
+        let m = if node_terms.iter().any(Option::is_some) {
             2 * self.lattice().len()
         } else {
             0
         };
-        if node_terms.len() != m {
-            node_terms.resize(m, 0.0);
+        if node_terms_buf.len() != m {
+            node_terms_buf.resize(m, 0.0);
         }
         // The terms' whole-cell forces of the current state, from the per-cell quantities the
         // last evaluation left (see `CellContext::state`).
@@ -389,27 +400,26 @@ impl<T: Real> Tissue<T> {
                 .forces(&self.terms_view(cell_state), cell_force);
             Some(&cell_force[..])
         };
-        evaluate(
-            &self.params,
-            &self.cells,
-            self.cells.phi(),
+        let input = EvalInput {
+            params: &self.params,
+            cells: &self.cells,
+            phi: self.cells.phi(),
             shapes,
-            out,
+            cell_force,
+            populations: &self.ext.populations,
+            ids: &self.cell_id,
+            active: self.active,
+            growth: &self.ext.target_scale,
+            node_terms: &node_terms,
+        };
+        let scratch = EvalScratch {
             sums,
             cell_state,
-            cell_force,
-            lap_s1,
-            node_terms,
-            (
-                &self.ext.populations,
-                &self.cell_id,
-                self.active,
-                &self.ext.target_scale,
-            ),
+            node_scratch: lap_s1,
+            node_coefficients: node_terms_buf,
             kind_constants,
-            self.wall_term(),
-            post,
-        );
+        };
+        evaluate(&input, out, scratch, post);
     }
 
     /// Evaluates the derived quantities of the current state (areas, shapes, forces,
