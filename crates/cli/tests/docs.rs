@@ -9,6 +9,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use crate::common::quarter_scene;
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
@@ -98,34 +100,14 @@ fn check_named(line: &str) {
     }
 }
 
-/// The shipped scenes at a small scale: a quarter of the lattice and of the cells (the same
-/// density, steps and outputs). A scene that places its cells (`init = "positions"`) stays as
-/// it is: its positions do not scale, and it has a few cells anyway.
+/// The shipped scenes at a small scale ([`quarter_scene`]), in `dir/scenes/`.
 fn small_scenes(dir: &Path) {
     let scenes = dir.join("scenes");
     std::fs::create_dir_all(&scenes).unwrap();
     for e in std::fs::read_dir(root().join("scenes")).unwrap() {
         let path = e.unwrap().path();
         let text = std::fs::read_to_string(&path).unwrap();
-        if text.contains("init = \"positions\"") {
-            std::fs::write(scenes.join(path.file_name().unwrap()), text).unwrap();
-            continue;
-        }
-        let mut out = String::new();
-        for line in text.lines() {
-            let halved = |key: &str, div: usize| -> Option<String> {
-                let v = line.strip_prefix(key)?.trim().strip_prefix('=')?.trim();
-                let n: usize = v.parse().ok()?;
-                Some(format!("{key} = {}", (n / div).max(1)))
-            };
-            let l = halved("lx", 2)
-                .or_else(|| halved("ly", 2))
-                .or_else(|| halved("count", 4))
-                .unwrap_or_else(|| line.to_string());
-            out += &l;
-            out += "\n";
-        }
-        std::fs::write(scenes.join(path.file_name().unwrap()), out).unwrap();
+        std::fs::write(scenes.join(path.file_name().unwrap()), quarter_scene(&text)).unwrap();
     }
 }
 

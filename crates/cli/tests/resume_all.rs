@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use crate::common::{bin, run_files, scene_path, stderr};
+use crate::common::{bin, quarter_scene, run_files, scene_path, stderr};
 
 /// The overrides that make a scene short: a relaxation of 40 TU (the initial discs grow to their cells; a wound opens and a
 /// clock starts inside the run) and `time` TU of activity, frames every 10 TU.
@@ -23,29 +23,12 @@ fn short(time: u32) -> Vec<String> {
     .collect()
 }
 
-/// The scene `name` at a quarter of its area and cells (scenes that place their cells stay
-/// as they are), written into `dir`.
+/// The scene `name` at a quarter of its area and cells ([`quarter_scene`]), written into
+/// `dir`.
 fn small(name: &str, dir: &Path) -> std::path::PathBuf {
     let text = std::fs::read_to_string(scene_path(name)).unwrap();
-    let mut out = String::new();
-    for line in text.lines() {
-        let scaled = |key: &str, div: usize| -> Option<String> {
-            if text.contains("init = \"positions\"") {
-                return None;
-            }
-            let v = line.strip_prefix(key)?.trim().strip_prefix('=')?.trim();
-            let n: usize = v.parse().ok()?;
-            Some(format!("{key} = {}", (n / div).max(1)))
-        };
-        let l = scaled("lx", 2)
-            .or_else(|| scaled("ly", 2))
-            .or_else(|| scaled("count", 4))
-            .unwrap_or_else(|| line.to_string());
-        out += &l;
-        out += "\n";
-    }
     let path = dir.join(name);
-    std::fs::write(&path, out).unwrap();
+    std::fs::write(&path, quarter_scene(&text)).unwrap();
     path
 }
 

@@ -170,10 +170,8 @@ fn a_known_half_integer_texture_puts_the_marks_at_the_right_pixels() {
     }
 }
 
-/// Values fill the cells on a colour bar: the low cell gets viridis' dark end, the high one
-/// its yellow end; mismatched arrays are refused with what is wrong.
-#[test]
-fn values_fill_cells_at_the_ends_of_the_colour_bar() {
+/// Two cells of radius 8, at x = 16 and x = 48, on a 64 × 32 picture of 256 pixels.
+fn two_cells() -> TissuePicture {
     let lattice = Lattice::new(64, 32);
     let a = disc(lattice, 16.0, 16.0, 8.0, 24);
     let b = disc(lattice, 48.0, 16.0, 8.0, 24);
@@ -184,6 +182,14 @@ fn values_fill_cells_at_the_ends_of_the_colour_bar() {
         origins: vec![a.origins[0], b.origins[0]],
         phi: [a.phi, b.phi].concat(),
     };
+    p
+}
+
+/// Values fill the cells on a colour bar: the low cell gets viridis' dark end, the high one
+/// its yellow end; mismatched arrays are refused with what is wrong.
+#[test]
+fn values_fill_cells_at_the_ends_of_the_colour_bar() {
+    let mut p = two_cells();
     p.fill = Fill::Values {
         values: vec![1.0, 3.0],
         label: "area".into(),
@@ -272,16 +278,7 @@ fn movies_hold_every_frame() {
 /// order right of the field, and a category without a name is refused.
 #[test]
 fn categories_fill_cells_with_distinct_colours_and_a_legend() {
-    let lattice = Lattice::new(64, 32);
-    let a = disc(lattice, 16.0, 16.0, 8.0, 24);
-    let b = disc(lattice, 48.0, 16.0, 8.0, 24);
-    let mut p = TissuePicture::new(64, 32, 256);
-    p.patches = Patches {
-        nx: 24,
-        ny: 24,
-        origins: vec![a.origins[0], b.origins[0]],
-        phi: [a.phi, b.phi].concat(),
-    };
+    let mut p = two_cells();
     p.fill = Fill::Categories {
         of_cell: vec![1, 0],
         names: vec!["soft".into(), "stiff".into()],

@@ -360,16 +360,12 @@ impl Scene {
     /// a new run and for a checkpoint's (whose state arrays then replace the parts' state,
     /// [`mechanics::Extensions::restore_arrays`]).
     pub fn extensions<T: Real>(&self, tissue: &Tissue<T>) -> mechanics::Extensions {
-        mechanics::Extensions::none()
-            .with_terms(self.terms())
-            .with_populations(self.file.populations())
-            .with_walls(self.walls())
-            .with_proliferation(
-                self.file
-                    .division
-                    .as_ref()
-                    .map(|spec| division::clock(spec, &self.file, tissue)),
-            )
+        self.configured_extensions().with_proliferation(
+            self.file
+                .division
+                .as_ref()
+                .map(|spec| division::clock(spec, &self.file, tissue)),
+        )
     }
 
     /// The most cells the run can hold: `[division] max_cells` (or its default) with

@@ -67,3 +67,27 @@ pub fn resume_matches(dir: &Path, want: &[(String, Vec<u8>)], what: &str) {
         "{what}: the resumed run is marked complete"
     );
 }
+
+/// A scene's text at a quarter of its area and cells (the same density, steps and outputs):
+/// `lx` and `ly` halved, `count` quartered. A scene that places its cells
+/// (`init = "positions"`) stays as it is: its positions do not scale, and it has a few cells.
+pub fn quarter_scene(text: &str) -> String {
+    if text.contains("init = \"positions\"") {
+        return text.to_string();
+    }
+    let mut out = String::new();
+    for line in text.lines() {
+        let scaled = |key: &str, div: usize| -> Option<String> {
+            let v = line.strip_prefix(key)?.trim().strip_prefix('=')?.trim();
+            let n: usize = v.parse().ok()?;
+            Some(format!("{key} = {}", (n / div).max(1)))
+        };
+        let l = scaled("lx", 2)
+            .or_else(|| scaled("ly", 2))
+            .or_else(|| scaled("count", 4))
+            .unwrap_or_else(|| line.to_string());
+        out += &l;
+        out += "\n";
+    }
+    out
+}
