@@ -241,6 +241,24 @@ fn a_state_from_a_mixture_keeps_its_populations() {
         .remove(0)
         .data;
     assert_eq!(got, want, "the frame's populations, not a new deal");
+    assert!(!stderr(&o).contains("not carried"), "{}", stderr(&o));
+    // The same frame into a scene without populations: the run goes on (the scene says
+    // so), and says that the frame's `population` is not carried.
+    let plain = dir.path().join("plain.toml");
+    std::fs::write(
+        &plain,
+        "[domain]\nlx = 100\nly = 100\n[cells]\ncount = 48\nradius = 8.0\n\
+         [model]\nmu = 5.0\nxi = 1.5\n[integrator]\ndt = 0.5\n\
+         [run]\nrelax_time = 0.0\ntime = 1.0\n",
+    )
+    .unwrap();
+    let o = run(&plain, &dir.path().join("d"), &["cells.init=frame", &from]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("its arrays population are not carried"),
+        "{}",
+        stderr(&o)
+    );
     // The deal of seed 9 differs, so the check can fail.
     let c = dir.path().join("c");
     let o = run(

@@ -433,4 +433,42 @@ mod tests {
             assert_eq!(differ, vec![part], "without {part:?}");
         }
     }
+
+    /// `init = "frame"` names each extension array it does not carry, and only those: from
+    /// a frame and a checkpoint of a run with every part, the same scene carries all of them
+    /// (so [`crate::state::not_carried`]'s list of the cells' own arrays is complete), and
+    /// a scene without polarity leaves out exactly the polarity's arrays.
+    #[test]
+    fn a_saved_state_names_what_a_new_scene_does_not_carry() {
+        // At step 0: once cells divide, the populations' counts no longer add up to
+        // `[cells] count`, which a scene must state.
+        let full = scene(None);
+        let mut sim = full.simulation::<f64>().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let frame = crate::frame::write_frame(dir.path(), sim.tissue(), sim.workspace()).unwrap();
+        let checkpoint = write_checkpoint(dir.path(), sim.tissue(), None, &full.to_toml()).unwrap();
+        // A frame also holds what the terms derive (the polarity's unit vector).
+        let polar: [&[&str]; 2] = [&["polarity.theta", "polarity"], &["polarity.theta"]];
+        for (path, polar) in [&frame, &checkpoint].into_iter().zip(polar) {
+            let from = |s: &scene::Scene| {
+                let set = [
+                    "cells.init=\"frame\"".to_string(),
+                    format!("cells.from={:?}", path.display().to_string()),
+                ];
+                scene::Scene::parse(&s.to_toml(), &set).unwrap()
+            };
+            assert_eq!(
+                crate::state::not_carried(&from(&full)).unwrap(),
+                Vec::<String>::new(),
+                "{}",
+                path.display()
+            );
+            assert_eq!(
+                crate::state::not_carried(&from(&scene(Some(Part::Terms)))).unwrap(),
+                polar,
+                "{}",
+                path.display()
+            );
+        }
+    }
 }

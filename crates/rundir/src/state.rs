@@ -66,6 +66,58 @@ pub fn saved_terms<T: Real>(
     )
 }
 
+/// The arrays of a state file that are not the state of the cells' fields: those of
+/// [`crate::frame::write_frame`] and [`crate::checkpoint::write_checkpoint`] that every run
+/// writes. The rest are the extensions' and are carried by [`saved_terms`] when the scene has
+/// the part that keeps them.
+const CORE_ARRAYS: [&str; 21] = [
+    "format",
+    "step",
+    "time",
+    "zeta",
+    "lattice",
+    "patch",
+    "id",
+    "cell_id",
+    "next_id",
+    "centre",
+    "velocity",
+    "force",
+    "cell_force",
+    "area",
+    "shape_tensor",
+    "origin",
+    "offset",
+    "phi",
+    "scene",
+    "controller",
+    "lineage",
+];
+
+/// The extensions' arrays of the saved state `scene` starts from (`init = "frame"`) that the
+/// scene has no part to carry, such as `polarity.theta` from a polar run into a scene without
+/// `[polarity]`: the new run starts without them, which a caller should say. Empty for the
+/// other layouts. (The `lineage` of a checkpoint is never carried: a new run starts a lineage
+/// of its own, its founders the cells of the file.)
+///
+/// # Errors
+/// The file cannot be read.
+pub fn not_carried(scene: &Scene) -> std::result::Result<Vec<String>, StateError> {
+    let Some(from) = scene.init_from() else {
+        return Ok(Vec::new());
+    };
+    let names = crate::frame::npz_names(Path::new(from)).map_err(|error| StateError::Read {
+        from: from.to_string(),
+        error,
+    })?;
+    let ext = scene.configured_extensions();
+    let carried: Vec<String> = ext.frame_arrays().into_iter().map(|a| a.name).collect();
+    Ok(names
+        .into_iter()
+        .filter(|n| !CORE_ARRAYS.contains(&n.as_str()) && !carried.contains(n))
+        .collect())
+}
+
 /// The saved state `scene` starts from (`init = "frame"`; `None` for the other layouts),
 /// read and checked against the scene, so that a caller can refuse a scene before it writes
 /// anything.
