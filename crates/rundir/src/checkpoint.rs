@@ -443,7 +443,7 @@ mod tests {
         // At step 0: once cells divide, the populations' counts no longer add up to
         // `[cells] count`, which a scene must state.
         let full = scene(None);
-        let mut sim = full.simulation::<f64>().unwrap();
+        let sim = full.simulation::<f64>().unwrap();
         let dir = tempfile::tempdir().unwrap();
         let frame = crate::frame::write_frame(dir.path(), sim.tissue(), sim.workspace()).unwrap();
         let checkpoint = write_checkpoint(dir.path(), sim.tissue(), None, &full.to_toml()).unwrap();
