@@ -562,6 +562,17 @@ impl<T: Real> Simulation<T> {
         self.backend.as_deref().map(|b| b.name())
     }
 
+    /// Whether the tissue has reached the run's end (its stop iteration or stop time; a wall
+    /// time limit is not an end): a run stopped by a callback at its last step has done
+    /// all it was asked.
+    pub fn at_end(&self) -> bool {
+        let t = &self.tissue;
+        self.stop_iteration.is_some_and(|n| t.iteration() >= n)
+            || self
+                .stop_time
+                .is_some_and(|s| t.time() >= s - 1e-9 * self.step_params.dt)
+    }
+
     /// The iteration the run stops at, when a stop iteration is set.
     pub fn stop_at_iteration(&self) -> Option<u64> {
         self.stop_iteration
@@ -606,12 +617,7 @@ impl<T: Real> Simulation<T> {
     }
 
     fn done(&self, start: Instant) -> bool {
-        let t = &self.tissue;
-        self.stop_iteration.is_some_and(|n| t.iteration() >= n)
-            || self
-                .stop_time
-                .is_some_and(|s| t.time() >= s - 1e-9 * self.step_params.dt)
-            || self.wall_time_limit.is_some_and(|w| start.elapsed() >= w)
+        self.at_end() || self.wall_time_limit.is_some_and(|w| start.elapsed() >= w)
     }
 
     /// Runs `hook` of the callbacks, then of the writers (`call` only where the schedule

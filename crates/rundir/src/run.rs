@@ -152,6 +152,18 @@ impl Interrupt {
         }
     }
 
+    /// Asks the runs that hold this handle (or a clone) to stop after their step in
+    /// progress, as if `signal` had come: how a host that catches its own interrupts (an
+    /// embedding interpreter) stops a run. The second call does not end the process.
+    pub fn raise(&self, signal: i32) {
+        self.signal.store(signal.max(1) as usize, Ordering::SeqCst);
+    }
+
+    /// Forgets a raised or caught signal, so that the runs holding this handle can go on.
+    pub fn clear(&self) {
+        self.signal.store(0, Ordering::SeqCst);
+    }
+
     /// The signal caught, if any.
     pub fn caught(&self) -> Option<i32> {
         match self.signal.load(Ordering::SeqCst) {
@@ -456,13 +468,15 @@ impl RunDir {
     }
 
     /// Runs `sim` (from [`RunDir::simulation`]) to its end, then marks the run complete; or,
-    /// when a signal stops it, leaves it resumable ([`Outcome::Stopped`]).
+    /// when a signal stops it before its end, leaves it resumable ([`Outcome::Stopped`]).
     ///
     /// # Errors
     /// The simulation's error (what was written so far is kept) or a failed mark.
     pub fn run<T: Real>(&self, sim: &mut Simulation<T>) -> Result<Outcome> {
         let info = sim.run()?;
-        if let Some(signal) = self.interrupt.caught() {
+        // A signal that came during the last step finds the run at its end, with its
+        // final outputs and checkpoint written: it is complete, not stopped.
+        if let (Some(signal), false) = (self.interrupt.caught(), sim.at_end()) {
             let t = sim.tissue();
             return Ok(Outcome::Stopped {
                 step: t.iteration(),
@@ -661,6 +675,45 @@ mod tests {
     }
 
     use super::scene_diff;
+
+    /// A signal during the last step leaves a complete run (its final outputs are written),
+    /// one a step earlier a stopped run that resumes: the two outcomes, from a handle
+    /// raised by a callback at a chosen step.
+    #[test]
+    fn a_signal_at_the_last_step_completes_the_run() {
+        use super::{Interrupt, Outcome, RunDir};
+        use mechanics::{CallbackError, Observation, Schedule};
+        let text = "[domain]\nlx = 40\nly = 40\n[cells]\ncount = 2\nradius = 5.0\n\
+                    [run]\nrelax_time = 0\ntime = 2.0\noutput_every = 1.0\n";
+        let scene = scene::Scene::parse(text, &[]).unwrap();
+        let steps = scene.step_counts().total_steps();
+        // The handle is checked before this callback: raised at step k, the run stops after k + 1.
+        for (at, complete) in [(steps - 1, true), (steps - 2, false)] {
+            let dir = tempfile::tempdir().unwrap();
+            let out = dir.path().join("run");
+            let interrupt = Interrupt::never();
+            let run = RunDir::create(&out, scene.clone(), None, false, interrupt.clone()).unwrap();
+            let (mut sim, _) = run.simulation::<f64>().unwrap();
+            let raise = interrupt.clone();
+            sim.add_callback(
+                "raise",
+                Schedule::IterationInterval(1),
+                move |obs: &mut Observation<'_, f64>| -> Result<(), CallbackError> {
+                    if obs.iteration() == at {
+                        raise.raise(15);
+                    }
+                    Ok(())
+                },
+            );
+            let outcome = run.run(&mut sim).unwrap();
+            assert_eq!(
+                matches!(outcome, Outcome::Complete(_)),
+                complete,
+                "raised at step {at} of {steps}: {outcome:?}"
+            );
+            assert_eq!(crate::is_complete(&out), complete);
+        }
+    }
 
     /// Each table of an array of tables is compared with its own: two `[[population]]`
     /// tables that agree give no difference (the first version compared every
