@@ -171,7 +171,7 @@ pub enum SimulationError {
 /// Something called on a schedule during a run: a diagnostic, an output writer, a progress
 /// report (after Oceananigans' `Callback` and ripgrep's `Sink`). Only [`Callback::call`] is
 /// required; closures `FnMut(&mut Observation<T>) -> Result<(), CallbackError>` are callbacks.
-pub trait Callback<T: Real> {
+pub trait Callback<T: Real>: Send {
     /// Called when the schedule fires.
     ///
     /// # Errors
@@ -197,7 +197,7 @@ pub trait Callback<T: Real> {
 
 impl<T: Real, F> Callback<T> for F
 where
-    F: FnMut(&mut Observation<'_, T>) -> Result<(), CallbackError>,
+    F: FnMut(&mut Observation<'_, T>) -> Result<(), CallbackError> + Send,
 {
     fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError> {
         self(obs)
@@ -213,7 +213,7 @@ where
 /// them); one that changes fields should then call [`Tissue::recentre`], so that each patch
 /// follows its cell. A fix must be a deterministic function of the state (noise from
 /// [`crate::terms::NoiseKey`]), for runs to stay reproducible and resumable.
-pub trait Fix<T: Real> {
+pub trait Fix<T: Real>: Send {
     /// Changes the state.
     ///
     /// # Errors
@@ -223,7 +223,7 @@ pub trait Fix<T: Real> {
 
 impl<T: Real, F> Fix<T> for F
 where
-    F: FnMut(&mut Tissue<T>) -> Result<(), CallbackError>,
+    F: FnMut(&mut Tissue<T>) -> Result<(), CallbackError> + Send,
 {
     fn apply(&mut self, tissue: &mut Tissue<T>) -> Result<(), CallbackError> {
         self(tissue)
@@ -425,6 +425,29 @@ impl<T: Real> Simulation<T> {
     pub fn stop_time(mut self, t: f64) -> Self {
         self.stop_time = Some(t);
         self
+    }
+
+    /// Sets where the next [`Simulation::run`] stops, replacing both criteria: after `n`
+    /// steps in all, at model time `t` (whichever comes first; `None` for neither). A
+    /// simulation run again goes on from where it stopped, as one run would (a stop landed
+    /// on by an adaptive step is the exception: it shortens the step before it). How a host
+    /// steps a simulation piece by piece.
+    pub fn set_stop(&mut self, iteration: Option<u64>, time: Option<f64>) {
+        self.stop_iteration = iteration;
+        self.stop_time = time;
+    }
+
+    /// The tissue, to change between runs: what a [`Fix`] does between steps, done now (a
+    /// host's edit of the state, a term added). The next step starts from what is left.
+    pub fn tissue_mut(&mut self) -> &mut Tissue<T> {
+        &mut self.tissue
+    }
+
+    /// Evaluates the current state ([`Tissue::observe`]) and returns the tissue with the
+    /// workspace that holds its per-cell quantities, lattice sums and tissue velocity.
+    pub fn observe(&mut self) -> (&Tissue<T>, &Workspace<T>, Observables) {
+        let o = self.tissue.observe(&mut self.workspace);
+        (&self.tissue, &self.workspace, o)
     }
 
     /// Stops after this much wall time.

@@ -27,7 +27,7 @@ pub const PHI_BOUND: f64 = 2.0;
 /// checker, never inside a kernel).
 ///
 /// `()` checks nothing; [`StateCheck`] is the default.
-pub trait StepCheck {
+pub trait StepCheck: Send {
     /// Checks the state about to be stepped.
     ///
     /// # Errors
@@ -178,7 +178,7 @@ impl<T: Real> Tissue<T> {
             None => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
-        self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post);
+        self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post, 0.0);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -187,7 +187,7 @@ impl<T: Real> Tissue<T> {
         check.check(at, cell_state)?;
         if !self.ext.terms.is_empty() {
             if let Some((term, stiffness, cell)) =
-                self.ext.terms.stiffest(&self.terms_view(cell_state))
+                self.ext.terms.stiffest(&self.terms_view(cell_state, 0.0))
             {
                 if stiffness.is_nan() || stiffness * dt > 2.0 {
                     return Err(StepError::TermUnstable {
@@ -221,8 +221,10 @@ impl<T: Real> Tissue<T> {
     }
 
     /// What the terms see of every slot, with the per-cell quantities `cells`.
-    fn terms_view<'a>(&'a self, cells: &'a [CellState]) -> CellsView<'a> {
+    fn terms_view<'a>(&'a self, cells: &'a [CellState], stage: f64) -> CellsView<'a> {
         CellsView {
+            time: self.time + stage,
+            stage,
             cells,
             ids: &self.cell_id,
             centres: &self.centre,
@@ -240,7 +242,7 @@ impl<T: Real> Tissue<T> {
         f: impl FnOnce(&mut crate::terms::Terms, &CellsView<'_>),
     ) {
         let mut terms = std::mem::take(&mut self.ext.terms);
-        f(&mut terms, &self.terms_view(cell_state));
+        f(&mut terms, &self.terms_view(cell_state, 0.0));
         self.ext.terms = terms;
     }
 
@@ -275,6 +277,7 @@ impl<T: Real> Tissue<T> {
                 com,
                 centres: next_centre,
             },
+            h,
         );
         self.cells.swap_phi(phi_old);
         if !self.ext.terms.is_empty() {
@@ -313,6 +316,7 @@ impl<T: Real> Tissue<T> {
             cell_state,
             term_scratch,
             Post::Nothing,
+            h,
         );
         if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
@@ -354,6 +358,7 @@ impl<T: Real> Tissue<T> {
         cell_state: &mut [CellState],
         scratch: &mut TermScratch,
         post: Post<'_, T>,
+        stage: f64,
     ) {
         let TermScratch {
             cell_force,
@@ -397,7 +402,7 @@ impl<T: Real> Tissue<T> {
         } else {
             self.ext
                 .terms
-                .forces(&self.terms_view(cell_state), cell_force);
+                .forces(&self.terms_view(cell_state, stage), cell_force);
             Some(&cell_force[..])
         };
         let input = EvalInput {
@@ -439,7 +444,7 @@ impl<T: Real> Tissue<T> {
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
-        self.evaluate_fields(true, k2, sums, cell_state, term_scratch, Post::Nothing);
+        self.evaluate_fields(true, k2, sums, cell_state, term_scratch, Post::Nothing, 0.0);
     }
 }
 

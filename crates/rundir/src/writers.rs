@@ -1,9 +1,9 @@
 //! The output writers of a run directory, added to a [`Simulation`]: series rows and frames,
 //! each on its own schedule and each also writing the final state.
 
-use std::cell::Cell;
 use std::path::{Path, PathBuf};
-use std::rc::Rc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use mechanics::{Callback, CallbackError, Observation, Schedule, Simulation};
@@ -18,13 +18,13 @@ use crate::Result;
 /// Counts what the writers of [`add_writers`] wrote.
 #[derive(Debug, Clone, Default)]
 pub struct Written {
-    frames: Rc<Cell<usize>>,
+    frames: Arc<AtomicUsize>,
 }
 
 impl Written {
     /// Frames written so far.
     pub fn frames(&self) -> usize {
-        self.frames.get()
+        self.frames.load(Ordering::Relaxed)
     }
 }
 
@@ -148,7 +148,7 @@ impl<T: Real> Callback<T> for SeriesRows {
 /// Frames in `frames/`.
 struct Frames {
     dir: PathBuf,
-    written: Rc<Cell<usize>>,
+    written: Arc<AtomicUsize>,
 }
 
 impl<T: Real> Callback<T> for Frames {
@@ -156,7 +156,7 @@ impl<T: Real> Callback<T> for Frames {
         let tissue = obs.tissue();
         let ws = obs.workspace();
         write_frame(&self.dir, tissue, ws)?;
-        self.written.set(self.written.get() + 1);
+        self.written.fetch_add(1, Ordering::Relaxed);
         Ok(())
     }
 }

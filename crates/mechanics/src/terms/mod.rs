@@ -108,6 +108,18 @@ pub trait CellTerm: Send + Sync + fmt::Debug {
         [0.0; 2]
     }
 
+    /// The whole-cell forces on every cell at once into `out` (one per slot of `cells`),
+    /// where `x` is the term's state of every identity (`state_names().len()` values each).
+    /// The default asks [`CellTerm::force`] cell by cell; a term that is cheaper in bulk (one
+    /// call into another language per evaluation, say) overrides this instead.
+    fn forces(&self, cells: &CellBatch<'_>, x: &[f64], out: &mut [[f64; 2]]) {
+        let len = self.state_names().len();
+        for (slot, f) in out.iter_mut().enumerate() {
+            let cell = cells.context(slot);
+            *f = self.force(&cell, &x[cell.id * len..(cell.id + 1) * len]);
+        }
+    }
+
     /// The deterministic rate `dx/dt` of the state `x` into `out`, from the cell as the
     /// evaluation at this state left it.
     fn rate(&self, cell: &CellContext<'_>, x: &[f64], out: &mut [f64]) {
@@ -201,10 +213,21 @@ impl Terms {
             kick: Vec::new(),
             scratch: vec![0.0; len],
         });
-        if self.n > 0 {
-            let n = self.n;
-            self.n = 0;
-            self.initialise(n);
+        // The new term's state for the identities there are; the others keep theirs.
+        let (n, seed, t) = (self.n, self.seed, self.entries.len() - 1);
+        let e = self.entries.last_mut().expect("just pushed");
+        for v in [&mut e.x, &mut e.old, &mut e.rate1, &mut e.kick] {
+            v.resize(n * len, 0.0);
+        }
+        for id in 0..n {
+            let key = |k: u64| NoiseKey {
+                seed,
+                cell: id as u64,
+                step: 0,
+                stage: INITIAL_STAGE + ((t as u64) << 16) + k,
+            };
+            e.term
+                .initial_state(id, &key, &mut e.x[id * len..(id + 1) * len]);
         }
     }
 
@@ -383,17 +406,26 @@ impl Terms {
             .sum()
     }
 
-    /// The whole-cell forces of the current state into `out` (by slot).
+    /// The whole-cell forces of the current state into `out` (by slot): each term's
+    /// [`CellTerm::forces`], summed from zero in the terms' order.
     pub(crate) fn forces(&self, view: &CellsView<'_>, out: &mut [[f64; 2]]) {
-        for (slot, f) in out.iter_mut().enumerate() {
-            let cell = view.context(slot);
-            let mut total = [0.0; 2];
-            for e in &self.entries {
-                let x = &e.x[cell.id * e.len..(cell.id + 1) * e.len];
-                let g = e.term.force(&cell, x);
-                total = [total[0] + g[0], total[1] + g[1]];
+        let batch = CellBatch { view };
+        let mut terms = self.entries.iter();
+        let Some(first) = terms.next() else {
+            out.fill([0.0; 2]);
+            return;
+        };
+        first.term.forces(&batch, &first.x, out);
+        for f in out.iter_mut() {
+            *f = [0.0 + f[0], 0.0 + f[1]];
+        }
+        let mut more = Vec::new();
+        for e in terms {
+            more.resize(out.len(), [0.0; 2]);
+            e.term.forces(&batch, &e.x, &mut more);
+            for (f, g) in out.iter_mut().zip(&more) {
+                *f = [f[0] + g[0], f[1] + g[1]];
             }
-            *f = total;
         }
     }
 
@@ -493,7 +525,13 @@ impl Terms {
 }
 
 /// The per-cell data terms are called with, by slot.
+#[derive(Debug)]
 pub(crate) struct CellsView<'a> {
+    /// The model time of the state evaluated: the step's start, or (in a corrector) its end.
+    pub(crate) time: f64,
+    /// The time from the state the step started from to the one evaluated: 0, or `h` in a
+    /// corrector.
+    pub(crate) stage: f64,
     pub(crate) cells: &'a [CellState],
     pub(crate) ids: &'a [usize],
     pub(crate) centres: &'a [[f64; 2]],
@@ -503,8 +541,8 @@ pub(crate) struct CellsView<'a> {
     pub(crate) iteration: u64,
 }
 
-impl CellsView<'_> {
-    fn context(&self, slot: usize) -> CellContext<'_> {
+impl<'a> CellsView<'a> {
+    fn context(&self, slot: usize) -> CellContext<'a> {
         CellContext {
             id: self.ids[slot],
             centre: self.centres[slot],
@@ -512,6 +550,53 @@ impl CellsView<'_> {
             population: self.populations.population(self.ids[slot]),
             active: self.active,
         }
+    }
+}
+
+/// What a term sees of every cell at once ([`CellTerm::forces`]): the cells in slot order,
+/// and the time of the state an evaluation is of.
+#[derive(Debug, Clone, Copy)]
+pub struct CellBatch<'a> {
+    view: &'a CellsView<'a>,
+}
+
+impl<'a> CellBatch<'a> {
+    /// The number of cells.
+    pub fn len(&self) -> usize {
+        self.view.cells.len()
+    }
+
+    /// Whether there are no cells.
+    pub fn is_empty(&self) -> bool {
+        self.view.cells.is_empty()
+    }
+
+    /// The model time of the state the evaluation is of: the step's start in Heun's
+    /// predictor stage, its end (`t + h`) in the corrector.
+    pub fn time(&self) -> f64 {
+        self.view.time
+    }
+
+    /// The time from the state the step started from to the state evaluated: 0 in the
+    /// predictor stage, `h` in the corrector.
+    pub fn stage(&self) -> f64 {
+        self.view.stage
+    }
+
+    /// What [`CellTerm::force`] sees of the cell in `slot`.
+    pub fn context(&self, slot: usize) -> CellContext<'a> {
+        self.view.context(slot)
+    }
+
+    /// The position of the cell in `slot` in the state evaluated: its centre at the step's
+    /// start plus `stage ×` its velocity of the last evaluation, which in the corrector is
+    /// Heun's predictor of the centre (`c + h v(c)`), so that a force that depends on
+    /// position is integrated to second order like the fields.
+    pub fn position(&self, slot: usize) -> [f64; 2] {
+        let c = self.view.centres[slot];
+        let v = self.view.cells[slot].velocity;
+        let s = self.view.stage;
+        [c[0] + s * v.x, c[1] + s * v.y]
     }
 }
 
