@@ -450,6 +450,14 @@ impl<T: Real> Simulation<T> {
         (&self.tissue, &self.workspace, o)
     }
 
+    /// The lattice fields of the current state ([`Tissue::fields`], evaluated first) with
+    /// `Σ φ_i` at every node. Allocates.
+    pub fn fields(&mut self) -> (TissueFields, Vec<f64>) {
+        self.tissue.observe(&mut self.workspace);
+        let f = self.tissue.fields(&mut self.workspace);
+        (f, self.workspace.sum_field(crate::SumField::S1))
+    }
+
     /// Stops after this much wall time.
     pub fn wall_time_limit(mut self, limit: Duration) -> Self {
         self.wall_time_limit = Some(limit);

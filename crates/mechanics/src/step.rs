@@ -74,6 +74,7 @@ impl StepCheck for StateCheck {
         for (i, c) in cells.iter().enumerate() {
             let finite = c.area.is_finite()
                 && c.force.iter().all(|f| f.is_finite())
+                && c.cell_force.iter().all(|f| f.is_finite())
                 && c.phi_min.is_finite()
                 && c.phi_max.is_finite();
             if !finite {

@@ -36,6 +36,7 @@
 mod check;
 mod division;
 mod file;
+mod paths;
 mod registry;
 mod validate;
 mod walls;
@@ -44,6 +45,7 @@ pub use file::{
     AdhesionSpec, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain, InitKind,
     Integrator, Model, PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
 };
+pub use paths::absolute_paths;
 pub use registry::{register_term, registered_terms, TermBuilder, TermError};
 pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 

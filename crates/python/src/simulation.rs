@@ -1,0 +1,816 @@
+//! `monolayer.Simulation` (a scene stepped in memory, steered from Python), and the run
+//! directories (`run`, `resume`) and pictures (`render`) of the command line.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use mechanics::Precision;
+use mechanics::{CallbackError, Observation, Schedule, Simulation, Tissue};
+use phasefield::Real;
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use rundir::{Interrupt, Outcome, RunDir};
+
+use crate::cells::{cells_dict, fields_dict, phi_arrays};
+use crate::force::{ErrorSlot, PyForce};
+use crate::interrupt;
+use crate::scene::{scene_error, PyScene};
+
+/// A simulation in one of the two precisions of `[integrator] precision`.
+enum Inner {
+    F64(Simulation<f64>),
+    F32(Simulation<f32>),
+}
+
+/// `$body` with `$s` bound to the simulation, whatever its precision.
+macro_rules! with_sim {
+    ($inner:expr, $s:ident => $body:expr) => {
+        match $inner {
+            Inner::F64($s) => $body,
+            Inner::F32($s) => $body,
+        }
+    };
+}
+
+/// Where the progress is reported: a Python function of the model time, called at least
+/// every `every` TU.
+#[derive(Default)]
+struct Progress {
+    func: Option<Py<PyAny>>,
+    next: f64,
+    every: f64,
+}
+
+type ProgressSlot = Arc<Mutex<Option<Progress>>>;
+
+/// The first error of the Python code a run called, taken out of its slot.
+fn take(slot: &ErrorSlot) -> Option<PyErr> {
+    slot.lock().unwrap_or_else(|p| p.into_inner()).take()
+}
+
+fn keep(slot: &ErrorSlot, e: PyErr) {
+    slot.lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get_or_insert(e);
+}
+
+/// The callback every simulation run from Python has, after every step: stops on Ctrl-C
+/// (raising `interrupt` for a run directory's checkpoint), on an error of Python code called
+/// in the run, and reports the progress.
+fn watcher<T: Real>(
+    errors: ErrorSlot,
+    progress: ProgressSlot,
+    raise: Option<Interrupt>,
+) -> impl FnMut(&mut Observation<'_, T>) -> Result<(), CallbackError> + Send {
+    move |obs| {
+        if interrupt::caught() {
+            match &raise {
+                Some(i) => i.raise(2),
+                None => obs.request_stop(),
+            }
+        }
+        if errors.lock().map_or(true, |e| e.is_some()) {
+            obs.request_stop();
+        }
+        let mut p = progress.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(Progress {
+            func: Some(f),
+            next,
+            every,
+        }) = p.as_mut()
+        {
+            let t = obs.time();
+            if t >= *next {
+                *next = t + *every;
+                let r = Python::attach(|py| f.bind(py).call1((t,)).map(|_| ()));
+                if let Err(e) = r {
+                    keep(&errors, e);
+                    obs.request_stop();
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A rayon pool of `threads` (all the cores for `None`).
+fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+    if threads == Some(0) {
+        return Err(PyValueError::new_err(
+            "threads = 0: give a number of threads of at least 1, or None for every core",
+        ));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| PyRuntimeError::new_err(format!("cannot start the threads: {e}")))
+}
+
+/// A step error as Python sees it: `RuntimeError` with the message of the command line.
+fn run_error(e: impl std::fmt::Display) -> PyErr {
+    PyRuntimeError::new_err(e.to_string())
+}
+
+/// A scene simulated in memory, stepped and steered from Python.
+#[pyclass(module = "monolayer._native", name = "Simulation")]
+pub struct PySimulation {
+    inner: Mutex<Inner>,
+    pool: rayon::ThreadPool,
+    scene: PyScene,
+    errors: ErrorSlot,
+    progress: ProgressSlot,
+    forces: usize,
+}
+
+impl PySimulation {
+    fn inner(&mut self) -> &mut Inner {
+        self.inner.get_mut().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Runs to the stop criteria `(iteration, time)` with the lock released, then raises
+    /// what stopped it early: Ctrl-C, an error of Python code, a step error.
+    fn run_to(
+        &mut self,
+        py: Python<'_>,
+        stop: (Option<u64>, Option<f64>),
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<()> {
+        let end = stop.1.unwrap_or(f64::INFINITY);
+        let now = self.time();
+        *self.progress.lock().unwrap_or_else(|p| p.into_inner()) = Some(Progress {
+            func: progress,
+            next: now,
+            every: if end.is_finite() {
+                ((end - now) / 200.0).max(0.0)
+            } else {
+                0.0
+            },
+        });
+        interrupt::clear();
+        let Self { inner, pool, .. } = self;
+        let inner = inner.get_mut().unwrap_or_else(|p| p.into_inner());
+        let result = py.detach(|| {
+            pool.install(|| {
+                with_sim!(inner, s => {
+                    s.set_stop(stop.0, stop.1);
+                    s.run().map(|_| ())
+                })
+            })
+        });
+        self.progress
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .take();
+        if let Some(e) = take(&self.errors) {
+            return Err(e);
+        }
+        if interrupt::caught() {
+            let (it, t) = (self.iteration(), self.time());
+            return interrupt::deliver(
+                py,
+                format!("stopped after step {it} (t = {t}); the simulation can go on"),
+            );
+        }
+        result.map_err(run_error)
+    }
+}
+
+/// `every` (model time) or `steps` (iterations) as a schedule.
+fn schedule(every: Option<f64>, steps: Option<u64>) -> PyResult<Schedule> {
+    match (every, steps) {
+        (Some(t), None) if t > 0.0 && t.is_finite() => Ok(Schedule::TimeInterval(t)),
+        (None, Some(n)) if n > 0 => Ok(Schedule::IterationInterval(n)),
+        (None, None) => Ok(Schedule::IterationInterval(1)),
+        _ => Err(PyValueError::new_err(
+            "give every=T (model time, T > 0) or steps=N (N ≥ 1), not both",
+        )),
+    }
+}
+
+/// What a callback sees: the time, the step and the cells' columns at that state.
+#[pyclass(module = "monolayer._native", name = "Observation")]
+pub struct PyObservation {
+    #[pyo3(get)]
+    time: f64,
+    #[pyo3(get)]
+    iteration: u64,
+    #[pyo3(get)]
+    cells: Py<PyDict>,
+    stop: Arc<AtomicBool>,
+}
+
+#[pymethods]
+impl PyObservation {
+    /// Asks the run to stop after this step's callbacks (`run` then returns normally).
+    fn stop(&self) {
+        self.stop.store(true, Ordering::SeqCst);
+    }
+}
+
+/// A change to the state between steps (a fix): what `fn(edit)` asks, applied after it
+/// returns.
+#[pyclass(module = "monolayer._native", name = "Edit")]
+pub struct PyEdit {
+    #[pyo3(get)]
+    time: f64,
+    #[pyo3(get)]
+    iteration: u64,
+    /// The identities of the living cells, in increasing order.
+    #[pyo3(get)]
+    ids: Vec<usize>,
+    states: Vec<(String, Vec<f64>)>,
+    asked: Vec<Change>,
+}
+
+enum Change {
+    Param(String, f64),
+    State(String, Vec<f64>),
+}
+
+#[pymethods]
+impl PyEdit {
+    /// Sets a model parameter: `zeta`, `xi`, `gamma`, `mu`, `lambda`, `kappa`, `omega`.
+    fn set_param(&mut self, name: String, value: f64) -> PyResult<()> {
+        if !value.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "set_param({name:?}, {value}): give a finite value"
+            )));
+        }
+        if !PARAMS.contains(&name.as_str()) {
+            return Err(PyValueError::new_err(format!(
+                "set_param({name:?}): no such parameter; use one of {}",
+                PARAMS.join(", ")
+            )));
+        }
+        self.asked.push(Change::Param(name, value));
+        Ok(())
+    }
+
+    /// The per-cell state `name` of a term (`"polarity.theta"`), one value per identity
+    /// `0..max(id)+1`.
+    fn state(&self, name: &str) -> PyResult<Vec<f64>> {
+        self.states
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.clone())
+            .ok_or_else(|| {
+                PyValueError::new_err(format!(
+                    "no per-cell state {name:?}; the scene has {}",
+                    names(&self.states)
+                ))
+            })
+    }
+
+    /// Sets the per-cell state `name` of a term, one value per identity (as [`state`] gives).
+    fn set_state(&mut self, name: String, values: Vec<f64>) -> PyResult<()> {
+        let Some((_, now)) = self.states.iter().find(|(n, _)| *n == name) else {
+            return Err(PyValueError::new_err(format!(
+                "no per-cell state {name:?}; the scene has {}",
+                names(&self.states)
+            )));
+        };
+        if values.len() != now.len() || values.iter().any(|v| !v.is_finite()) {
+            return Err(PyValueError::new_err(format!(
+                "set_state({name:?}): give {} finite values, one per identity",
+                now.len()
+            )));
+        }
+        self.asked.push(Change::State(name, values));
+        Ok(())
+    }
+}
+
+const PARAMS: [&str; 7] = ["zeta", "xi", "gamma", "mu", "lambda", "kappa", "omega"];
+
+fn names(states: &[(String, Vec<f64>)]) -> String {
+    if states.is_empty() {
+        "none".into()
+    } else {
+        states
+            .iter()
+            .map(|(n, _)| n.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Calls `func(edit)` on the state of `tissue`, then applies what it asked.
+fn apply_edit<T: Real>(py: Python<'_>, func: &Py<PyAny>, tissue: &mut Tissue<T>) -> PyResult<()> {
+    let mut ids: Vec<usize> = tissue.cell_ids().to_vec();
+    ids.sort_unstable();
+    let states = tissue
+        .terms()
+        .variables()
+        .into_iter()
+        .map(|(n, v)| (n.replacen('/', ".", 1), v))
+        .collect();
+    let edit = Bound::new(
+        py,
+        PyEdit {
+            time: tissue.time(),
+            iteration: tissue.iteration(),
+            ids,
+            states,
+            asked: Vec::new(),
+        },
+    )?;
+    func.bind(py).call1((edit.clone(),))?;
+    let asked = std::mem::take(&mut edit.borrow_mut().asked);
+    for change in asked {
+        match change {
+            Change::Param(name, v) => {
+                let p = tissue.params_mut();
+                match name.as_str() {
+                    "zeta" => p.zeta = v,
+                    "xi" => p.xi = v,
+                    "gamma" => p.energy.gamma = v,
+                    "mu" => p.energy.mu = v,
+                    "lambda" => p.energy.lambda = v,
+                    "kappa" => p.energy.kappa = v,
+                    "omega" => p.omega = v,
+                    _ => unreachable!("checked by set_param"),
+                }
+            }
+            Change::State(name, values) => tissue
+                .terms_mut()
+                .set_variable(&name.replacen('.', "/", 1), &values)
+                .map_err(PyValueError::new_err)?,
+        }
+    }
+    Ok(())
+}
+
+#[pymethods]
+impl PySimulation {
+    #[new]
+    #[pyo3(signature = (scene, threads=None, backend="cpu"))]
+    fn new(scene: PyScene, threads: Option<usize>, backend: &str) -> PyResult<Self> {
+        match backend {
+            "cpu" => {}
+            "gpu" => {
+                return Err(PyValueError::new_err(
+                    "backend = \"gpu\": the Python package is built without the GPU backend; run GPU scenes with the command line (`cargo build --release -p monolayer-cli --features gpu`), or use backend=\"cpu\"",
+                ))
+            }
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "backend = {other:?}: use \"cpu\""
+                )))
+            }
+        }
+        let pool = pool(threads)?;
+        let s = &scene.scene;
+        let build = |e: rundir::StateError| scene_error(None, e);
+        let inner = match s.precision() {
+            Precision::F64 => {
+                Inner::F64(s.simulation_from(rundir::initial_tissue::<f64>(s).map_err(build)?))
+            }
+            Precision::F32 => {
+                Inner::F32(s.simulation_from(rundir::initial_tissue::<f32>(s).map_err(build)?))
+            }
+        };
+        let errors: ErrorSlot = Arc::default();
+        let progress: ProgressSlot = Arc::default();
+        let mut sim = Self {
+            inner: Mutex::new(inner),
+            pool,
+            scene,
+            errors: errors.clone(),
+            progress: progress.clone(),
+            forces: 0,
+        };
+        with_sim!(sim.inner(), s => s.add_callback(
+            "python",
+            Schedule::IterationInterval(1),
+            watcher(errors.clone(), progress.clone(), None),
+        ));
+        Ok(sim)
+    }
+
+    /// The scene.
+    #[getter]
+    fn scene(&self) -> PyScene {
+        self.scene.clone()
+    }
+
+    /// The model time.
+    #[getter]
+    fn time(&mut self) -> f64 {
+        with_sim!(self.inner(), s => s.tissue().time())
+    }
+
+    /// Steps taken.
+    #[getter]
+    fn iteration(&mut self) -> u64 {
+        with_sim!(self.inner(), s => s.tissue().iteration())
+    }
+
+    /// The number of cells.
+    #[getter]
+    fn n_cells(&mut self) -> usize {
+        with_sim!(self.inner(), s => s.tissue().n_cells())
+    }
+
+    /// Takes `n` steps (the interpreter's lock released).
+    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
+        let it = self.iteration();
+        self.run_to(py, (Some(it + n), None), None)
+    }
+
+    /// Runs to model time `until` (the scene's end by default); `progress(t)` is called
+    /// about 200 times on the way.
+    #[pyo3(signature = (until=None, progress=None))]
+    fn run_until(
+        &mut self,
+        py: Python<'_>,
+        until: Option<f64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<()> {
+        let until = until.unwrap_or_else(|| self.scene.scene.end_time());
+        if !until.is_finite() {
+            return Err(PyValueError::new_err("until: give a finite model time"));
+        }
+        self.run_to(py, (None, Some(until)), progress)
+    }
+
+    /// The cells' columns (a dict of 1-D NumPy arrays, copies).
+    fn cells<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        with_sim!(self.inner(), s => {
+            let (t, ws, _) = s.observe();
+            cells_dict(py, t, ws)
+        })
+    }
+
+    /// Every cell's field on its patch: `(phi, origin, id)`, copies.
+    fn phi<'py>(
+        &mut self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        with_sim!(self.inner(), s => phi_arrays(py, s.tissue()))
+    }
+
+    /// The lattice fields (a dict of NumPy arrays, copies).
+    fn fields<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (l, f, phi_sum) = with_sim!(self.inner(), s => {
+            let (f, phi_sum) = s.fields();
+            (s.tissue().lattice(), f, phi_sum)
+        });
+        fields_dict(py, l, f, phi_sum)
+    }
+
+    /// The observables of the paper's series (a dict of floats).
+    fn observables<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let o = with_sim!(self.inner(), s => s.observe().2);
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("v_rms", o.v_rms),
+            ("s_rms", o.s_rms),
+            ("area_mean", o.area_mean),
+            ("area_min", o.area_min),
+            ("area_max", o.area_max),
+            ("cell_speed_rms", o.cell_speed_rms),
+            ("phi_min", o.phi_min),
+            ("phi_max", o.phi_max),
+        ] {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+
+    /// Calls `func(observation)` on a schedule while the simulation runs (every step by
+    /// default; `every` in model time, or `steps`).
+    #[pyo3(signature = (func, every=None, steps=None))]
+    fn add_callback(
+        &mut self,
+        func: Py<PyAny>,
+        every: Option<f64>,
+        steps: Option<u64>,
+    ) -> PyResult<()> {
+        let schedule = schedule(every, steps)?;
+        let errors = self.errors.clone();
+        macro_rules! callback {
+            ($s:ident, $T:ty) => {{
+                let errors = errors.clone();
+                let func = Python::attach(|py| func.clone_ref(py));
+                $s.add_callback(
+                    "python callback",
+                    schedule,
+                    move |obs: &mut Observation<'_, $T>| -> Result<(), CallbackError> {
+                        let stop = Arc::new(AtomicBool::new(false));
+                        let (time, iteration) = (obs.time(), obs.iteration());
+                        let tissue = obs.tissue();
+                        let ws = obs.workspace();
+                        let r = Python::attach(|py| -> PyResult<()> {
+                            let cells = cells_dict(py, tissue, ws)?.unbind();
+                            let o = PyObservation {
+                                time,
+                                iteration,
+                                cells,
+                                stop: stop.clone(),
+                            };
+                            func.bind(py).call1((o,))?;
+                            Ok(())
+                        });
+                        if let Err(e) = r {
+                            keep(&errors, e);
+                            obs.request_stop();
+                        }
+                        if stop.load(Ordering::SeqCst) {
+                            obs.request_stop();
+                        }
+                        Ok(())
+                    },
+                )
+            }};
+        }
+        match self.inner() {
+            Inner::F64(s) => callback!(s, f64),
+            Inner::F32(s) => callback!(s, f32),
+        }
+        Ok(())
+    }
+
+    /// Adds a whole-cell force `func(t, cells) -> (n, 2) array`, called at every evaluation
+    /// (both stages of each step) with the cells' columns `id`, `population`, `x`, `y`,
+    /// `vx`, `vy`, `area`.
+    #[pyo3(signature = (func, name=None))]
+    fn add_force(&mut self, func: Py<PyAny>, name: Option<String>) -> PyResult<()> {
+        self.forces += 1;
+        let name = name.unwrap_or_else(|| format!("python_force_{}", self.forces));
+        let taken = with_sim!(self.inner(), s => s.tissue().terms().get(&name).is_some());
+        if taken {
+            return Err(PyValueError::new_err(format!(
+                "a force or term named {name:?} is there already; give another name"
+            )));
+        }
+        let term = Arc::new(PyForce {
+            name,
+            func,
+            error: self.errors.clone(),
+        });
+        with_sim!(self.inner(), s => s.tissue_mut().terms_mut().add(term));
+        Ok(())
+    }
+
+    /// Changes the state now: `func(edit)` (a [`PyEdit`]) asks for changes, applied when it
+    /// returns, as a fix would between two steps.
+    fn edit(&mut self, py: Python<'_>, func: Py<PyAny>) -> PyResult<()> {
+        with_sim!(self.inner(), s => apply_edit(py, &func, s.tissue_mut()))
+    }
+
+    /// Calls `func(edit)` after every step at which the schedule fires (every step by
+    /// default), before the callbacks: a fix.
+    #[pyo3(signature = (func, every=None, steps=None))]
+    fn add_fix(&mut self, func: Py<PyAny>, every: Option<f64>, steps: Option<u64>) -> PyResult<()> {
+        let schedule = schedule(every, steps)?;
+        let errors = self.errors.clone();
+        macro_rules! fix {
+            ($s:ident, $T:ty) => {{
+                $s.add_fix(
+                    "python fix",
+                    schedule,
+                    move |t: &mut Tissue<$T>| -> Result<(), CallbackError> {
+                        if let Err(e) = Python::attach(|py| apply_edit(py, &func, t)) {
+                            keep(&errors, e);
+                        }
+                        Ok(())
+                    },
+                )
+            }};
+        }
+        match self.inner() {
+            Inner::F64(s) => fix!(s, f64),
+            Inner::F32(s) => fix!(s, f32),
+        }
+        Ok(())
+    }
+
+    /// The state as a run directory's frame, drawn by the command line's renderer: PNG bytes.
+    #[pyo3(signature = (colour="none", **options))]
+    fn render<'py>(
+        &mut self,
+        py: Python<'py>,
+        colour: &str,
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyBytes>> {
+        let tmp = tempfile::tempdir().map_err(|e| PyOSError::new_err(e.to_string()))?;
+        let dir = tmp.path();
+        std::fs::write(dir.join("scene.toml"), self.scene.scene.to_toml())
+            .map_err(|e| PyOSError::new_err(e.to_string()))?;
+        let step = with_sim!(self.inner(), s => {
+            let (t, ws, _) = s.observe();
+            rundir::write_frame(dir, t, ws).map_err(|e| PyOSError::new_err(e.to_string()))?;
+            if let Some(clock) = t.extensions().proliferation() {
+                rundir::write_lineage(dir, clock).map_err(|e| PyOSError::new_err(e.to_string()))?;
+            }
+            t.iteration()
+        });
+        let mut pngs = render_in(dir, Some(vec![step]), colour, options)?;
+        Ok(PyBytes::new(py, &pngs.remove(0).1))
+    }
+
+    fn __repr__(&mut self) -> String {
+        let (n, t) = with_sim!(self.inner(), s => (s.tissue().n_cells(), s.tissue().time()));
+        format!("Simulation({n} cells at t = {t})")
+    }
+}
+
+/// Renders frames of the run directory `dir` (`steps`, or all) with `colour` and the boolean
+/// `options` of `monolayer render` (`director`, `defects`, `flow`, `axes`, `polarity`,
+/// `tracks`, `events`) and `size`: `(step, PNG bytes)` for each.
+fn render_in(
+    dir: &Path,
+    steps: Option<Vec<u64>>,
+    colour: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<(u64, Vec<u8>)>> {
+    use study::view::{render_run, Colour, Frames, RenderOptions};
+    let mut opts = RenderOptions {
+        colour: colour
+            .parse::<Colour>()
+            .map_err(|e| PyValueError::new_err(e.replace("--colour", "colour")))?,
+        frames: steps.map_or(Frames::All, Frames::Steps),
+        ..RenderOptions::default()
+    };
+    if let Some(o) = options {
+        for (k, v) in o.iter() {
+            let k: String = k.extract()?;
+            match k.as_str() {
+                "size" => opts.size = Some(v.extract()?),
+                "range" => opts.range = Some(v.extract()?),
+                flag => {
+                    let on: bool = v.extract()?;
+                    match flag {
+                        "director" => opts.director = on,
+                        "defects" => opts.defects = on,
+                        "flow" => opts.flow = on,
+                        "axes" => opts.axes = on,
+                        "polarity" => opts.polarity = on,
+                        "tracks" => opts.tracks = on,
+                        "events" => opts.events = on,
+                        _ => {
+                            return Err(PyValueError::new_err(format!(
+                            "render: no option {flag:?}; use size, range, director, defects, flow, axes, polarity, tracks or events"
+                        )))
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let out = tempfile::tempdir().map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let info = render_run(dir, out.path(), &opts, &mut |_, _| {})
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    info.files
+        .iter()
+        .map(|f| {
+            let step = f
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .and_then(|s| s.strip_prefix("frame_"))
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(0);
+            std::fs::read(f)
+                .map(|b| (step, b))
+                .map_err(|e| PyOSError::new_err(format!("{}: {e}", f.display())))
+        })
+        .collect()
+}
+
+/// Frames of a run directory drawn by the command line's renderer: `[(step, PNG bytes)]`.
+#[pyfunction]
+#[pyo3(signature = (dir, steps=None, colour="none", **options))]
+pub fn render_dir<'py>(
+    py: Python<'py>,
+    dir: PathBuf,
+    steps: Option<Vec<u64>>,
+    colour: &str,
+    options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Vec<(u64, Bound<'py, PyBytes>)>> {
+    Ok(render_in(&dir, steps, colour, options)?
+        .into_iter()
+        .map(|(s, b)| (s, PyBytes::new(py, &b)))
+        .collect())
+}
+
+/// Drives the run directory `dir` to its end (or a Ctrl-C) with the lock released.
+fn drive<T: Real>(
+    py: Python<'_>,
+    dir: &RunDir,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+    interrupt: Interrupt,
+) -> PyResult<Py<PyDict>> {
+    let pool = pool(threads)?;
+    let (mut sim, written) = dir.simulation::<T>().map_err(run_error)?;
+    let errors: ErrorSlot = Arc::default();
+    let now = sim.tissue().time();
+    let end = dir.scene().end_time();
+    let progress: ProgressSlot = Arc::new(Mutex::new(Some(Progress {
+        func: progress,
+        next: now,
+        every: ((end - now) / 200.0).max(0.0),
+    })));
+    sim.add_callback(
+        "python",
+        Schedule::IterationInterval(1),
+        watcher(errors.clone(), progress, Some(interrupt)),
+    );
+    interrupt::clear();
+    let outcome = py.detach(|| pool.install(|| dir.run(&mut sim)));
+    if let Some(e) = take(&errors) {
+        return Err(e);
+    }
+    let outcome = outcome.map_err(run_error)?;
+    match outcome {
+        Outcome::Complete(info) => {
+            let d = PyDict::new(py);
+            d.set_item("steps", info.iterations)?;
+            d.set_item("wall_s", info.wall_time.as_secs_f64())?;
+            d.set_item("frames", written.frames())?;
+            d.set_item("dir", dir.dir())?;
+            Ok(d.unbind())
+        }
+        Outcome::Stopped { step, time, .. } => {
+            interrupt::deliver(
+                py,
+                format!(
+                    "stopped at step {step} (t = {}): resume with monolayer.resume({:?})",
+                    (time * 1e9).round() / 1e9,
+                    dir.dir().display().to_string()
+                ),
+            )?;
+            unreachable!("deliver raises")
+        }
+    }
+}
+
+fn drive_any(
+    py: Python<'_>,
+    dir: &RunDir,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+    interrupt: Interrupt,
+) -> PyResult<Py<PyDict>> {
+    match dir.scene().precision() {
+        Precision::F64 => drive::<f64>(py, dir, threads, progress, interrupt),
+        Precision::F32 => drive::<f32>(py, dir, threads, progress, interrupt),
+    }
+}
+
+/// Runs `scene` into the run directory `out`, writing what `monolayer run` writes (frames,
+/// series, checkpoints, the lock, `run.json`); returns what it did. Ctrl-C stops it after
+/// the step in progress with a checkpoint, and raises `KeyboardInterrupt`.
+#[pyfunction]
+#[pyo3(signature = (scene, out, overwrite=false, threads=None, progress=None))]
+pub fn run_dir(
+    py: Python<'_>,
+    scene: &PyScene,
+    out: PathBuf,
+    overwrite: bool,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Py<PyDict>, Vec<String>)> {
+    let s = &scene.scene;
+    if s.backend() != scene::ComputeBackend::Cpu {
+        return Err(PyValueError::new_err(
+            "[integrator] backend = \"gpu\": the Python package is built without the GPU backend; run it with the command line, or set integrator.backend = \"cpu\"",
+        ));
+    }
+    let state = rundir::initial_state(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
+    let dropped = rundir::not_carried(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
+    let mut warnings = s.warnings();
+    if let (Some(from), false) = (s.init_from(), dropped.is_empty()) {
+        warnings.push(format!(
+            "[cells] from = {from:?}: its arrays {} are not carried: the scene has no part that keeps them; add that part's table to the scene to carry them",
+            dropped.join(", ")
+        ));
+    }
+    let interrupt = Interrupt::never();
+    let dir = RunDir::create(&out, s.clone(), state, overwrite, interrupt.clone())
+        .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    Ok((drive_any(py, &dir, threads, progress, interrupt)?, warnings))
+}
+
+/// Continues the run in `dir` from its latest checkpoint to the end of its scene (to
+/// `run.time = time` when given, to extend it), as `monolayer run --resume`.
+#[pyfunction]
+#[pyo3(signature = (dir, time=None, threads=None, progress=None))]
+pub fn resume_dir(
+    py: Python<'_>,
+    dir: PathBuf,
+    time: Option<f64>,
+    threads: Option<usize>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Py<PyDict>> {
+    let set: Vec<String> = time
+        .map(|t| format!("run.time={t:?}"))
+        .into_iter()
+        .collect();
+    let interrupt = Interrupt::never();
+    let run = RunDir::resume(&dir, &set, interrupt.clone())
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    drive_any(py, &run, threads, progress, interrupt)
+}
