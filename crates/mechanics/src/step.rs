@@ -1,7 +1,7 @@
 //! The time step (Heun's predictor–corrector, docs/model.md §4), the check at its chokepoint, and
 //! the evaluations that observe a state without stepping it.
 
-use phasefield::Real;
+use phasefield::{ComTable, Real};
 use rayon::prelude::*;
 
 use crate::equations::{adhesion_coefficient, heun_corrector, heun_predictor, wall_coefficients};
@@ -179,7 +179,7 @@ impl<T: Real> Tissue<T> {
             None => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
-        self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post, 0.0);
+        self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post, 0.0, None);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -229,6 +229,7 @@ impl<T: Real> Tissue<T> {
             cells,
             ids: &self.cell_id,
             centres: &self.centre,
+            centre_of: None,
             active: self.active,
             populations: &self.ext.populations,
             iteration: self.iteration,
@@ -279,6 +280,7 @@ impl<T: Real> Tissue<T> {
                 centres: next_centre,
             },
             h,
+            Some(com),
         );
         self.cells.swap_phi(phi_old);
         if !self.ext.terms.is_empty() {
@@ -308,6 +310,7 @@ impl<T: Real> Tissue<T> {
             sums,
             cell_state,
             term_scratch,
+            com,
             ..
         } = ws;
         self.evaluate_fields(
@@ -318,6 +321,7 @@ impl<T: Real> Tissue<T> {
             term_scratch,
             Post::Nothing,
             h,
+            Some(com),
         );
         if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
@@ -360,6 +364,7 @@ impl<T: Real> Tissue<T> {
         scratch: &mut TermScratch,
         post: Post<'_, T>,
         stage: f64,
+        com: Option<&ComTable>,
     ) {
         let TermScratch {
             cell_force,
@@ -401,9 +406,15 @@ impl<T: Real> Tissue<T> {
         let cell_force = if self.ext.terms.is_empty() {
             None
         } else {
-            self.ext
-                .terms
-                .forces(&self.terms_view(cell_state, stage), cell_force);
+            // In a corrector the fields are the predicted state: its centres of mass,
+            // measured only for a term that asks for them.
+            let predicted = |slot: usize| match com {
+                Some(com) => com.cell_centre(&self.cells, slot),
+                None => self.centre[slot],
+            };
+            let mut view = self.terms_view(cell_state, stage);
+            view.centre_of = Some(&predicted);
+            self.ext.terms.forces(&view, cell_force);
             Some(&cell_force[..])
         };
         let input = EvalInput {
@@ -445,7 +456,16 @@ impl<T: Real> Tissue<T> {
             ..
         } = ws;
         self.compute_centres_into(com, observed_centre);
-        self.evaluate_fields(true, k2, sums, cell_state, term_scratch, Post::Nothing, 0.0);
+        self.evaluate_fields(
+            true,
+            k2,
+            sums,
+            cell_state,
+            term_scratch,
+            Post::Nothing,
+            0.0,
+            None,
+        );
     }
 }
 

@@ -36,11 +36,16 @@ pub(crate) fn clear() {
     flag().store(false, Ordering::SeqCst);
 }
 
-/// After a run that a Ctrl-C stopped: Python's handler raises `KeyboardInterrupt` (or
-/// whatever the user's handler does); if it did not (a handler that returns), the
-/// interrupt is raised here with `what`.
+/// After a run that a Ctrl-C stopped: says `what` on `sys.stderr`, then Python's handler
+/// raises `KeyboardInterrupt` (or does what the user's handler does); if it did not (a
+/// handler that returns), the interrupt is raised here with `what`.
 pub(crate) fn deliver(py: Python<'_>, what: String) -> PyResult<()> {
     clear();
+    // Said on the notebook's or terminal's stderr, as the command line says it: Python's
+    // handler raises a `KeyboardInterrupt` without a message.
+    if let Ok(err) = py.import("sys").and_then(|s| s.getattr("stderr")) {
+        let _ = err.call_method1("write", (format!("{what}\n"),));
+    }
     py.check_signals()?;
     Err(PyKeyboardInterrupt::new_err(what))
 }

@@ -140,6 +140,27 @@ impl PyScene {
         Ok(slf)
     }
 
+    /// Sets several keys at once (`{"domain.lx": 50, "cells.count": 15}`), validating the
+    /// scene once, after all of them; returns the scene.
+    fn update<'py>(
+        mut slf: PyRefMut<'py, Self>,
+        values: &Bound<'py, PyDict>,
+    ) -> PyResult<PyRefMut<'py, Self>> {
+        let mut set = slf.set.clone();
+        for (k, v) in values.iter() {
+            let key: String = k.extract()?;
+            set.push(format!("{key}={}", to_toml(&v, &key)?));
+        }
+        let next = Self::build(slf.text.clone(), slf.path.clone(), set)?;
+        *slf = next;
+        Ok(slf)
+    }
+
+    /// A copy of the scene, to change without changing this one.
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
     /// The resolved scene as TOML: every key with its value, what `DIR/scene.toml` holds.
     fn to_toml(&self) -> String {
         self.scene.to_toml()

@@ -525,7 +525,6 @@ impl Terms {
 }
 
 /// The per-cell data terms are called with, by slot.
-#[derive(Debug)]
 pub(crate) struct CellsView<'a> {
     /// The model time of the state evaluated: the step's start, or (in a corrector) its end.
     pub(crate) time: f64,
@@ -535,10 +534,23 @@ pub(crate) struct CellsView<'a> {
     pub(crate) cells: &'a [CellState],
     pub(crate) ids: &'a [usize],
     pub(crate) centres: &'a [[f64; 2]],
+    /// The centre of mass of the cell in a slot in the state evaluated, measured on demand
+    /// (in a corrector, of the predicted fields); `None`: `centres`.
+    pub(crate) centre_of: Option<&'a dyn Fn(usize) -> [f64; 2]>,
     pub(crate) active: bool,
     pub(crate) populations: &'a Populations,
     /// The iteration of the state the step starts from.
     pub(crate) iteration: u64,
+}
+
+impl std::fmt::Debug for CellsView<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("CellsView")
+            .field("time", &self.time)
+            .field("stage", &self.stage)
+            .field("cells", &self.cells.len())
+            .finish_non_exhaustive()
+    }
 }
 
 impl<'a> CellsView<'a> {
@@ -588,15 +600,16 @@ impl<'a> CellBatch<'a> {
         self.view.context(slot)
     }
 
-    /// The position of the cell in `slot` in the state evaluated: its centre at the step's
-    /// start plus `stage ×` its velocity of the last evaluation, which in the corrector is
-    /// Heun's predictor of the centre (`c + h v(c)`), so that a force that depends on
-    /// position is integrated to second order like the fields.
+    /// The position of the cell in `slot` in the state evaluated: its centre of mass at the
+    /// step's start in the predictor, that of Heun's predicted field in the corrector
+    /// (measured on each call, a pass over the cell's patch), so that a force that depends
+    /// on position is integrated to second order like the fields.
+    /// ([`CellContext::centre`] is the step's start in both stages.)
     pub fn position(&self, slot: usize) -> [f64; 2] {
-        let c = self.view.centres[slot];
-        let v = self.view.cells[slot].velocity;
-        let s = self.view.stage;
-        [c[0] + s * v.x, c[1] + s * v.y]
+        match self.view.centre_of {
+            Some(f) => f(slot),
+            None => self.view.centres[slot],
+        }
     }
 }
 
