@@ -178,6 +178,13 @@ impl PyScene {
         self.set.clone()
     }
 
+    /// Pickling (a process pool's arguments): the resolved scene's text, which names its
+    /// files by absolute paths.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let cls = py.get_type::<PyScene>().getattr("from_text")?;
+        Ok((cls, (self.scene.to_toml(),)))
+    }
+
     fn __repr__(&self) -> String {
         let f = self.scene.file();
         format!(
