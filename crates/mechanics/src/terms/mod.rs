@@ -162,6 +162,27 @@ struct Entry {
     scratch: Vec<f64>,
 }
 
+impl Entry {
+    /// Sizes the state for identities below `n_new` and gives those from `n` on their
+    /// initial state (`t`: the term's place among the terms, which its keys carry).
+    fn extend(&mut self, t: usize, seed: u64, n: usize, n_new: usize) {
+        let len = self.len;
+        for v in [&mut self.x, &mut self.old, &mut self.rate1, &mut self.kick] {
+            v.resize(n_new * len, 0.0);
+        }
+        for id in n..n_new {
+            let key = |k: u64| NoiseKey {
+                seed,
+                cell: id as u64,
+                step: 0,
+                stage: INITIAL_STAGE + ((t as u64) << 16) + k,
+            };
+            self.term
+                .initial_state(id, &key, &mut self.x[id * len..(id + 1) * len]);
+        }
+    }
+}
+
 /// The terms of a tissue with their per-cell state: built with [`Terms::new`] and
 /// [`Terms::with`], attached by [`crate::Tissue::with_terms`].
 #[derive(Debug, Clone, Default)]
@@ -215,20 +236,10 @@ impl Terms {
         });
         // The new term's state for the identities there are; the others keep theirs.
         let (n, seed, t) = (self.n, self.seed, self.entries.len() - 1);
-        let e = self.entries.last_mut().expect("just pushed");
-        for v in [&mut e.x, &mut e.old, &mut e.rate1, &mut e.kick] {
-            v.resize(n * len, 0.0);
-        }
-        for id in 0..n {
-            let key = |k: u64| NoiseKey {
-                seed,
-                cell: id as u64,
-                step: 0,
-                stage: INITIAL_STAGE + ((t as u64) << 16) + k,
-            };
-            e.term
-                .initial_state(id, &key, &mut e.x[id * len..(id + 1) * len]);
-        }
+        self.entries
+            .last_mut()
+            .expect("just pushed")
+            .extend(t, seed, 0, n);
     }
 
     /// Whether there is no term.
@@ -373,20 +384,7 @@ impl Terms {
         }
         let (n, seed) = (self.n, self.seed);
         for (t, e) in self.entries.iter_mut().enumerate() {
-            let len = e.len;
-            for v in [&mut e.x, &mut e.old, &mut e.rate1, &mut e.kick] {
-                v.resize(n_new * len, 0.0);
-            }
-            for id in n..n_new {
-                let key = |k: u64| NoiseKey {
-                    seed,
-                    cell: id as u64,
-                    step: 0,
-                    stage: INITIAL_STAGE + ((t as u64) << 16) + k,
-                };
-                e.term
-                    .initial_state(id, &key, &mut e.x[id * len..(id + 1) * len]);
-            }
+            e.extend(t, seed, n, n_new);
         }
         self.n = n_new;
     }
