@@ -59,7 +59,7 @@ def test_an_in_memory_simulation_ends_where_the_command_line_ends(tmp_path, cli,
 
 def test_ctrl_c_stops_a_run_directory_with_a_checkpoint_and_it_resumes_to_the_same_bytes(tmp_path, cli, root):
     cli_run(cli, root, tmp_path / "cli")
-    scene = small_paper(root).set("run.time", 400.0)
+    scene = small_paper(root).set("run.time", 2000.0)
     # The uninterrupted run of the longer scene, from Python.
     full = ml.run(scene, tmp_path / "full", threads=1, progress=False)
     frames = tmp_path / "stopped" / "frames"
