@@ -432,7 +432,19 @@ impl PySimulation {
         if !until.is_finite() {
             return Err(PyValueError::new_err("until: give a finite model time"));
         }
-        self.run_to(py, (None, Some(until)), progress)
+        // With fixed steps, the step count (a clock summed step by step drifts from the
+        // multiples of dt over thousands of steps); an adaptive run lands on the time.
+        let (adaptive, dt) = {
+            let i = &self.scene.scene.file().integrator;
+            (i.adaptive, i.dt)
+        };
+        if adaptive {
+            return self.run_to(py, (None, Some(until)), progress);
+        }
+        let now = self.time();
+        let ahead = ((until - now) / dt).round().max(0.0) as u64;
+        let stop = self.iteration() + ahead;
+        self.run_to(py, (Some(stop), Some(until.max(now) + 0.5 * dt)), progress)
     }
 
     /// The cells' columns (a dict of 1-D NumPy arrays, copies).
