@@ -148,7 +148,7 @@ impl PySimulation {
                 0.0
             },
         });
-        interrupt::clear();
+        let _armed = interrupt::Armed::new(py);
         let Self { inner, pool, .. } = self;
         let inner = inner.get_mut().unwrap_or_else(|p| p.into_inner());
         let result = py.detach(|| {
@@ -730,7 +730,7 @@ fn drive<T: Real>(
         Schedule::IterationInterval(1),
         watcher(errors.clone(), progress, Some(interrupt)),
     );
-    interrupt::clear();
+    let _armed = interrupt::Armed::new(py);
     let outcome = py.detach(|| pool.install(|| dir.run(&mut sim)));
     if let Some(e) = take(&errors) {
         return Err(e);

@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -67,11 +68,15 @@ def test_ctrl_c_stops_a_run_directory_with_a_checkpoint_and_it_resumes_to_the_sa
     def ctrl_c():
         # A real SIGINT, as a terminal's Ctrl-C or Jupyter's interrupt sends, once the run
         # has written its third frame (20 TU in).
+        # (A daemon with a deadline: a run that fails early must not leave it waiting.)
+        deadline = time.monotonic() + 300
         while len(list(frames.glob("*.npz"))) < 3:
-            pass
+            if time.monotonic() > deadline:
+                return
+            time.sleep(0.005)
         os.kill(os.getpid(), signal.SIGINT)
 
-    watcher = threading.Thread(target=ctrl_c)
+    watcher = threading.Thread(target=ctrl_c, daemon=True)
     watcher.start()
     with pytest.raises(KeyboardInterrupt) as e:
         ml.run(scene, tmp_path / "stopped", threads=1, progress=False)

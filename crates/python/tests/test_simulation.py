@@ -1,6 +1,7 @@
 """The simulation stepped from Python: the lock released, Ctrl-C, every error with its
 exception and message, memory over many snapshots and callbacks, edits."""
 
+import asyncio
 import os
 import resource
 import signal
@@ -37,19 +38,28 @@ def test_the_lock_is_released_while_the_simulation_steps(root):
     assert sim.time == pytest.approx(sim.scene.end_time)
 
 
+def ctrl_c_after(steps, n):
+    """Sends a real SIGINT once `steps` holds `n` entries (a daemon with a deadline, so that a
+    run failing early leaves nothing waiting)."""
+
+    def send():
+        deadline = time.monotonic() + 300
+        while len(steps) < n:
+            if time.monotonic() > deadline:
+                return
+            time.sleep(0.001)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    threading.Thread(target=send, daemon=True).start()
+
+
 def test_ctrl_c_raises_after_a_whole_step_and_the_simulation_goes_on(root):
     # Long enough that the signal comes mid-run on a slow machine too.
     scene = small_paper(root).set("run.time", 4000.0)
     sim = ml.Simulation(scene, threads=1)
     steps = []
     sim.add_callback(lambda o: steps.append(o.iteration), steps=1)
-
-    def ctrl_c():
-        while len(steps) < 30:
-            time.sleep(0.001)
-        os.kill(os.getpid(), signal.SIGINT)
-
-    threading.Thread(target=ctrl_c).start()
+    ctrl_c_after(steps, 30)
     with pytest.raises(KeyboardInterrupt):
         sim.run(progress=False)
     stopped = sim.iteration
@@ -61,6 +71,24 @@ def test_ctrl_c_raises_after_a_whole_step_and_the_simulation_goes_on(root):
     # Stopping and going on changes nothing: the same end as a run in one go.
     again = ml.Simulation(scene, threads=1).run(progress=False)
     assert np.array_equal(sim.phi()[0], again.phi()[0])
+
+
+def test_ctrl_c_still_stops_a_run_after_something_else_set_the_handler(root):
+    # asyncio.run (on which Jupyter's kernels run) sets SIGINT's handler and puts Python's
+    # back, as any library may: the process's handler is then Python's alone. A handler of
+    # ours installed once, for good, was gone from then on, and Ctrl-C came only after the run.
+    sim = ml.Simulation(small_paper(root).set("run.time", 4000.0), threads=1)
+    sim.step(1)
+    asyncio.run(asyncio.sleep(0))
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    steps = []
+    sim.add_callback(lambda o: steps.append(o.iteration), steps=1)
+    ctrl_c_after(steps, 30)
+    with pytest.raises(KeyboardInterrupt):
+        sim.run(progress=False)
+    assert 30 <= sim.iteration < 20_000, "stopped mid-run"
+    # Python's handler is back in place after the run.
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 
 @pytest.mark.parametrize(

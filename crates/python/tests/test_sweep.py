@@ -2,6 +2,7 @@
 `monolayer sweep`: the command line collects its summary, and each point's run is the one the
 command line's sweep writes, byte for byte."""
 
+import multiprocessing
 import pickle
 import subprocess
 from concurrent.futures import ProcessPoolExecutor
@@ -20,7 +21,9 @@ def test_a_sweep_run_by_a_process_pool_is_the_command_lines_sweep(tmp_path, cli,
         "model.zeta=0.005_seed=1",
         "model.zeta=0.005_seed=2",
     ]
-    with ProcessPoolExecutor(2) as pool:
+    # Spawned, not forked: a fork copies a process whose other threads (a simulation's pool,
+    # a progress bar's monitor) may hold locks that no thread of the child will release.
+    with ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
         list(pool.map(ml.run, [p.scene for p in points], [p.out for p in points], [False] * 4, [1] * 4, [False] * 4))
     o = subprocess.run([cli, "sweep", "--collect", "--out", str(tmp_path / "py")], capture_output=True, text=True)
     assert o.returncode == 0, o.stderr

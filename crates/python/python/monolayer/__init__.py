@@ -382,7 +382,8 @@ def sweep(
     and ``seeds`` (a range of consecutive seeds), in the order and with the directory layout
     of ``monolayer sweep`` (``out/sweep.toml``, ``out/runs/NAME``), for any executor::
 
-        with ProcessPoolExecutor() as pool:
+        spawn = multiprocessing.get_context("spawn")  # never fork a process with threads
+        with ProcessPoolExecutor(mp_context=spawn) as pool:
             for p in ml.sweep(scene, {"model.zeta": [0.002, 0.004]}, range(1, 4), "out/s"):
                 pool.submit(ml.run, p.scene, p.out)
 
