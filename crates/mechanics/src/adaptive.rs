@@ -159,7 +159,10 @@ impl<T: Real> Tissue<T> {
                 self.predict(ws, h);
             }
             first = false;
-            let diff = self.correct::<true>(ws, h);
+            let diff = match self.correct::<true>(ws, h) {
+                Ok(d) => d,
+                Err(slot) => return Err(self.abandon_step(ws, slot)),
+            };
             let err = 0.5 * h * diff / params.tolerance;
             if err <= 1.0 {
                 // The controller adapts the proposal only from full (unclipped) steps.

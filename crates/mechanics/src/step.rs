@@ -132,10 +132,13 @@ impl<T: Real> Tissue<T> {
         // derivative inside the force pass too (`kernels::NodeTerms`).
         self.start_step(ws, dt, Some(dt), check)?;
         for pass in 0..step_params.npc {
-            if pass + 1 < step_params.npc {
-                self.correct::<false>(ws, dt);
+            let done = if pass + 1 < step_params.npc {
+                self.correct::<false>(ws, dt).map(|_| ())
             } else {
-                self.correct_last(ws, dt);
+                self.correct_last(ws, dt)
+            };
+            if let Err(slot) = done {
+                return Err(self.abandon_step(ws, slot));
             }
         }
         self.iteration += 1;
@@ -179,7 +182,8 @@ impl<T: Real> Tissue<T> {
             None => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
-        self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post, 0.0, None);
+        // (Stage 0 never refuses: the check below reports a force that is not finite.)
+        let _ = self.evaluate_fields(shapes, k1, sums, cell_state, term_scratch, post, 0.0, None);
         let at = CheckPoint {
             iteration: self.iteration,
             time: self.time,
@@ -248,13 +252,31 @@ impl<T: Real> Tissue<T> {
         self.ext.terms = terms;
     }
 
+    /// Back to the state before the step, from a corrector whose evaluation refused to start
+    /// (a whole-cell force of slot `slot` not finite: see [`Tissue::evaluate_fields`]): the
+    /// fields hold a predicted or corrected state and `ws.phi_old` the step's start, which
+    /// nothing has overwritten yet; the terms go back to the state they saved at the start.
+    pub(crate) fn abandon_step(&mut self, ws: &mut Workspace<T>, slot: usize) -> StepError {
+        self.cells.swap_phi(&mut ws.phi_old);
+        self.ext.terms.restore();
+        StepError::NonFinite {
+            step: self.iteration,
+            time: self.time,
+            cell_idx: slot,
+        }
+    }
+
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
     /// fields, with `φ_old + h/2 (k1 + k2)` written over `ws.phi_old` cell by cell right after
     /// each cell's `k2`, and its centre of mass into `ws.next_centre`, then swapped in: the
     /// fields hold the new state and `ws.phi_old` the predicted one. (The adaptive step, which
     /// may have to go back to `φ_old`, and the earlier passes of several use
     /// [`Tissue::correct`].)
-    pub(crate) fn correct_last(&mut self, ws: &mut Workspace<T>, h: f64) {
+    ///
+    /// # Errors
+    /// The slot of a whole-cell force that is not finite, with nothing overwritten (see
+    /// [`Tissue::abandon_step`]).
+    pub(crate) fn correct_last(&mut self, ws: &mut Workspace<T>, h: f64) -> Result<(), usize> {
         let Workspace {
             phi_old,
             k1,
@@ -281,11 +303,12 @@ impl<T: Real> Tissue<T> {
             },
             h,
             Some(com),
-        );
+        )?;
         self.cells.swap_phi(phi_old);
         if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
         }
+        Ok(())
     }
 
     /// The predictor `φ = φ_old + h k1` (forward Euler) from what [`Tissue::start_step`]
@@ -302,7 +325,14 @@ impl<T: Real> Tissue<T> {
     /// predicted state), then `φ = φ_old + h/2 (k1 + k2)`. With `ESTIMATE`, also returns
     /// `max |k2 − k1|` over every node (the adaptive step's error estimate; a maximum is exact
     /// in any order), otherwise 0 without computing it.
-    pub(crate) fn correct<const ESTIMATE: bool>(&mut self, ws: &mut Workspace<T>, h: f64) -> f64 {
+    ///
+    /// # Errors
+    /// As [`Tissue::correct_last`]; the fields are then still the predicted ones.
+    pub(crate) fn correct<const ESTIMATE: bool>(
+        &mut self,
+        ws: &mut Workspace<T>,
+        h: f64,
+    ) -> Result<f64, usize> {
         let Workspace {
             phi_old,
             k1,
@@ -322,7 +352,7 @@ impl<T: Real> Tissue<T> {
             Post::Nothing,
             h,
             Some(com),
-        );
+        )?;
         if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
         }
@@ -332,7 +362,7 @@ impl<T: Real> Tissue<T> {
             .par_iter_mut()
             .zip(phi_old.par_iter())
             .zip(k1.par_iter().zip(k2.par_iter()));
-        if ESTIMATE {
+        Ok(if ESTIMATE {
             updates
                 .map(|((p, o), (r1, r2))| {
                     let (r1, r2) = (r1.to_f64(), r2.to_f64());
@@ -345,7 +375,7 @@ impl<T: Real> Tissue<T> {
                 *p = T::from_f64(heun_corrector(o.to_f64(), h, r1.to_f64(), r2.to_f64()))
             });
             0.0
-        }
+        })
     }
 
     /// Whether a step computes the deformation tensors and `Q`: only the active force uses
@@ -365,7 +395,7 @@ impl<T: Real> Tissue<T> {
         post: Post<'_, T>,
         stage: f64,
         com: Option<&ComTable>,
-    ) {
+    ) -> Result<(), usize> {
         let TermScratch {
             cell_force,
             lap_s1,
@@ -415,6 +445,18 @@ impl<T: Real> Tissue<T> {
             let mut view = self.terms_view(cell_state, stage);
             view.centre_of = Some(&predicted);
             self.ext.terms.forces(&view, cell_force);
+            // In a corrector (`stage > 0`), a force that is not finite refuses the evaluation
+            // before the fused corrector overwrites the step's start (`Post::Correct`), so that
+            // the step can go back to it (`Tissue::abandon_step`). At the step's start the
+            // chokepoint's check reports it (`StateCheck`).
+            if stage > 0.0 {
+                if let Some(slot) = cell_force
+                    .iter()
+                    .position(|f| !(f[0].is_finite() && f[1].is_finite()))
+                {
+                    return Err(slot);
+                }
+            }
             Some(&cell_force[..])
         };
         let input = EvalInput {
@@ -437,6 +479,7 @@ impl<T: Real> Tissue<T> {
             kind_constants,
         };
         evaluate(&input, out, scratch, post);
+        Ok(())
     }
 
     /// Evaluates the derived quantities of the current state (areas, shapes, forces,
@@ -465,7 +508,8 @@ impl<T: Real> Tissue<T> {
             Post::Nothing,
             0.0,
             None,
-        );
+        )
+        .ok();
     }
 }
 
@@ -498,7 +542,7 @@ mod tests {
             .expect("stable");
         t.predict(ws, sp.dt);
         for _ in 0..sp.npc {
-            t.correct::<false>(ws, sp.dt);
+            t.correct::<false>(ws, sp.dt).expect("finite forces");
         }
         t.iteration += 1;
         t.time += sp.dt;

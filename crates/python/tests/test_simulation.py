@@ -137,6 +137,26 @@ def test_errors_inside_a_run_are_raised_and_leave_a_state_that_goes_on(tmp_path,
     with pytest.raises(Boom, match="from the force"):
         sim.step(5)
     assert sim.iteration == 2, "stopped before the step, at the last good state"
+    # Raised in Heun's corrector (the step's second call): the same, and the state is the
+    # step's start to the bit.
+    sim5 = ml.Simulation(single(), threads=1)
+    sim5.step(2)
+    before = sim5.phi()[0].copy()
+    calls = []
+
+    def second(t, c):
+        calls.append(t)
+        if len(calls) == 2:
+            raise Boom("in the corrector")
+        return np.zeros((len(c["id"]), 2))
+
+    sim5.add_force(second, name="second")
+    with pytest.raises(Boom, match="in the corrector"):
+        sim5.step(1)
+    assert len(calls) == 2 and sim5.iteration == 2
+    assert np.array_equal(sim5.phi()[0], before)
+    sim5.step(1)
+    assert sim5.iteration == 3, "and it goes on"
     # A force of the wrong shape, and a non-finite one.
     sim2 = ml.Simulation(single(), threads=1)
     sim2.add_force(lambda t, c: np.zeros((3, 2)))

@@ -598,3 +598,78 @@ fn a_rejected_adaptive_step_replays_its_noise() {
         "no attempt was rejected, so nothing was tested"
     );
 }
+
+/// Arms [`FailsInTheCorrector`] (only its test uses it).
+static ARMED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// A force that is not finite in Heun's corrector only (`NaN` while [`ARMED`]), as a host's
+/// force that fails in its second call gives.
+#[derive(Debug)]
+struct FailsInTheCorrector;
+
+impl CellTerm for FailsInTheCorrector {
+    fn name(&self) -> &str {
+        "fails"
+    }
+    fn force(&self, _: &CellContext<'_>, _: &[f64]) -> [f64; 2] {
+        [0.0; 2]
+    }
+    fn forces(&self, cells: &CellBatch<'_>, _: &[f64], out: &mut [[f64; 2]]) {
+        let nan = cells.stage() > 0.0 && ARMED.load(std::sync::atomic::Ordering::SeqCst);
+        out.fill(if nan { [f64::NAN; 2] } else { [0.0; 2] });
+    }
+}
+
+/// A whole-cell force that is not finite in the corrector stops the step with the tissue at
+/// the step's start to the bit (fields, clock, the terms' state), whatever the number of
+/// corrector passes: the fused last corrector writes over the start in place, so the force is
+/// checked before it runs. Disarmed, the next step is the one an untouched copy takes.
+#[test]
+fn a_force_that_fails_in_the_corrector_leaves_the_step_start() {
+    use std::sync::atomic::Ordering::SeqCst;
+    for npc in [1, 2] {
+        let terms = Terms::new(1)
+            .with(Polarity::new(0.04).with_rotational_diffusion(0.01))
+            .with(FailsInTheCorrector);
+        let (mut t, mut ws) = relaxed_cell(terms);
+        let sp = StepParams {
+            npc,
+            ..StepParams::default()
+        };
+        t.step(&mut ws, &sp).expect("stable");
+        let (copy, phi, theta) = (
+            t.clone(),
+            t.cells().phi().to_vec(),
+            t.terms().state("polarity").unwrap().to_vec(),
+        );
+        let (clock, time) = (t.iteration(), t.time());
+        ARMED.store(true, SeqCst);
+        let e = t.step(&mut ws, &sp);
+        ARMED.store(false, SeqCst);
+        let e = e.expect_err("a NaN force in the corrector");
+        assert!(
+            matches!(e, crate::StepError::NonFinite { cell_idx: 0, .. }),
+            "{e}"
+        );
+        assert_eq!(t.cells().phi(), &phi[..], "npc {npc}: the fields");
+        assert_eq!(
+            t.terms().state("polarity").unwrap(),
+            &theta[..],
+            "npc {npc}: θ"
+        );
+        assert_eq!(
+            (t.iteration(), t.time()),
+            (clock, time),
+            "npc {npc}: the clock"
+        );
+        t.step(&mut ws, &sp).expect("stable");
+        let mut copy = copy;
+        let mut ws2 = Workspace::new(copy.cells());
+        copy.step(&mut ws2, &sp).expect("stable");
+        assert_eq!(
+            t.cells().phi(),
+            copy.cells().phi(),
+            "npc {npc}: goes on as before"
+        );
+    }
+}
