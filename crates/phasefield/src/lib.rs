@@ -81,7 +81,7 @@ pub enum PhaseFieldError {
         ly: usize,
     },
     /// The initial discs do not fit.
-    #[error("{n_cells} cells with initial discs of radius {disc_radius} do not fit in the domain (at most {max_cells}); use fewer cells or a larger domain")]
+    #[error("{n_cells} cells with initial discs of radius {disc_radius} do not fit in the domain (at most {max_cells})")]
     TooManyCells {
         /// Cells requested.
         n_cells: usize,
