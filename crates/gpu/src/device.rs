@@ -88,6 +88,50 @@ impl Device {
             .min(self.limits.max_buffer_size)
     }
 
+    /// The device's copy bandwidth in GB/s, bytes read plus bytes written: the best of
+    /// `repeats` timed copies of a `bytes`-byte buffer into another (after one untimed), each
+    /// submitted alone and waited for, so that the figure includes a submission's latency
+    /// (negligible from about 100 MB). This is the roof that the step's counted bytes per
+    /// node-update ([`crate::GpuBackend::bytes_per_node_update`]) are set against.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] for more than the device's largest buffer, or
+    /// [`GpuError::Lost`].
+    pub fn copy_bandwidth(&self, bytes: u64, repeats: usize) -> Result<f64, GpuError> {
+        let bytes = bytes.max(4) / 4 * 4;
+        if bytes > self.limits.max_buffer_size {
+            return Err(GpuError::TooLarge(format!(
+                "a copy of {bytes} bytes: the device's largest buffer is {} bytes",
+                self.limits.max_buffer_size
+            )));
+        }
+        let buffer = |label| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let (from, to) = (buffer("copy from"), buffer("copy to"));
+        let mut best = f64::INFINITY;
+        for i in 0..=repeats {
+            let t0 = std::time::Instant::now();
+            let mut enc = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            enc.copy_buffer_to_buffer(&from, 0, &to, 0, bytes);
+            self.queue.submit(Some(enc.finish()));
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| GpuError::Lost(e.to_string()))?;
+            if i > 0 {
+                best = best.min(t0.elapsed().as_secs_f64());
+            }
+        }
+        Ok(2.0 * bytes as f64 / best / 1e9)
+    }
+
     /// The wgpu device and queue, for tests that run kernels of their own.
     pub fn raw(&self) -> (&wgpu::Device, &wgpu::Queue) {
         (&self.device, &self.queue)

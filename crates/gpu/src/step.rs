@@ -802,13 +802,19 @@ impl GpuBackend {
     /// gather reads φ once more (4), the force pass reads φ and the node's sums (4 + 16) and
     /// writes `R` and the new φ (8; the corrector also reads `R` and φⁿ, 8 more); the lattice
     /// sums write 16 bytes a lattice node, 2 evaluations a step, counted per patch node with
-    /// `lattice_nodes / patch_nodes`. Neighbours of the stencil are taken as cached.
+    /// `lattice_nodes / patch_nodes`. With `K` chunks the lattice pass runs once per chunk
+    /// over the whole lattice, and every chunk but the last writes its partial sums (32 bytes
+    /// a node) that the next reads (32 more): `64 (K − 1)` bytes a lattice node and
+    /// evaluation (about 39 B per node-update at 10⁶ cells in 3 chunks). Neighbours of the
+    /// stencil and the bins' lists are taken as cached.
     pub fn bytes_per_node_update(&self) -> f64 {
         let predictor = 4.0 + 4.0 + 4.0 + 16.0 + 8.0;
         let corrector = predictor + 8.0;
         let correctors = self.npc as f64;
-        let lattice = 16.0 * (1.0 + correctors) * self.lattice.len() as f64
-            / (self.n_cells * self.shape.len()).max(1) as f64;
+        let per_patch_node =
+            self.lattice.len() as f64 / (self.n_cells * self.shape.len()).max(1) as f64;
+        let chunks = 64.0 * self.chunks.len().saturating_sub(1) as f64;
+        let lattice = (16.0 + chunks) * (1.0 + correctors) * per_patch_node;
         predictor + correctors * corrector + lattice
     }
 

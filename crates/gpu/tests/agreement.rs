@@ -182,6 +182,17 @@ fn chunked_arrays_agree_with_one_array() {
     let mut split =
         GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap();
     assert_eq!(split.n_chunks(), 3);
+    // The counted traffic includes the chunks' partial sums: 64 bytes a lattice node and
+    // evaluation for each chunk but the last (written by one, read by the next), two
+    // evaluations a step, per patch node.
+    let per_patch_node =
+        tissue.lattice().len() as f64 / (tissue.n_cells() * tissue.cells().patch_len()) as f64;
+    let extra = split.bytes_per_node_update() - whole.bytes_per_node_update();
+    let expected = 64.0 * 2.0 * 2.0 * per_patch_node;
+    assert!(
+        (extra - expected).abs() <= 1e-9 * expected,
+        "chunk traffic {extra} B, expected {expected} B"
+    );
     let a = split.evaluate(&tissue, sp.dt).unwrap();
     let mut one = GpuBackend::new(&tissue, &sp).unwrap();
     let b = one.evaluate(&tissue, sp.dt).unwrap();
