@@ -29,7 +29,7 @@ mod device;
 mod step;
 
 pub use device::{adapter_info, Device, GpuError};
-pub use step::{Evaluation, GpuBackend, GpuMemory, GpuOptions, SUPPORTED};
+pub use step::{Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Params, SUPPORTED};
 
 /// The WGSL source of the step's kernels, with the constants of a patch shape and pressure
 /// form filled in (for the tests that compare each equation with its Rust reference).

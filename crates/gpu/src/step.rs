@@ -39,7 +39,9 @@ fn shader_source_split(shape: &PatchShape, kind: PressureKind, cap: u32, split: 
     format!(
         "const NX: u32 = {nx}u;\nconst NY: u32 = {ny}u;\nconst PLEN: u32 = {plen}u;\n\
          const NPT: u32 = {npt}u;\nconst MARGIN: u32 = {margin}u;\nconst CAP: u32 = {cap}u;\n\
-         const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n{SOURCE}",
+         const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n{params}{chunk}{SOURCE}",
+        params = Params::WGSL,
+        chunk = Chunk::WGSL,
         npt = plen.div_ceil(WG),
         paper = u32::from(kind == PressureKind::Paper),
     )
@@ -57,26 +59,94 @@ pub struct Evaluation {
     pub cells: Vec<f32>,
 }
 
-/// The uniform parameters of the kernels (the shader's `Params`).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-struct Params {
-    double_well: f32,
-    gradient: f32,
-    area: f32,
-    inv_target_area: f32,
-    repulsion: f32,
-    zeta: f32,
-    xi: f32,
-    dt: f32,
-    lx: u32,
-    ly: u32,
-    nbx: u32,
-    nby: u32,
-    n_cells: u32,
-    grid_x: u32,
-    bound: f32,
-    pad: u32,
+/// A structure shared by the host and the kernels, written once: the Rust definition
+/// (`#[repr(C)]`, `Pod`) and its WGSL declaration (`WGSL`, which [`shader_source`] prepends
+/// to the kernels) come from the same list of fields, so they cannot drift. Every field is
+/// `f32` or `u32` (4 bytes, aligned to 4 in both languages, checked at compile time), and the
+/// size is a multiple of 16 (a uniform block's rule), so the two layouts are the same field
+/// by field.
+macro_rules! shared_struct {
+    ($(#[$meta:meta])* $vis:vis struct $name:ident { $($(#[$fmeta:meta])* $field:ident: $ty:ident,)* }) => {
+        $(#[$meta])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+        $vis struct $name {
+            $($(#[$fmeta])* pub $field: $ty,)*
+        }
+
+        impl $name {
+            /// The WGSL declaration of this structure.
+            pub const WGSL: &'static str = concat!(
+                "struct ", stringify!($name), " {\n",
+                $("    ", stringify!($field), ": ", stringify!($ty), ",\n",)*
+                "}\n"
+            );
+        }
+
+        const _: () = {
+            $(assert!(
+                std::mem::size_of::<$ty>() == 4 && std::mem::align_of::<$ty>() == 4,
+                "shared structures hold f32 and u32 only"
+            );)*
+            let fields = [$(stringify!($field)),*].len();
+            assert!(std::mem::size_of::<$name>() == 4 * fields);
+            assert!(std::mem::size_of::<$name>() % 16 == 0, "pad to 16 bytes");
+        };
+    };
+}
+
+shared_struct! {
+    /// The uniform parameters of the kernels (the shader's `Params`).
+    pub struct Params {
+        /// `8γ/λ` ([`phasefield::EnergyCoefficients`], as the next four).
+        double_well: f32,
+        /// `2γλ`.
+        gradient: f32,
+        /// `4μ/πR²`.
+        area: f32,
+        /// `1/πR²`.
+        inv_target_area: f32,
+        /// `2κ/λ`.
+        repulsion: f32,
+        /// The activity ζ.
+        zeta: f32,
+        /// The friction ξ.
+        xi: f32,
+        /// The time step.
+        dt: f32,
+        /// Lattice nodes along x.
+        lx: u32,
+        /// Lattice nodes along y.
+        ly: u32,
+        /// Bins along x.
+        nbx: u32,
+        /// Bins along y.
+        nby: u32,
+        /// Cells.
+        n_cells: u32,
+        /// Workgroups along x of a per-cell dispatch (the rest along y).
+        grid_x: u32,
+        /// The band around `[0, 1]` that a field may not leave ([`mechanics::PHI_BOUND`]).
+        bound: f32,
+        /// Padding to 16 bytes.
+        pad: u32,
+    }
+}
+
+shared_struct! {
+    /// The cells of one chunk (the shader's `Chunk`): cells `lo .. lo + count`, whose φ sit at
+    /// `(i − lo) · PLEN` in the dispatch's arrays; `first` and `last` (0 or 1) say whether the
+    /// lattice pass starts or ends the sums over chunks.
+    pub struct Chunk {
+        /// The first cell.
+        lo: u32,
+        /// How many cells.
+        count: u32,
+        /// Whether this is the first chunk.
+        first: u32,
+        /// Whether this is the last chunk.
+        last: u32,
+    }
 }
 
 /// What the device holds, in bytes, for a state: for the memory estimate and its refusal.
@@ -380,15 +450,15 @@ impl GpuBackend {
             .iter()
             .enumerate()
             .map(|(k, &(lo, count))| {
-                let v = [
-                    lo as u32,
-                    count as u32,
-                    u32::from(k == 0),
-                    u32::from(k + 1 == chunks.len()),
-                ];
+                let v = Chunk {
+                    lo: lo as u32,
+                    count: count as u32,
+                    first: u32::from(k == 0),
+                    last: u32::from(k + 1 == chunks.len()),
+                };
                 d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("chunk"),
-                    contents: bytemuck::cast_slice(&v),
+                    contents: bytemuck::bytes_of(&v),
                     usage: wgpu::BufferUsages::UNIFORM,
                 })
             })

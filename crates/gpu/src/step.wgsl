@@ -15,35 +15,8 @@
 const WG: u32 = 256u;
 const TAU: f32 = 6.283185307179586;
 
-struct Params {
-    // EnergyCoefficients: 8γ/λ, 2γλ, 4μ/πR², 1/πR², 2κ/λ.
-    double_well: f32,
-    gradient: f32,
-    area: f32,
-    inv_target_area: f32,
-    repulsion: f32,
-    zeta: f32,
-    xi: f32,
-    dt: f32,
-    lx: u32,
-    ly: u32,
-    nbx: u32,
-    nby: u32,
-    n_cells: u32,
-    grid_x: u32,
-    bound: f32,
-    _pad: u32,
-}
-
-// The cells of one chunk (the per-cell φ arrays are split into chunks of at most a binding's
-// size): cells lo .. lo + count, whose φ sit at (i − lo) * PLEN in this dispatch's arrays;
-// first and last say whether the lattice pass starts or ends the sums over chunks.
-struct Chunk {
-    lo: u32,
-    count: u32,
-    first: u32,
-    last: u32,
-}
+// `Params` and `Chunk` are prepended by the host, generated from their Rust definitions
+// (`shared_struct!` in step.rs), so that the two layouts cannot drift.
 
 struct Status {
     failed: atomic<u32>,

@@ -18,8 +18,8 @@ mod common;
 /// v_x, v_y, R_old, R_new, Δt.
 const IN: usize = 16;
 /// Outputs per sample, in the order of `NAMES`.
-const OUT: usize = 16;
-const NAMES: [&str; 16] = [
+const OUT: usize = 17;
+const NAMES: [&str; OUT] = [
     "area_factor",
     "free_energy_derivative",
     "shape_tensor_density.xx",
@@ -36,6 +36,7 @@ const NAMES: [&str; 16] = [
     "heun_corrector",
     "pressure_regrouped",
     "laplacian",
+    "pressure_own_part",
 ];
 
 const HARNESS: &str = r#"
@@ -45,7 +46,7 @@ const HARNESS: &str = r#"
 @compute @workgroup_size(64)
 fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= arrayLength(&eq_out) / 16u) {
+    if (i >= arrayLength(&eq_out) / 17u) {
         return;
     }
     let x = i * 16u;
@@ -63,7 +64,7 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r_new = eq_in[x + 14u];
     let dt = eq_in[x + 15u];
     let af = area_factor(area);
-    let o = i * 16u;
+    let o = i * 17u;
     eq_out[o] = af;
     eq_out[o + 1u] = free_energy_derivative(phi, lap, af, others);
     let sh = shape_tensor_density(g);
@@ -91,26 +92,26 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     st.ym = eq_in[x + 6u];
     st.yp = eq_in[x + 7u];
     eq_out[o + 15u] = laplacian(st);
+    // The lattice pass's own part of the pressure (the gather's).
+    eq_out[o + 16u] = pressure_own_part(phi, lap, af);
 }
 "#;
 
-/// The kernel's uniform block (the shader's `Params`), with the coefficients of `coef`.
+/// The kernel's uniform block (the shader's `Params`, one definition for Rust and WGSL),
+/// with the coefficients of `coef`.
 fn params_bytes(coef: &EnergyCoefficients, zeta: f32, xi: f32) -> Vec<u8> {
-    let f = [
-        coef.double_well as f32,
-        coef.gradient as f32,
-        coef.area as f32,
-        coef.inv_target_area as f32,
-        coef.repulsion as f32,
+    let p = gpu::Params {
+        double_well: coef.double_well as f32,
+        gradient: coef.gradient as f32,
+        area: coef.area as f32,
+        inv_target_area: coef.inv_target_area as f32,
+        repulsion: coef.repulsion as f32,
         zeta,
         xi,
-        0.1,
-    ];
-    let mut out: Vec<u8> = bytemuck::cast_slice(&f).to_vec();
-    out.extend_from_slice(bytemuck::cast_slice(&[0u32; 6]));
-    out.extend_from_slice(bytemuck::cast_slice(&[0.0f32]));
-    out.extend_from_slice(bytemuck::cast_slice(&[0u32]));
-    out
+        dt: 0.1,
+        ..bytemuck::Zeroable::zeroed()
+    };
+    bytemuck::bytes_of(&p).to_vec()
 }
 
 fn run_kernel(
@@ -276,6 +277,17 @@ fn reference(
         ),
         (regrouped, reg_scale),
         (lap5, nb.iter().map(|v| (v - phi).abs()).sum::<f64>()),
+        // `pressure_cell_part` less its repulsion term, −(2κ/λ)φ³ (paper) or −(2κ/λ)φ⁴
+        // (interaction, where nothing is left).
+        (
+            eq::pressure_cell_part(kind, c, phi, lap, af)
+                + c.repulsion
+                    * match kind {
+                        PressureKind::Paper => phi.powi(3),
+                        PressureKind::Interaction => phi.powi(4),
+                    },
+            cell_scale,
+        ),
     ]
 }
 
