@@ -12,7 +12,9 @@
 # The device host has no cargo and no network, and may have another processor: `prepare`
 # builds for the portable x86-64-v2 level (GPU_CHECK_CPU; Rust never fuses a multiply and an
 # add, so the results are the same bits as a native build), into its own target directory
-# (GPU_CHECK_TARGET, default target/gpu-check). The scenes are compiled into the binary.
+# (GPU_CHECK_TARGET, default target/gpu-check). GPU_CHECK_BUILD=workspace takes the
+# workspace's own release test build instead, as it is (CI). The scenes are compiled into the
+# binary.
 #
 # `run` stops every command by an overall budget (BUDGET_S, default 540 s: a device command
 # may run 10 minutes) and writes each result the moment it has it:
@@ -37,17 +39,36 @@ prepare() {
     local flags="-C target-cpu=${GPU_CHECK_CPU:-x86-64-v2}"
     rm -rf "$DIR/bin"
     mkdir -p "$DIR/bin" "$DIR/debs"
-    RUSTFLAGS="$flags" CARGO_TARGET_DIR="$target" cargo build --release --locked -q -p gpu --example gpu_check
-    cp "$target/release/examples/gpu_check" "$DIR/bin/"
-    RUSTFLAGS="$flags" CARGO_TARGET_DIR="$target" cargo test --release --locked -q -p gpu --no-run --message-format=json 2>/dev/null |
-        python3 -c '
-import json, sys, shutil
+    # The example and the gpu crate's test executables, picked from cargo's own list.
+    local pick='
+import json, shutil, sys
+found = 0
 for line in sys.stdin:
     m = json.loads(line)
-    if m.get("reason") == "compiler-artifact" and m.get("executable") and m["target"]["kind"] == ["test"]:
-        shutil.copy(m["executable"], sys.argv[1] + "/bin/test-" + m["target"]["name"])
-' "$DIR"
-    ls "$DIR"/bin/test-* >/dev/null
+    if m.get("reason") != "compiler-artifact" or not m.get("executable"):
+        continue
+    if not m["manifest_path"].endswith("crates/gpu/Cargo.toml"):
+        continue
+    kind, name = m["target"]["kind"], m["target"]["name"]
+    if kind == ["example"] and name == "gpu_check":
+        shutil.copy(m["executable"], sys.argv[1] + "/bin/gpu_check"); found += 1
+    elif kind == ["test"]:
+        shutil.copy(m["executable"], sys.argv[1] + "/bin/test-" + name); found += 1
+sys.exit(0 if found >= 2 else "gpu_check: the example or the tests were not built")
+'
+    if [ "${GPU_CHECK_BUILD:-portable}" = workspace ]; then
+        # CI: the workspace's own release test build (this machine's flags), which builds the
+        # examples too and is already there; nothing is compiled again.
+        cargo test --release --locked --no-run --message-format=json 2>/dev/null | python3 -c "$pick" "$DIR"
+        flags="(the workspace's)"
+    else
+        RUSTFLAGS="$flags" CARGO_TARGET_DIR="$target" cargo build --release --locked -q -p gpu --example gpu_check
+        RUSTFLAGS="$flags" CARGO_TARGET_DIR="$target" cargo test --release --locked -q -p gpu --no-run \
+            --message-format=json 2>/dev/null | python3 -c "$pick" "$DIR"
+        # `cargo build` names no example in `cargo test`'s list: copied here.
+        cp "$target/release/examples/gpu_check" "$DIR/bin/"
+    fi
+    ls "$DIR"/bin/gpu_check "$DIR"/bin/test-* >/dev/null
     # The Vulkan loader, vulkaninfo and what the NVIDIA driver's ICD loads, as packages that
     # `run` unpacks without installing (GPU_CHECK_DEBS=0 skips the download).
     if [ "${GPU_CHECK_DEBS:-1}" != 0 ]; then
