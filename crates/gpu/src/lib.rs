@@ -29,7 +29,9 @@ mod device;
 mod step;
 
 pub use device::{adapter_info, Device, GpuError};
-pub use step::{Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Params, SUPPORTED};
+pub use step::{
+    Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Kind, Params, MAX_KINDS, SUPPORTED,
+};
 
 /// The WGSL source of the step's kernels, with the constants of a patch shape and pressure
 /// form filled in (for the tests that compare each equation with its Rust reference).

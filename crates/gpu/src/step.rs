@@ -10,11 +10,12 @@ use wgpu::util::DeviceExt;
 
 use crate::device::{Device, GpuError};
 
-/// Invocations per workgroup (the shader's `WG`).
-/// The extensions of the paper's model the GPU backend runs: none yet (issue 40), so a tissue
-/// with any part of [`mechanics::Part::ALL`] is refused by [`GpuBackend::check`], naming it.
-pub const SUPPORTED: &[mechanics::Part] = &[];
+/// The extensions of the paper's model the GPU backend runs: populations (per-cell constants,
+/// [`Kind`]); a tissue with any other part of [`mechanics::Part::ALL`] is refused by
+/// [`GpuBackend::check`], naming it.
+pub const SUPPORTED: &[mechanics::Part] = &[mechanics::Part::Populations];
 
+/// Invocations per workgroup (the shader's `WG`).
 const WG: u32 = 256;
 /// Workgroups along one dimension of a dispatch (Vulkan's guaranteed minimum).
 const MAX_GROUPS: u32 = 65_535;
@@ -39,8 +40,10 @@ fn shader_source_split(shape: &PatchShape, kind: PressureKind, cap: u32, split: 
     format!(
         "const NX: u32 = {nx}u;\nconst NY: u32 = {ny}u;\nconst PLEN: u32 = {plen}u;\n\
          const NPT: u32 = {npt}u;\nconst MARGIN: u32 = {margin}u;\nconst CAP: u32 = {cap}u;\n\
-         const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n{params}{chunk}{SOURCE}",
+         const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n\
+         const MAX_KINDS: u32 = {MAX_KINDS}u;\n{params}{kind}{chunk}{SOURCE}",
         params = Params::WGSL,
+        kind = Kind::WGSL,
         chunk = Chunk::WGSL,
         npt = plen.div_ceil(WG),
         paper = u32::from(kind == PressureKind::Paper),
@@ -132,6 +135,36 @@ shared_struct! {
         pad: u32,
     }
 }
+
+shared_struct! {
+    /// The constants of one population in an evaluation (the shader's `Kind`,
+    /// [`mechanics::terms::CellConstants`]): one entry, the tissue's, without populations.
+    pub struct Kind {
+        /// `8γ/λ` with the population's γ.
+        double_well: f32,
+        /// `2γλ`.
+        gradient: f32,
+        /// `4μ/πR²` with its μ and R.
+        area: f32,
+        /// `1/πR²`.
+        inv_target_area: f32,
+        /// Its friction ξ.
+        xi: f32,
+        /// The weight of its `S_i` in the active stress (its ζ when the populations' ζ differ,
+        /// 1 otherwise).
+        zeta_weight: f32,
+        /// Padding to 16 bytes.
+        pad0: u32,
+        /// Padding to 16 bytes.
+        pad1: u32,
+    }
+}
+
+/// The most populations the device holds constants for (a uniform array of [`Kind`]).
+pub const MAX_KINDS: usize = 16;
+
+/// The uniform table of every population's constants.
+type Kinds = [Kind; MAX_KINDS];
 
 shared_struct! {
     /// The cells of one chunk (the shader's `Chunk`): cells `lo .. lo + count`, whose φ sit at
@@ -288,6 +321,8 @@ pub struct GpuBackend {
     n_cells: usize,
     npc: usize,
     params: Params,
+    kinds: Kinds,
+    kinds_buf: wgpu::Buffer,
     groups_cells: (u32, u32),
     groups_nodes: (u32, u32),
     groups_bins: u32,
@@ -328,6 +363,12 @@ impl GpuBackend {
         let ext = mechanics::backend::unsupported(tissue, SUPPORTED);
         if !ext.is_empty() {
             return Err(GpuError::Unsupported(ext.join(", ")));
+        }
+        let kinds = tissue.populations().kinds().len();
+        if kinds > MAX_KINDS {
+            return Err(GpuError::Setting(format!(
+                "the GPU backend holds at most {MAX_KINDS} populations, and this scene has {kinds}: merge some [[population]] tables or run with backend = \"cpu\""
+            )));
         }
         if tissue.cells().shape().margin.is_none() {
             return Err(GpuError::Setting(
@@ -505,6 +546,12 @@ impl GpuBackend {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let kinds_buf = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("kinds"),
+            size: std::mem::size_of::<Kinds>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
 
         let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("step.wgsl"),
@@ -548,6 +595,16 @@ impl GpuBackend {
         for b in 13..=17 {
             entries.push(storage_entry(b, false));
         }
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 18,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        });
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("step"),
             entries: &entries,
@@ -583,7 +640,7 @@ impl GpuBackend {
             count: pipeline("count_step", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 18] = [
+            let bufs: [&wgpu::Buffer; 19] = [
                 &params_buf,
                 x,
                 old,
@@ -602,6 +659,7 @@ impl GpuBackend {
                 &acc[1],
                 &acc[2],
                 &acc[3],
+                &kinds_buf,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -653,6 +711,8 @@ impl GpuBackend {
             origin,
             status,
             params_buf,
+            kinds: [Kind::zeroed(); MAX_KINDS],
+            kinds_buf,
             lattice,
             shape,
             n_cells: n,
@@ -676,20 +736,57 @@ impl GpuBackend {
         self.dev.describe()
     }
 
-    fn params_of<T: Real>(&self, tissue: &Tissue<T>, dt: f64) -> Params {
+    /// The uniforms of a step of `tissue` of size `dt`: the parameters and every population's
+    /// constants, as the host's step takes them ([`mechanics::terms::Populations::constants`]:
+    /// with populations of their own ζ, the force's ζ is 1 and each `S_i` is weighted by its
+    /// cell's).
+    fn uniforms_of<T: Real>(&self, tissue: &Tissue<T>, dt: f64) -> (Params, Kinds) {
         let p = tissue.params();
         let c = p.energy.coefficients();
-        Params {
+        let (zeta, constants) = tissue.populations().constants(p, tissue.active());
+        let mut kinds = [Kind::zeroed(); MAX_KINDS];
+        for (k, c) in kinds.iter_mut().zip(&constants) {
+            *k = Kind {
+                double_well: c.coef.double_well as f32,
+                gradient: c.coef.gradient as f32,
+                area: c.coef.area as f32,
+                inv_target_area: c.coef.inv_target_area as f32,
+                xi: c.xi as f32,
+                zeta_weight: c.zeta_weight as f32,
+                pad0: 0,
+                pad1: 0,
+            };
+        }
+        let params = Params {
             double_well: c.double_well as f32,
             gradient: c.gradient as f32,
             area: c.area as f32,
             inv_target_area: c.inv_target_area as f32,
             repulsion: c.repulsion as f32,
-            zeta: p.zeta as f32,
+            zeta: zeta as f32,
             xi: p.xi as f32,
             dt: dt as f32,
             ..self.params
+        };
+        (params, kinds)
+    }
+
+    /// Takes the uniforms of a step of `tissue` of size `dt`, writing what changed; whether
+    /// anything did.
+    fn set_uniforms<T: Real>(&mut self, tissue: &Tissue<T>, dt: f64) -> bool {
+        let (params, kinds) = self.uniforms_of(tissue, dt);
+        let changed = params != self.params || kinds != self.kinds;
+        if changed {
+            // A change (the activity switch) applies from this step on: the steps recorded
+            // before it go first.
+            self.flush();
+            self.params = params;
+            self.kinds = kinds;
+            let q = &self.dev.queue;
+            q.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
+            q.write_buffer(&self.kinds_buf, 0, bytemuck::cast_slice(&self.kinds));
         }
+        changed
     }
 
     fn upload_state<T: Real>(&mut self, tissue: &Tissue<T>) -> Result<(), GpuError> {
@@ -726,8 +823,23 @@ impl GpuBackend {
         }
         q.write_buffer(&self.origin, 0, bytemuck::cast_slice(&origins));
         q.write_buffer(&self.status, 0, bytemuck::cast_slice(&[0u32; 4]));
-        self.params = self.params_of(tissue, f64::from(self.params.dt));
-        q.write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
+        // The cell buffer: the centres and each slot's population index (slot 11, a u32's
+        // bits); the rest is computed by every evaluation before it is read.
+        let mut per_cell = vec![0.0f32; self.n_cells * CELL_STRIDE];
+        let (ids, pops) = (tissue.cell_ids(), tissue.populations());
+        for ((row, centre), &id) in per_cell
+            .chunks_exact_mut(CELL_STRIDE)
+            .zip(tissue.centres())
+            .zip(ids)
+        {
+            row[9] = centre[0] as f32;
+            row[10] = centre[1] as f32;
+            row[11] = f32::from_bits(pops.population(id) as u32);
+        }
+        q.write_buffer(&self.cell, 0, bytemuck::cast_slice(&per_cell));
+        let dt = f64::from(self.params.dt);
+        self.params.dt = f32::NAN; // written whatever it was
+        self.set_uniforms(tissue, dt);
         self.base = (tissue.iteration(), tissue.time());
         self.queued.clear();
         Ok(())
@@ -757,13 +869,7 @@ impl GpuBackend {
         dt: f64,
     ) -> Result<Evaluation, GpuError> {
         self.flush();
-        let want = self.params_of(tissue, dt);
-        if want != self.params {
-            self.params = want;
-            self.dev
-                .queue
-                .write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
-        }
+        self.set_uniforms(tissue, dt);
         self.record_passes(true);
         self.flush();
         let plen = self.shape.len();
@@ -979,16 +1085,7 @@ impl<T: Real> Backend<T> for GpuBackend {
                 self.npc, params.npc
             )));
         }
-        let want = self.params_of(tissue, params.dt);
-        if want != self.params {
-            // A change (the activity switch) applies from this step on: the steps recorded
-            // before it go first.
-            self.flush();
-            self.params = want;
-            self.dev
-                .queue
-                .write_buffer(&self.params_buf, 0, bytemuck::bytes_of(&self.params));
-        }
+        self.set_uniforms(tissue, params.dt);
         self.record();
         self.queued.push(params.dt);
         if self.recorded >= BATCH {

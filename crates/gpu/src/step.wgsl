@@ -34,7 +34,8 @@ struct Status {
 @group(0) @binding(3) var<storage, read_write> k1: array<f32>;
 // The predictor's or a middle corrector's output.
 @group(0) @binding(4) var<storage, read_write> out_phi: array<f32>;
-// Per cell, 12 floats: area, S_xx, S_xy, φ_min, φ_max, F_x, F_y, v_x, v_y, centre x, y, 0.
+// Per cell, 12 floats: area, S_xx, S_xy, φ_min, φ_max, F_x, F_y, v_x, v_y, centre x, y, and
+// the population index (a u32's bits, written by the host).
 @group(0) @binding(5) var<storage, read_write> cell: array<f32>;
 // Per cell: the lattice origin of its patch (x, y).
 @group(0) @binding(6) var<storage, read_write> origin: array<vec2<u32>>;
@@ -106,16 +107,26 @@ override CHECK: u32 = 0u;
 
 const CELL_STRIDE: u32 = 12u;
 
+// The constants of each population (`Kind`, generated from its Rust definition; one entry, the
+// tissue's, without populations), and those of the cell at hand, which the equations read:
+// set by `use_cell` from the population index the host writes into the cell's slot 11.
+@group(0) @binding(18) var<uniform> kinds: array<Kind, MAX_KINDS>;
+var<private> kc: Kind;
+
+fn use_cell(c: u32) {
+    kc = kinds[bitcast<u32>(cell[c + 11u])];
+}
+
 // ---- the equations ----
 
 // phasefield::EnergyCoefficients::area_factor
 fn area_factor(area: f32) -> f32 {
-    return -prm.area * (1.0 - area * prm.inv_target_area);
+    return -kc.area * (1.0 - area * kc.inv_target_area);
 }
 
 // phasefield::EnergyCoefficients::free_energy_derivative
 fn free_energy_derivative(phi: f32, lap: f32, af: f32, others_sq: f32) -> f32 {
-    let ch = prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi) - prm.gradient * lap;
+    let ch = kc.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi) - kc.gradient * lap;
     return ch + af * phi + prm.repulsion * phi * others_sq;
 }
 
@@ -128,8 +139,8 @@ fn shape_tensor_density(grad: vec2<f32>) -> vec2<f32> {
 fn pressure_cell_part(phi: f32, lap: f32, af: f32) -> f32 {
     if (PAPER == 1u) {
         return -prm.repulsion * (phi * phi) * phi
-            - prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
-            + prm.gradient * lap - af * phi;
+            - kc.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
+            + kc.gradient * lap - af * phi;
     }
     return -prm.repulsion * (phi * phi) * (phi * phi);
 }
@@ -156,8 +167,8 @@ fn pressure_regrouped(s1: f32, s2: f32, s3: f32, s4: f32, own: f32) -> f32 {
 // `pressure_cell_part` less its repulsion term −(2κ/λ)φ³ (paper) or −(2κ/λ)φ⁴ (interaction).
 fn pressure_own_part(phi: f32, lap: f32, af: f32) -> f32 {
     if (PAPER == 1u) {
-        return -prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
-            + prm.gradient * lap - af * phi;
+        return -kc.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi)
+            + kc.gradient * lap - af * phi;
     }
     return 0.0;
 }
@@ -165,7 +176,7 @@ fn pressure_own_part(phi: f32, lap: f32, af: f32) -> f32 {
 // mechanics::equations::pressure_self_part
 fn pressure_self_part(phi: f32) -> f32 {
     if (PAPER == 1u) {
-        return -(prm.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi));
+        return -(kc.double_well * phi * (1.0 - phi) * (1.0 - 2.0 * phi));
     }
     return 0.0;
 }
@@ -437,6 +448,7 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
                 if (a < NX && bb < NY) {
                     let st = stencil((i - chunk.lo) * PLEN, a, bb);
                     let c = i * CELL_STRIDE;
+                    use_cell(c);
                     let af = area_factor(cell[c]);
                     let sh = vec2<f32>(cell[c + 1u], cell[c + 2u]);
                     let p = st.c;
@@ -446,7 +458,7 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
                     s3 += p2 * p;
                     s4 += p2 * p2;
                     own += pressure_own_part(p, laplacian(st), af);
-                    q += p * sh;
+                    q += p * sh * kc.zeta_weight;
                 }
             }
         }
@@ -471,6 +483,7 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
     let base = li * PLEN;
     let o = origin[i];
     let c = i * CELL_STRIDE;
+    use_cell(c);
     var fields: array<vec4<f32>, NPT>;
     var acc = vec4<f32>(0.0);
     for (var j = 0u; j < NPT; j++) {
@@ -489,7 +502,7 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         }
     }
     let force = reduce(lid, acc).xy;
-    let v = velocity(force, prm.xi);
+    let v = velocity(force, kc.xi);
     let af = area_factor(cell[c]);
     var vals: array<f32, NPT>;
     var four = vec4<f32>(0.0);

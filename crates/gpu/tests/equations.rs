@@ -49,6 +49,8 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= arrayLength(&eq_out) / 17u) {
         return;
     }
+    // The cell's constants, which the equations read (`use_cell` in the step): the tissue's.
+    kc = Kind(prm.double_well, prm.gradient, prm.area, prm.inv_target_area, prm.xi, 1.0, 0u, 0u);
     let x = i * 16u;
     let phi = eq_in[x];
     let lap = eq_in[x + 1u];

@@ -35,8 +35,7 @@ use nalgebra::Vector2;
 
 pub use noise::NoiseKey;
 pub use polarity::{Align, Polarity, Propulsion};
-pub(crate) use populations::CellConstants;
-pub use populations::{Population, Populations};
+pub use populations::{CellConstants, Population, Populations};
 
 use crate::workspace::CellState;
 

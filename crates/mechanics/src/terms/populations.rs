@@ -84,14 +84,18 @@ pub struct Populations {
     of_cell: Vec<u16>,
 }
 
-/// A cell's constants in one evaluation.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct CellConstants {
-    pub(crate) coef: EnergyCoefficients,
-    pub(crate) xi: f64,
+/// A cell's constants in one evaluation (one set per population), as the step uses them and
+/// a backend must ([`Populations::constants`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct CellConstants {
+    /// The free energy's coefficients, with the population's γ, μ and R.
+    pub coef: EnergyCoefficients,
+    /// The friction ξ.
+    pub xi: f64,
     /// The weight of the cell's `S_i` in the active stress's sum: 1 when every cell has the
     /// tissue's ζ (which then multiplies the sum), ζ_i otherwise.
-    pub(crate) zeta_weight: f64,
+    pub zeta_weight: f64,
 }
 
 impl Populations {
@@ -240,6 +244,18 @@ impl Populations {
                 },
             }
         }));
+    }
+
+    /// What an evaluation with `params` and the activity `active` takes from the populations:
+    /// the ζ that multiplies the active stress's sum (the tissue's, or 1 when the populations'
+    /// ζ differ and each `S_i` is weighted by its own) and the constants of every population,
+    /// indexed by [`Populations::population`] (one entry, the tissue's, without populations).
+    /// The host's step uses the same (`kernels::evaluate`); a backend takes them from here.
+    pub fn constants(&self, params: &ModelParams, active: bool) -> (f64, Vec<CellConstants>) {
+        let mixed = self.mixed_zeta(params, active);
+        let mut out = Vec::new();
+        self.fill_constants(params, active, mixed, &mut out);
+        (if mixed { 1.0 } else { params.zeta }, out)
     }
 
     /// Whether some cell has a non-zero ζ in an evaluation with `params`.
