@@ -11,9 +11,9 @@ use wgpu::util::DeviceExt;
 use crate::device::{Device, GpuError};
 
 /// The extensions of the paper's model the GPU backend runs: populations (per-cell constants,
-/// [`Kind`]); a tissue with any other part of [`mechanics::Part::ALL`] is refused by
+/// [`Kind`]) and walls (a static lattice field); a tissue with any other part of [`mechanics::Part::ALL`] is refused by
 /// [`GpuBackend::check`], naming it.
-pub const SUPPORTED: &[mechanics::Part] = &[mechanics::Part::Populations];
+pub const SUPPORTED: &[mechanics::Part] = &[mechanics::Part::Populations, mechanics::Part::Walls];
 
 /// Invocations per workgroup (the shader's `WG`).
 const WG: u32 = 256;
@@ -131,8 +131,17 @@ shared_struct! {
         grid_x: u32,
         /// The band around `[0, 1]` that a field may not leave ([`mechanics::PHI_BOUND`]).
         bound: f32,
+        /// The walls' `2κ_w/λ` ([`mechanics::equations::wall_coefficients`]; 0 without walls
+        /// in effect).
+        wall_repulsion: f32,
+        /// The walls' `2ω_wλ`.
+        wall_adhesion: f32,
         /// Padding to 16 bytes.
-        pad: u32,
+        pad0: u32,
+        /// Padding to 16 bytes.
+        pad1: u32,
+        /// Padding to 16 bytes.
+        pad2: u32,
     }
 }
 
@@ -323,6 +332,9 @@ pub struct GpuBackend {
     params: Params,
     kinds: Kinds,
     kinds_buf: wgpu::Buffer,
+    /// The wall field, and which field it holds (the address of the tissue's, or `None`).
+    wall: wgpu::Buffer,
+    wall_uploaded: Option<usize>,
     groups_cells: (u32, u32),
     groups_nodes: (u32, u32),
     groups_bins: u32,
@@ -538,8 +550,21 @@ impl GpuBackend {
             n_cells: n as u32,
             grid_x: groups_cells.0,
             bound: mechanics::PHI_BOUND as f32,
-            pad: 0,
+            wall_repulsion: 0.0,
+            wall_adhesion: 0.0,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
+        // The wall field (w, ∇²w per node), written by `set_uniforms` whenever the field in
+        // effect changes (a wound opens when the activity starts); a placeholder without walls.
+        let walls = tissue.walls().is_some();
+        let wall = storage(
+            "wall",
+            if walls { lattice.len() as u64 * 8 } else { 16 },
+            copy,
+        );
+        let w = f64::from(u8::from(walls));
         let params_buf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: std::mem::size_of::<Params>() as u64,
@@ -595,6 +620,7 @@ impl GpuBackend {
         for b in 13..=17 {
             entries.push(storage_entry(b, false));
         }
+        entries.push(storage_entry(19, true));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: 18,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -633,14 +659,14 @@ impl GpuBackend {
             bin_clear: pipeline("bin_clear", &[]),
             bin_fill: pipeline("bin_fill", &[]),
             bin_sort: pipeline("bin_sort", &[]),
-            lattice: pipeline("lattice_sums", &[]),
-            predict: pipeline("force_update", &[("MODE", 0.0)]),
-            correct: pipeline("force_update", &[("MODE", 1.0)]),
-            correct_last: pipeline("force_update", &[("MODE", 2.0)]),
+            lattice: pipeline("lattice_sums", &[("WALLS", w)]),
+            predict: pipeline("force_update", &[("MODE", 0.0), ("WALLS", w)]),
+            correct: pipeline("force_update", &[("MODE", 1.0), ("WALLS", w)]),
+            correct_last: pipeline("force_update", &[("MODE", 2.0), ("WALLS", w)]),
             count: pipeline("count_step", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 19] = [
+            let bufs: [&wgpu::Buffer; 20] = [
                 &params_buf,
                 x,
                 old,
@@ -660,6 +686,7 @@ impl GpuBackend {
                 &acc[2],
                 &acc[3],
                 &kinds_buf,
+                &wall,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -713,6 +740,8 @@ impl GpuBackend {
             params_buf,
             kinds: [Kind::zeroed(); MAX_KINDS],
             kinds_buf,
+            wall,
+            wall_uploaded: None,
             lattice,
             shape,
             n_cells: n,
@@ -757,7 +786,15 @@ impl GpuBackend {
                 pad1: 0,
             };
         }
+        let [wall_repulsion, wall_adhesion] = match (tissue.walls(), tissue.wall_field()) {
+            (Some(w), Some(_)) => {
+                mechanics::equations::wall_coefficients(w.kappa, w.omega, p.energy.lambda)
+            }
+            _ => [0.0; 2],
+        };
         let params = Params {
+            wall_repulsion: wall_repulsion as f32,
+            wall_adhesion: wall_adhesion as f32,
             double_well: c.double_well as f32,
             gradient: c.gradient as f32,
             area: c.area as f32,
@@ -774,6 +811,24 @@ impl GpuBackend {
     /// Takes the uniforms of a step of `tissue` of size `dt`, writing what changed; whether
     /// anything did.
     fn set_uniforms<T: Real>(&mut self, tissue: &Tissue<T>, dt: f64) -> bool {
+        // The wall field in effect, when it is not the one on the device.
+        let field = tissue.wall_field();
+        let key = field.map(|f| f as *const phasefield::WallField as usize);
+        if key != self.wall_uploaded {
+            self.flush();
+            if let Some(f) = field {
+                let values: Vec<[f32; 2]> = f
+                    .w()
+                    .iter()
+                    .zip(f.laplacian())
+                    .map(|(&w, &l)| [w as f32, l as f32])
+                    .collect();
+                self.dev
+                    .queue
+                    .write_buffer(&self.wall, 0, bytemuck::cast_slice(&values));
+            }
+            self.wall_uploaded = key;
+        }
         let (params, kinds) = self.uniforms_of(tissue, dt);
         let changed = params != self.params || kinds != self.kinds;
         if changed {

@@ -104,6 +104,10 @@ var<workgroup> wg_halt: u32;
 override MODE: u32 = 0u;
 // Whether the cell pass checks the state (the first evaluation of a step).
 override CHECK: u32 = 0u;
+// Whether the tissue has walls: the lattice pass adds their pressure and the force pass their
+// derivative, from the static wall field (w, ∇²w per node, `wall`).
+override WALLS: u32 = 0u;
+@group(0) @binding(19) var<storage, read> wall: array<vec2<f32>>;
 
 const CELL_STRIDE: u32 = 12u;
 
@@ -197,6 +201,16 @@ fn velocity(force: vec2<f32>, xi: f32) -> vec2<f32> {
 // mechanics::equations::rhs
 fn rhs(v: vec2<f32>, grad: vec2<f32>, dfdphi: f32) -> f32 {
     return -v.x * grad.x - v.y * grad.y - dfdphi;
+}
+
+// mechanics::equations::wall_derivative, with the coefficients of `prm`
+fn wall_derivative(phi: f32, w: f32, lap_w: f32) -> f32 {
+    return prm.wall_repulsion * phi * (w * w) - prm.wall_adhesion * lap_w;
+}
+
+// mechanics::equations::wall_pressure, with the coefficients of `prm`
+fn wall_pressure(s1: f32, s2: f32, w: f32, lap_w: f32) -> f32 {
+    return prm.wall_repulsion * (w * w) * s2 - prm.wall_adhesion * lap_w * s1;
 }
 
 // mechanics::equations::heun_predictor
@@ -464,7 +478,12 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         }
     }
     if (chunk.last == 1u) {
-        lat_set(node, vec4<f32>(pressure_regrouped(s1, s2, s3, s4, own), s2, q.x, q.y));
+        var p = pressure_regrouped(s1, s2, s3, s4, own);
+        if (WALLS == 1u) {
+            let wl = wall[node];
+            p += wall_pressure(s1, s2, wl.x, wl.y);
+        }
+        lat_set(node, vec4<f32>(p, s2, q.x, q.y));
     } else {
         acc_set(node, vec4<f32>(s1, s2, s3, s4), vec4<f32>(own, q.x, q.y, 0.0));
     }
@@ -513,7 +532,12 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             let b = k % NY;
             let s = stencil(base, a, b);
             let others = fields[j].y - s.c * s.c;
-            let r = rhs(v, gradient(s), free_energy_derivative(s.c, laplacian(s), af, others));
+            var dfdphi = free_energy_derivative(s.c, laplacian(s), af, others);
+            if (WALLS == 1u) {
+                let wl = wall[((o.x + a) % prm.lx) * prm.ly + (o.y + b) % prm.ly];
+                dfdphi += wall_derivative(s.c, wl.x, wl.y);
+            }
+            let r = rhs(v, gradient(s), dfdphi);
             let idx = base + k;
             if (MODE == 0u) {
                 k1[idx] = r;

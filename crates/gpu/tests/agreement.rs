@@ -7,8 +7,9 @@ use gpu::GpuBackend;
 mod common;
 use mechanics::prelude::*;
 use mechanics::terms::{Population, Populations};
+use mechanics::walls::Walls;
 use mechanics::{CellState, SumField};
-use phasefield::{init, Cells, Lattice, PatchShape, Real};
+use phasefield::{init, Cells, Lattice, PatchShape, Real, WallField, WallShape};
 
 /// 60 cells on 100² at margin 12, relaxed 40 TU on the CPU: the paper's scene at a stage
 /// where the cells touch and press on each other.
@@ -62,6 +63,15 @@ fn two_populations(tissue: Tissue<f32>) -> Tissue<f32> {
     tissue.with_populations(Populations::new(kinds, &[30, 30], 7))
 }
 
+/// `tissue` in a channel 92 nodes wide (4 solid rows each side, where some cells sit and are
+/// pushed out), with wall repulsion and adhesion.
+fn walled(tissue: Tissue<f32>) -> Tissue<f32> {
+    let lattice = tissue.lattice();
+    let solid = WallShape::Channel { width: 92.0 }.solid(lattice);
+    let field = WallField::new(lattice, &solid, 1.0, 0.0);
+    tissue.with_walls(Walls::new(field, 1.0, 0.002))
+}
+
 #[test]
 fn one_evaluation_agrees_with_the_cpu() {
     if common::try_device().is_none() {
@@ -71,6 +81,7 @@ fn one_evaluation_agrees_with_the_cpu() {
         ("ζ = 0", paper_tissue(0.0)),
         ("ζ = 0.005", paper_tissue(0.005)),
         ("two populations", two_populations(paper_tissue(0.005))),
+        ("walls", walled(paper_tissue(0.005))),
     ];
     for (zeta, tissue) in cases {
         let sp = StepParams::paper();
@@ -191,6 +202,16 @@ fn a_hundred_steps_of_two_populations_agree_with_the_cpu() {
         return;
     };
     println!("two populations, 100 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
+    assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
+}
+
+/// Walls (`walled`): 100 active steps agree with the CPU to the minimal model's bounds.
+#[test]
+fn a_hundred_steps_in_a_channel_agree_with_the_cpu() {
+    let Some((dphi, dc)) = steps_agree(walled(paper_tissue(0.005)), 100) else {
+        return;
+    };
+    println!("walls, 100 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
     assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
 }
 

@@ -18,7 +18,7 @@ mod common;
 /// v_x, v_y, R_old, R_new, Δt.
 const IN: usize = 16;
 /// Outputs per sample, in the order of `NAMES`.
-const OUT: usize = 17;
+const OUT: usize = 19;
 const NAMES: [&str; OUT] = [
     "area_factor",
     "free_energy_derivative",
@@ -37,6 +37,8 @@ const NAMES: [&str; OUT] = [
     "pressure_regrouped",
     "laplacian",
     "pressure_own_part",
+    "wall_derivative",
+    "wall_pressure",
 ];
 
 const HARNESS: &str = r#"
@@ -46,7 +48,7 @@ const HARNESS: &str = r#"
 @compute @workgroup_size(64)
 fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= arrayLength(&eq_out) / 17u) {
+    if (i >= arrayLength(&eq_out) / 19u) {
         return;
     }
     // The cell's constants, which the equations read (`use_cell` in the step): the tissue's.
@@ -66,7 +68,7 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r_new = eq_in[x + 14u];
     let dt = eq_in[x + 15u];
     let af = area_factor(area);
-    let o = i * 17u;
+    let o = i * 19u;
     eq_out[o] = af;
     eq_out[o + 1u] = free_energy_derivative(phi, lap, af, others);
     let sh = shape_tensor_density(g);
@@ -96,8 +98,14 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     eq_out[o + 15u] = laplacian(st);
     // The lattice pass's own part of the pressure (the gather's).
     eq_out[o + 16u] = pressure_own_part(phi, lap, af);
+    // The walls' parts, with w = the `others` input and ∇²w = the Laplacian's.
+    eq_out[o + 17u] = wall_derivative(phi, others, lap);
+    eq_out[o + 18u] = wall_pressure(s1, s2, others, lap);
 }
 "#;
+
+/// The walls' coefficients in the harness (`wall_coefficients(1, 0.02, 2.5)`).
+const WALL: [f64; 2] = [0.8, 0.1];
 
 /// The kernel's uniform block (the shader's `Params`, one definition for Rust and WGSL),
 /// with the coefficients of `coef`.
@@ -111,6 +119,8 @@ fn params_bytes(coef: &EnergyCoefficients, zeta: f32, xi: f32) -> Vec<u8> {
         zeta,
         xi,
         dt: 0.1,
+        wall_repulsion: WALL[0] as f32,
+        wall_adhesion: WALL[1] as f32,
         ..bytemuck::Zeroable::zeroed()
     };
     bytemuck::bytes_of(&p).to_vec()
@@ -289,6 +299,14 @@ fn reference(
                         PressureKind::Interaction => phi.powi(4),
                     },
             cell_scale,
+        ),
+        (
+            eq::wall_derivative(WALL, phi, others, lap),
+            WALL[0] * (phi * others * others).abs() + WALL[1] * lap.abs(),
+        ),
+        (
+            eq::wall_pressure(WALL, s1, s2, others, lap),
+            WALL[0] * (others * others * s2).abs() + WALL[1] * (lap * s1).abs(),
         ),
     ]
 }
