@@ -2,6 +2,7 @@
 //! the tissue velocity `v = Σ_i φ_i v_i`, the nematic field `Q = Σ_i φ_i S_i`, the pressure
 //! `P` and the stress `σ = −P𝕀 − ζQ`.
 
+use phasefield::kernel::StencilRun;
 use phasefield::Real;
 
 use crate::geometry::TracelessTensor;
@@ -48,13 +49,15 @@ impl<T: Real> Tissue<T> {
             ..
         } = ws;
         let cs: &[_] = cell_state;
-        scatter::<2, T, _, _>(
+        scatter::<2, T, _, _, _>(
             &self.cells,
             self.cells.phi(),
             velocity_field,
-            |i, run, sums| {
+            |i| {
                 let [a, b] = value(&cs[i]);
-                run.add_to([], |s, []| [s.c * a, s.c * b], sums);
+                move |run: &StencilRun<'_, T>, sums| {
+                    run.add_to([], |s, []| [s.c * a, s.c * b], sums)
+                }
             },
             |_| {},
         );

@@ -18,14 +18,14 @@
 use std::cell::RefCell;
 
 use nalgebra::Vector2;
-use phasefield::kernel::{add_lanes, PaddedParts, PaddedPatch, LANES};
-use phasefield::{Cells, ComTable, PatchShape, Real, Stencil};
+use phasefield::kernel::{add_lanes, PaddedParts, PaddedPatch, StencilRun, LANES};
+use phasefield::{Cells, ComTable, EnergyCoefficients, PatchShape, Real, Stencil};
 use rayon::prelude::*;
 
 use crate::equations::{
     adhesion_derivative, adhesion_pressure_cell_part, force_density, heun_corrector,
     heun_predictor, nematic_density, pressure, pressure_cell_part, pressure_self_coefficient,
-    pressure_self_part_with, rhs, shape_tensor_density, velocity,
+    pressure_self_part_with, rhs, velocity,
 };
 use crate::geometry::TracelessTensor;
 use crate::node_terms::NodeTerm;
@@ -83,14 +83,15 @@ pub fn thread_scratch_bytes(shape: &PatchShape) -> usize {
 /// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]
 fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mut CellState) {
-    // Area and range need no stencil: passes over the patch in LANES partial results, one
-    // quantity per pass, which compile to clean SIMD code; the three in one loop were
-    // shuffled between registers (56 instructions per chunk of 8). `if c > m { c } else { m }`
-    // is one SIMD max instruction, where `f64::max`, which must return the other operand of a
-    // NaN, is five. A NaN is skipped either way, and caught by the area, which it makes NaN.
+    // Area and range need no stencil: passes over the patch in LANES partial results, which
+    // compile to clean SIMD code; the three in one loop were shuffled between registers (56
+    // instructions per chunk of 8). `if c > m { c } else { m }` is one SIMD max instruction,
+    // where `f64::max`, which must return the other operand of a NaN, is five. A NaN is
+    // skipped either way, and caught by the area, which it makes NaN.
     let mut area = [0.0; LANES];
-    let (mut hi, mut neg_lo) = ([f64::NEG_INFINITY; LANES], [f64::NEG_INFINITY; LANES]);
+    let (mut hi, mut lo) = ([f64::NEG_INFINITY; LANES], [f64::INFINITY; LANES]);
     let larger = |m: f64, c: f64| if c > m { c } else { m };
+    let smaller = |m: f64, c: f64| if c < m { c } else { m };
     let chunks = cell.chunks_exact(LANES);
     let rest = chunks.remainder();
     for chunk in chunks.clone() {
@@ -99,40 +100,35 @@ fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mu
             area[l] += c * c;
         }
     }
-    for chunk in chunks.clone() {
-        for l in 0..LANES {
-            hi[l] = larger(hi[l], chunk[l].to_f64());
-        }
-    }
+    // The range in one pass (the two extremes together compile to one SIMD max and one min
+    // per vector; a pass for each cost 0.6 instructions per node-update more, issue 38).
     for chunk in chunks {
         for l in 0..LANES {
-            neg_lo[l] = larger(neg_lo[l], -chunk[l].to_f64());
+            let c = chunk[l].to_f64();
+            hi[l] = larger(hi[l], c);
+            lo[l] = smaller(lo[l], c);
         }
     }
     for (l, c) in rest.iter().enumerate() {
         let c = c.to_f64();
         area[l] += c * c;
         hi[l] = larger(hi[l], c);
-        neg_lo[l] = larger(neg_lo[l], -c);
+        lo[l] = smaller(lo[l], c);
     }
     st.area = area.iter().sum();
     st.phi_max = hi.into_iter().fold(f64::NEG_INFINITY, f64::max);
-    st.phi_min = -neg_lo.into_iter().fold(f64::NEG_INFINITY, f64::max);
+    st.phi_min = lo.into_iter().fold(f64::INFINITY, f64::min);
     // The accumulators live inside the closure and come back by value: when they were a local
     // of this function borrowed into it, and `LocalKey::with` was not inlined here (as after
     // the physics terms grew `evaluate`), LLVM kept them in memory and stored all of them at
     // every chunk of 8 nodes: 118 instructions a chunk where this loop takes 32 (issue 38,
     // 11.6 of the 17 instructions per node-update the minimal model had gained).
     let acc = if SHAPE {
-        PADDED.with_borrow_mut(|padded| {
-            padded.fill(cell, shape);
-            let PaddedParts { run, mask, .. } = padded.parts();
-            shape_sum(&run, mask)
-        })
+        PADDED.with_borrow_mut(|padded| shape_sum(padded, cell, shape))
     } else {
-        [[0.0; LANES]; 2]
+        [0.0; 2]
     };
-    st.shape = TracelessTensor::from(add_lanes(&acc).map(|s| 0.25 * s));
+    st.shape = TracelessTensor::from(acc.map(|s| 0.25 * s));
 }
 
 /// The deformation tensor's sum over the padded patch `run` (`mask` weighting its nodes), in
@@ -142,21 +138,27 @@ fn cell_sums<T: Real, const SHAPE: bool>(cell: &[T], shape: &PatchShape, st: &mu
 /// thread-local access of a larger `evaluate`, LLVM split the loop into scalar and 128-bit
 /// pieces (85–118 instructions a chunk of 8 nodes where this takes 32; issue 38).
 #[inline(never)]
-fn shape_sum(run: &phasefield::kernel::StencilRun<'_, f64>, mask: &[f64]) -> [[f64; LANES]; 2] {
-    // The density is quadratic in the gradient: fed the undivided differences
-    // (`Stencil::diff_x`, twice the gradient) it gives 4× its value, which the sum takes back
-    // by ¼, exactly, where the ½ of each difference cost a multiplication per node.
+fn shape_sum<T: Real>(
+    padded: &mut PaddedPatch<N_GATHERED>,
+    cell: &[T],
+    shape: &PatchShape,
+) -> [f64; 2] {
+    padded.fill(cell, shape);
+    let PaddedParts { run, mask, .. } = padded.parts();
+    // `shape_tensor_density` of the undivided differences (`Stencil::diff_x`, twice the
+    // gradient), without its constant factors: `dy² − dx²` and `dx dy`. The density is
+    // quadratic in the gradient, so it is 4× its value; the factors (½ and −1 of the density,
+    // ¼ of the differences) are taken once on the sums, by `from_sums`. Each is a power of two
+    // or a sign, so the result is the same to the bit as the density's sum.
     let value = move |s: Stencil, [w]: [f64; 1]| {
-        let [sxx, sxy] = shape_tensor_density([s.diff_x(), s.diff_y()]);
-        [w * sxx, w * sxy]
+        let (dx, dy) = (s.diff_x(), s.diff_y());
+        [w * (dy * dy - dx * dx), w * (dx * dy)]
     };
-    // The five neighbour slices through an optimisation barrier: seen as one buffer at fixed
-    // offsets, LLVM loaded each vector once and shuffled it into its neighbours (53
-    // instructions a chunk where five plain loads take 32).
-    let run = std::hint::black_box(*run);
     let mut acc = [[0.0; LANES]; 2];
     run.sum_into([mask], value, &mut acc);
-    acc
+    let [xx, xy] = add_lanes(&acc);
+    // `0 − xy`, not `−xy`: a zero sum gives +0, as the density's sum does.
+    [0.5 * xx, 0.0 - xy]
 }
 
 /// What one evaluation reads: the state, the parameters, the terms' whole-cell forces, each
@@ -312,74 +314,107 @@ pub(crate) fn evaluate<T: Real>(
         .sum();
     {
         let cs: &[CellState] = cell_state;
-        scatter::<N_SUMS, T, _, _>(
-            cells,
-            phi,
-            global,
-            |i, run, [s1, s2, u, qxx, qxy, _]| {
-                let sums = [s1, s2, u, qxx, qxy];
-                let c = &cs[i];
-                let k = constants(i);
-                let coef = k.coef;
-                let area_factor = coef.area_factor(c.area);
-                // Not `.map`: an array map here was a call per patch column (1.6 instructions
-                // per node-update).
-                let [sxx, sxy] = c.shape.components();
-                let sh = [k.zeta_weight * sxx, k.zeta_weight * sxy];
-                let node = move |p: f64, u: f64| {
-                    let [q_xx, q_xy] = nematic_density(p, sh);
-                    [p, p * p, u, q_xx, q_xy]
-                };
-                // Adhesion adds its single-cell part `c φ ∇²φ` to `U` (a branch outside the
-                // node loops: without adhesion the loops are what they were).
-                match (kind, c_adh != 0.0) {
-                    (PressureKind::Paper, false) => run.add_to(
-                        [],
-                        move |s, []| {
-                            let p = s.c;
-                            let u = pressure_cell_part(
-                                PressureKind::Paper,
-                                &coef,
-                                p,
-                                s.laplacian(),
-                                area_factor,
-                            );
-                            node(p, u)
-                        },
-                        sums,
-                    ),
-                    (PressureKind::Interaction, false) => run.add_to(
-                        [],
-                        move |s, []| {
-                            let p = s.c;
-                            node(
-                                p,
-                                pressure_cell_part(PressureKind::Interaction, &coef, p, 0.0, 0.0),
-                            )
-                        },
-                        sums,
-                    ),
-                    (kind, true) => run.add_to(
-                        [],
-                        move |s, []| {
-                            let (p, lap) = (s.c, s.laplacian());
-                            let u = pressure_cell_part(kind, &coef, p, lap, area_factor)
-                                + adhesion_pressure_cell_part(c_adh, p, lap);
-                            node(p, u)
-                        },
-                        sums,
-                    ),
-                }
-            },
-            // The pressure, once per lattice node, where the force pass would compute it
-            // again for every cell over the node: the same formula on the same sums, so the
-            // same values to the bit.
-            |[s1, s2, u, _, _, p]| {
-                for (((p, &s1), &s2), &u) in p.iter_mut().zip(&*s1).zip(&*s2).zip(&*u) {
-                    *p = pressure(kind, &coef, s1, s2, u);
-                }
-            },
-        );
+        // What the scatter needs of cell `i`, once per cell and stripe: its energy
+        // coefficients, its area factor and its deformation tensor weighted by its ζ.
+        let per_cell = |i: usize| {
+            let k = constants(i);
+            let [sxx, sxy] = cs[i].shape.components();
+            let sh = [k.zeta_weight * sxx, k.zeta_weight * sxy];
+            (k.coef, k.coef.area_factor(cs[i].area), sh)
+        };
+        let node = move |p: f64, u: f64, sh: [f64; 2]| {
+            let [q_xx, q_xy] = nematic_density(p, sh);
+            [p, p * p, u, q_xx, q_xy]
+        };
+        // The pressure, once per lattice node, where the force pass would compute it again for
+        // every cell over the node: the same formula on the same sums, so the same values to
+        // the bit.
+        let finish = |[s1, s2, u, _, _, p]: [&mut [f64]; N_SUMS]| {
+            for (((p, &s1), &s2), &u) in p.iter_mut().zip(&*s1).zip(&*s2).zip(&*u) {
+                *p = pressure(kind, &coef, s1, s2, u);
+            }
+        };
+        // One scatter for each pressure form, and one with adhesion's single-cell part
+        // `c φ ∇²φ` added to `U`: the choice is made once per evaluation, and each node loop
+        // is compiled alone (without adhesion the loops are what they were).
+        match (kind, c_adh != 0.0) {
+            (PressureKind::Paper, false) => scatter::<N_SUMS, T, _, _, _>(
+                cells,
+                phi,
+                global,
+                |i| {
+                    let (coef, area_factor, sh) = per_cell(i);
+                    move |run: &StencilRun<'_, T>,
+                          [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
+                        run.add_to(
+                            [],
+                            move |s, []| {
+                                let p = s.c;
+                                let u = pressure_cell_part(
+                                    PressureKind::Paper,
+                                    &coef,
+                                    p,
+                                    s.laplacian(),
+                                    area_factor,
+                                );
+                                node(p, u, sh)
+                            },
+                            [s1, s2, u, qxx, qxy],
+                        )
+                    }
+                },
+                finish,
+            ),
+            (PressureKind::Interaction, false) => scatter::<N_SUMS, T, _, _, _>(
+                cells,
+                phi,
+                global,
+                |i| {
+                    let (coef, _, sh) = per_cell(i);
+                    move |run: &StencilRun<'_, T>,
+                          [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
+                        run.add_to(
+                            [],
+                            move |s, []| {
+                                let p = s.c;
+                                let u = pressure_cell_part(
+                                    PressureKind::Interaction,
+                                    &coef,
+                                    p,
+                                    0.0,
+                                    0.0,
+                                );
+                                node(p, u, sh)
+                            },
+                            [s1, s2, u, qxx, qxy],
+                        )
+                    }
+                },
+                finish,
+            ),
+            (kind, true) => scatter::<N_SUMS, T, _, _, _>(
+                cells,
+                phi,
+                global,
+                |i| {
+                    let (coef, area_factor, sh) = per_cell(i);
+                    move |run: &StencilRun<'_, T>,
+                          [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
+                        run.add_to(
+                            [],
+                            move |s, []| {
+                                let (p, lap) = (s.c, s.laplacian());
+                                let u = pressure_cell_part(kind, &coef, p, lap, area_factor)
+                                    + adhesion_pressure_cell_part(c_adh, p, lap);
+                                node(p, u, sh)
+                            },
+                            [s1, s2, u, qxx, qxy],
+                        )
+                    }
+                },
+                finish,
+            ),
+        }
     }
 
     // The node terms' lattice parts of the pressure, then their coefficients, gathered by
@@ -405,84 +440,19 @@ pub(crate) fn evaluate<T: Real>(
     let g: &LatticeSums<N_SUMS> = global;
     let map = cells.map();
     let ly = cells.lattice().ly;
+    let force_input = ForceInput {
+        global: g,
+        shape,
+        ly,
+        zeta,
+        cell_force,
+        node_terms,
+    };
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
         let CellConstants { coef, xi, .. } = constants(i);
         let c_self = pressure_self_coefficient(kind, &coef);
-        PADDED.with_borrow_mut(|padded| {
-            padded.fill(cell, shape);
-            padded.gather(xs, g.cell_runs(i), |x| {
-                let cols = g.columns(x);
-                [cols[I_P], cols[I_S2], cols[I_QXX], cols[I_QXY]]
-            });
-            let PaddedParts {
-                run,
-                mask,
-                fields: [p_all, s2, qxx, qxy],
-                out: flat,
-            } = padded.parts();
-            let mut acc = [[0.0; LANES]; 2];
-            // `move`: the coefficients are copied into the closure, so that they stay in
-            // registers across the chunk loop's optimisation barrier (by reference, each chunk
-            // loaded them again).
-            // The undivided differences (twice the gradient, `Stencil::diff_x`) here and in
-            // the right-hand side, the ½ taken once per cell: the force density is linear in
-            // the gradient, so the sum is twice the force, and `v/2 · 2∇φ` is `v · ∇φ`, both
-            // exactly (scaling by 2 is), with a multiplication fewer per derivative and node.
-            let value = move |s: Stencil, [w, p_all, qxx, qxy]: [f64; 4]| {
-                let p = p_all - pressure_self_part_with(c_self, s.c);
-                let [fx, fy] = force_density(p, zeta, [qxx, qxy], [s.diff_x(), s.diff_y()]);
-                [w * fx, w * fy]
-            };
-            run.sum_into([mask, p_all, qxx, qxy], value, &mut acc);
-            let force = add_lanes(&acc).map(|f| 0.5 * f);
-            // The terms' whole-cell forces (`crate::terms`), added before the velocity.
-            let v = match cell_force {
-                None => velocity(force, xi),
-                Some(f) => {
-                    let [gx, gy] = f[i];
-                    st.cell_force = Vector2::new(gx, gy);
-                    velocity([force[0] + gx, force[1] + gy], xi)
-                }
-            };
-            let half_v = v.map(|c| 0.5 * c);
-            st.force = Vector2::from(force);
-            st.velocity = Vector2::from(v);
-            let area_factor = coef.area_factor(st.area);
-            match node_terms {
-                None => run.write_to(
-                    [s2],
-                    move |s, [s2]| {
-                        let others = s2 - s.c * s.c;
-                        let dfdphi =
-                            coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
-                        [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
-                    },
-                    [flat],
-                ),
-                // Adhesion and walls: their derivative `a φ + b + c ∇²φ` (see `NodeTerms`),
-                // with `a` and `b` gathered beside the patch (a branch outside the node loops).
-                Some(NodeTerms { a, b, c_lap }) => NODE_TERMS.with_borrow_mut(|extra| {
-                    extra.prepare(shape);
-                    extra.gather(xs, g.cell_runs(i), |x| {
-                        [&a[x * ly..(x + 1) * ly], &b[x * ly..(x + 1) * ly]]
-                    });
-                    let [ea, eb] = extra.gathered();
-                    run.write_to(
-                        [s2, ea, eb],
-                        move |s, [s2, ea, eb]| {
-                            let others = s2 - s.c * s.c;
-                            let lap = s.laplacian();
-                            let dfdphi = coef.free_energy_derivative(s.c, lap, area_factor, others)
-                                + node_derivative(ea, eb, c_lap, s.c, lap);
-                            [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
-                        },
-                        [flat],
-                    )
-                }),
-            }
-            padded.store(out);
-        });
+        force_and_rhs(&force_input, i, xs, coef, xi, c_self, cell, st, out);
         // The Heun update of this cell, while its fields are in cache.
         let out: &[T] = out;
         match post {
@@ -557,6 +527,119 @@ pub(crate) fn evaluate<T: Real>(
                 });
         }
     }
+}
+
+/// What the force pass reads besides the cell: the lattice sums, the patch shape, the lattice
+/// height, ζ (1 when the sums are ζ-weighted), the terms' whole-cell forces and the node terms.
+struct ForceInput<'a> {
+    global: &'a LatticeSums<N_SUMS>,
+    shape: &'a PatchShape,
+    ly: usize,
+    zeta: f64,
+    cell_force: Option<&'a [[f64; 2]]>,
+    node_terms: Option<NodeTerms<'a>>,
+}
+
+/// Pass 3 for cell `i`, on its patch in the thread's padded scratch: the force `F_i`, the
+/// velocity `v_i` (into `st`), then the right-hand side `R_i` into `out`. A function of its
+/// own, never inlined, so that its two chunk loops are compiled with this cell's values alone
+/// in the registers, whatever `evaluate` around it grows into (issue 38: inlined there, the
+/// loops took 4–20 % more instructions depending on the rest of `evaluate`).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn force_and_rhs<T: Real>(
+    input: &ForceInput<'_>,
+    i: usize,
+    xs: &[u32],
+    coef: EnergyCoefficients,
+    xi: f64,
+    c_self: f64,
+    cell: &[T],
+    st: &mut CellState,
+    out: &mut [T],
+) {
+    let ForceInput {
+        global: g,
+        shape,
+        ly,
+        zeta,
+        cell_force,
+        node_terms,
+    } = *input;
+    PADDED.with_borrow_mut(|padded| {
+        padded.fill(cell, shape);
+        padded.gather(xs, g.cell_runs(i), |x| {
+            let cols = g.columns(x);
+            [cols[I_P], cols[I_S2], cols[I_QXX], cols[I_QXY]]
+        });
+        let PaddedParts {
+            run,
+            mask,
+            fields: [p_all, s2, qxx, qxy],
+            out: flat,
+        } = padded.parts();
+        let mut acc = [[0.0; LANES]; 2];
+        // `move`: the coefficients are copied into the closure, so that they stay in
+        // registers across the chunk loop's optimisation barrier (by reference, each chunk
+        // loaded them again).
+        // The undivided differences (twice the gradient, `Stencil::diff_x`) here and in
+        // the right-hand side, the ½ taken once per cell: the force density is linear in
+        // the gradient, so the sum is twice the force, and `v/2 · 2∇φ` is `v · ∇φ`, both
+        // exactly (scaling by 2 is), with a multiplication fewer per derivative and node.
+        let value = move |s: Stencil, [w, p_all, qxx, qxy]: [f64; 4]| {
+            let p = p_all - pressure_self_part_with(c_self, s.c);
+            let [fx, fy] = force_density(p, zeta, [qxx, qxy], [s.diff_x(), s.diff_y()]);
+            [w * fx, w * fy]
+        };
+        run.sum_into([mask, p_all, qxx, qxy], value, &mut acc);
+        let force = add_lanes(&acc).map(|f| 0.5 * f);
+        // The terms' whole-cell forces (`crate::terms`), added before the velocity.
+        let v = match cell_force {
+            None => velocity(force, xi),
+            Some(f) => {
+                let [gx, gy] = f[i];
+                st.cell_force = Vector2::new(gx, gy);
+                velocity([force[0] + gx, force[1] + gy], xi)
+            }
+        };
+        let half_v = v.map(|c| 0.5 * c);
+        st.force = Vector2::from(force);
+        st.velocity = Vector2::from(v);
+        let area_factor = coef.area_factor(st.area);
+        match node_terms {
+            None => run.write_to(
+                [s2],
+                move |s, [s2]| {
+                    let others = s2 - s.c * s.c;
+                    let dfdphi =
+                        coef.free_energy_derivative(s.c, s.laplacian(), area_factor, others);
+                    [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
+                },
+                [flat],
+            ),
+            // Adhesion and walls: their derivative `a φ + b + c ∇²φ` (see `NodeTerms`),
+            // with `a` and `b` gathered beside the patch (a branch outside the node loops).
+            Some(NodeTerms { a, b, c_lap }) => NODE_TERMS.with_borrow_mut(|extra| {
+                extra.prepare(shape);
+                extra.gather(xs, g.cell_runs(i), |x| {
+                    [&a[x * ly..(x + 1) * ly], &b[x * ly..(x + 1) * ly]]
+                });
+                let [ea, eb] = extra.gathered();
+                run.write_to(
+                    [s2, ea, eb],
+                    move |s, [s2, ea, eb]| {
+                        let others = s2 - s.c * s.c;
+                        let lap = s.laplacian();
+                        let dfdphi = coef.free_energy_derivative(s.c, lap, area_factor, others)
+                            + node_derivative(ea, eb, c_lap, s.c, lap);
+                        [rhs(half_v, [s.diff_x(), s.diff_y()], dfdphi)]
+                    },
+                    [flat],
+                )
+            }),
+        }
+        padded.store(out);
+    });
 }
 
 /// The node terms' coefficients of an evaluation, summed over its terms

@@ -218,31 +218,37 @@ impl<const K: usize> LatticeSums<K> {
 /// Adds the contributions of every cell's patch to the `K` fields of `out`, which is
 /// overwritten: nodes no patch covers are zero.
 ///
-/// `add(cell_idx, run, dst)` is called for each [`StencilRun`] of each patch column, with
-/// `dst[c]` the slice of field `c` on the lattice rows of the run (`dst[c][j]` is the node
-/// of `run.c[j]`); it adds its values there. The stencil lets a value use derivatives of `φ_i`
-/// without a buffer of its own.
+/// `add(cell_idx)` is called once for each cell and stripe its patch overlaps, and gives the
+/// cell's adder, which is called for each [`StencilRun`] of each of its patch columns in the
+/// stripe, with `dst[c]` the slice of field `c` on the lattice rows of the run (`dst[c][j]` is
+/// the node of `run.c[j]`); it adds its values there. The stencil lets a value use derivatives
+/// of `φ_i` without a buffer of its own. (Two levels, so that what depends on the cell alone
+/// is computed once per cell and stripe, not once per run, and the adder is small enough to
+/// be inlined into the column loop: with one closure taking the cell's index, the minimal
+/// model's step called it out of line for each column, 5 instructions per node-update of
+/// overhead; issue 38.)
 ///
 /// `finish(fields)` is then called once for each stripe that a patch overlaps, with
 /// `fields[c]` the stripe's part of field `c` (its lattice columns, one after the other), once
 /// every cell has added to it: it may compute fields that are functions of the sums node by
 /// node, while the stripe is in cache (the pressure, in [`crate::SumField::P`]). Stripes that no
 /// patch overlaps hold zeros in every field, so such a function must map zeros to zero.
-pub fn scatter<const K: usize, T: Real, F, G>(
+pub fn scatter<const K: usize, T: Real, F, A, G>(
     cells: &Cells<T>,
     phi: &[T],
     out: &mut LatticeSums<K>,
     add: F,
     finish: G,
 ) where
-    F: Fn(usize, &StencilRun<'_, T>, [&mut [f64]; K]) + Sync,
+    F: Fn(usize) -> A + Sync,
+    A: Fn(&StencilRun<'_, T>, [&mut [f64]; K]),
     G: Fn([&mut [f64]; K]) + Sync,
 {
     let lattice: Lattice = cells.lattice();
     assert_eq!(out.lattice, lattice, "the sums belong to another lattice");
     let shape = cells.shape();
     let map = cells.map();
-    let (nx, lx, ly) = (shape.nx, lattice.lx, lattice.ly);
+    let (nx, ly) = (shape.nx, lattice.ly);
     let plen = shape.len();
     out.index_stripes(&map.origin, nx);
     out.runs.clear();
@@ -267,38 +273,71 @@ pub fn scatter<const K: usize, T: Real, F, G>(
             let mut scratch = ColumnScratch::default();
             for &i in overlapping {
                 let i = i as usize;
-                let plan = ColumnPlan::new(shape, &all_runs[i]);
                 let cell = &phi[i * plen..(i + 1) * plen];
-                let ([ox, _], [fx, _]) = (map.origin[i], map.offset[i]);
-                // The stripe's lattice columns that the patch covers, and their storage columns
-                // (the inverse of `PatchMap::cell_x`: a patch is never wider than the lattice,
-                // so a lattice column holds at most one of its columns). Each lattice node gets
-                // one value per cell whatever the order of the columns, so the sums are those
-                // of a visit in storage order.
-                for x in x0..x0 + rows {
-                    // u = (x − ox) mod lx, the logical column; a = (u + fx) mod nx.
-                    let u = if x >= ox { x - ox } else { x + lx - ox };
-                    if u >= nx {
-                        continue;
-                    }
-                    let a = if u + fx >= nx { u + fx - nx } else { u + fx };
-                    debug_assert_eq!(map.cell_x(shape, i)[a] as usize, x);
-                    let base = (x - x0) * ly;
-                    for_each_run_in_column_with(cell, shape, &plan, &mut scratch, a, &mut |s| {
-                        let start = base + s.run.y0;
-                        let mut parts = fields.iter_mut();
-                        let dst = std::array::from_fn(|_| {
-                            let f = parts.next().expect("K fields");
-                            &mut f[start..start + s.run.len]
-                        });
-                        add(i, &s, dst);
-                    });
-                }
+                scatter_cell(
+                    cells,
+                    cell,
+                    i,
+                    &all_runs[i],
+                    x0,
+                    &mut fields,
+                    &mut scratch,
+                    &add(i),
+                );
             }
             if !overlapping.is_empty() {
                 finish(fields);
             }
         });
+}
+
+/// One cell's columns in one stripe of [`scatter`]: `fields` are the stripe's parts of the
+/// fields, from lattice column `x0` on. A function of its own, never inlined, so that the
+/// adder's chunk loop is compiled with this cell's values alone in the registers (inlined
+/// into the stripe loop, its coefficients were reloaded from the stack at every chunk: 95
+/// instructions a chunk of 8 nodes where this takes 86; issue 38).
+#[inline(never)]
+#[allow(clippy::too_many_arguments)]
+fn scatter_cell<const K: usize, T: Real, A>(
+    cells: &Cells<T>,
+    cell: &[T],
+    i: usize,
+    runs: &RowRuns,
+    x0: usize,
+    fields: &mut [&mut [f64]; K],
+    scratch: &mut ColumnScratch<T>,
+    add: &A,
+) where
+    A: Fn(&StencilRun<'_, T>, [&mut [f64]; K]),
+{
+    let (shape, map) = (cells.shape(), cells.map());
+    let (nx, lx, ly) = (shape.nx, cells.lattice().lx, cells.lattice().ly);
+    let rows = fields[0].len() / ly;
+    let plan = ColumnPlan::new(shape, runs);
+    let ([ox, _], [fx, _]) = (map.origin[i], map.offset[i]);
+    // The stripe's lattice columns that the patch covers, and their storage columns (the
+    // inverse of `PatchMap::cell_x`: a patch is never wider than the lattice, so a lattice
+    // column holds at most one of its columns). Each lattice node gets one value per cell
+    // whatever the order of the columns, so the sums are those of a visit in storage order.
+    for x in x0..x0 + rows {
+        // u = (x − ox) mod lx, the logical column; a = (u + fx) mod nx.
+        let u = if x >= ox { x - ox } else { x + lx - ox };
+        if u >= nx {
+            continue;
+        }
+        let a = if u + fx >= nx { u + fx - nx } else { u + fx };
+        debug_assert_eq!(map.cell_x(shape, i)[a] as usize, x);
+        let base = (x - x0) * ly;
+        for_each_run_in_column_with(cell, shape, &plan, scratch, a, &mut |s| {
+            let start = base + s.run.y0;
+            let mut parts = fields.iter_mut();
+            let dst = std::array::from_fn(|_| {
+                let f = parts.next().expect("K fields");
+                &mut f[start..start + s.run.len]
+            });
+            add(&s, dst);
+        });
+    }
 }
 
 #[cfg(test)]
