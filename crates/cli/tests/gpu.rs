@@ -176,7 +176,7 @@ fn the_gpu_refuses_what_it_does_not_run_by_name() {
     let dir = tempfile::tempdir().unwrap();
     for (scene, set, says) in [
         ("walker.toml", "run.time=1", "[polarity]"),
-        ("doublet.toml", "run.time=1", "[adhesion]"),
+        ("proliferation.toml", "run.time=1", "[division]"),
         ("paper.toml", "integrator.adaptive=true", "adaptive"),
         ("paper.toml", "integrator.npc=0", "npc"),
         ("paper.toml", "integrator.margin=0", "margin"),
@@ -202,13 +202,14 @@ fn the_gpu_refuses_what_it_does_not_run_by_name() {
 }
 
 /// Scenes with the extensions the GPU runs, populations (`sorting.toml`: two populations of
-/// opposite ζ) and walls (`channel.toml`; `wound.toml`, whose wall goes when the activity
-/// starts; here without its `[polarity]`, which the GPU does not run yet), run on the GPU and
+/// opposite ζ), walls (`channel.toml`; `wound.toml`, whose wall goes when the activity
+/// starts; here without its `[polarity]`, which the GPU does not run yet) and adhesion
+/// (`doublet.toml`, two cells that adhere), run on the GPU and
 /// follow the CPU's run: every row of `series.csv` agrees in
 /// v_rms, S_rms and the mean area to 1e-3 of its value (f32 round-off amplified over the
 /// steps, as across a resume).
 #[test]
-fn scenes_with_populations_and_walls_run_on_the_gpu_as_on_the_cpu() {
+fn scenes_with_populations_walls_and_adhesion_run_on_the_gpu_as_on_the_cpu() {
     let dir = tempfile::tempdir().unwrap();
     // The wound without its [polarity] table.
     let wound = std::fs::read_to_string(scene_path("wound.toml")).unwrap();
@@ -220,6 +221,7 @@ fn scenes_with_populations_and_walls_run_on_the_gpu_as_on_the_cpu() {
         "sorting.toml",
         "channel.toml",
         "wound-without-polarity.toml",
+        "doublet.toml",
     ] {
         let path = if scene.starts_with("wound") {
             still.clone()

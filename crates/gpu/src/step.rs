@@ -10,10 +10,15 @@ use wgpu::util::DeviceExt;
 
 use crate::device::{Device, GpuError};
 
-/// The extensions of the paper's model the GPU backend runs: populations (per-cell constants,
-/// [`Kind`]) and walls (a static lattice field); a tissue with any other part of [`mechanics::Part::ALL`] is refused by
+/// The extensions of the paper's model the GPU backend runs: adhesion (a lattice pass for the
+/// Laplacian of `s1`), populations (per-cell constants, [`Kind`]) and walls (a static lattice
+/// field); a tissue with any other part of [`mechanics::Part::ALL`] is refused by
 /// [`GpuBackend::check`], naming it.
-pub const SUPPORTED: &[mechanics::Part] = &[mechanics::Part::Populations, mechanics::Part::Walls];
+pub const SUPPORTED: &[mechanics::Part] = &[
+    mechanics::Part::Adhesion,
+    mechanics::Part::Populations,
+    mechanics::Part::Walls,
+];
 
 /// Invocations per workgroup (the shader's `WG`).
 const WG: u32 = 256;
@@ -136,8 +141,9 @@ shared_struct! {
         wall_repulsion: f32,
         /// The walls' `2ω_wλ`.
         wall_adhesion: f32,
-        /// Padding to 16 bytes.
-        pad0: u32,
+        /// The cells' adhesion coefficient `c = 2ωλ`
+        /// ([`mechanics::equations::adhesion_coefficient`]; 0 without adhesion).
+        adhesion: f32,
         /// Padding to 16 bytes.
         pad1: u32,
         /// Padding to 16 bytes.
@@ -204,15 +210,29 @@ pub struct GpuMemory {
 
 impl GpuMemory {
     /// The device memory of `n_cells` cells on patches of `shape` on `lattice`, stepped with
-    /// `npc` corrector passes.
-    pub fn estimate(lattice: Lattice, shape: &PatchShape, n_cells: usize, npc: usize) -> Self {
+    /// `npc` corrector passes, with the extensions `parts` (walls and adhesion hold 8 bytes a
+    /// lattice node each).
+    pub fn estimate(
+        lattice: Lattice,
+        shape: &PatchShape,
+        n_cells: usize,
+        npc: usize,
+        parts: &[mechanics::Part],
+    ) -> Self {
         let n = n_cells as u64;
+        let per_node_parts: u64 = parts
+            .iter()
+            .map(|p| match p {
+                mechanics::Part::Walls | mechanics::Part::Adhesion => 8,
+                _ => 0,
+            })
+            .sum();
         let phi_array = n * shape.len() as u64 * 4;
         let phi_arrays = if npc >= 2 { 4 } else { 3 };
         let (nb, cap) = bins(lattice, shape, n_cells);
         let total = phi_arrays * phi_array
             + n * (CELL_STRIDE as u64 * 4 + 8)
-            + lattice.len() as u64 * (16 + 32)
+            + lattice.len() as u64 * (16 + 32 + per_node_parts)
             + u64::from(nb) * (4 + 4 * u64::from(cap))
             + (lattice.lx + lattice.ly) as u64 * 8;
         Self {
@@ -287,6 +307,8 @@ struct Pipelines {
     bin_fill: wgpu::ComputePipeline,
     bin_sort: wgpu::ComputePipeline,
     lattice: wgpu::ComputePipeline,
+    /// The Laplacian of s1 and the adhesion's cross pressure, with adhesion.
+    adhesion: Option<wgpu::ComputePipeline>,
     predict: wgpu::ComputePipeline,
     correct: wgpu::ComputePipeline,
     correct_last: wgpu::ComputePipeline,
@@ -335,6 +357,11 @@ pub struct GpuBackend {
     /// The wall field, and which field it holds (the address of the tissue's, or `None`).
     wall: wgpu::Buffer,
     wall_uploaded: Option<usize>,
+    /// Whether the kernels were compiled with walls and with adhesion.
+    walls: bool,
+    adhesion: bool,
+    /// s1 and its Laplacian per lattice node, with adhesion (bound, never read by the host).
+    _adhesion_buffers: [wgpu::Buffer; 2],
     groups_cells: (u32, u32),
     groups_nodes: (u32, u32),
     groups_bins: u32,
@@ -425,7 +452,7 @@ impl GpuBackend {
         Self::check(tissue, step)?;
         let cells = tissue.cells();
         let (lattice, shape, n) = (cells.lattice(), cells.shape().clone(), cells.n_cells());
-        let mem = GpuMemory::estimate(lattice, &shape, n, step.npc);
+        let mem = GpuMemory::estimate(lattice, &shape, n, step.npc, &tissue.parts());
         let patch_bytes = shape.len() as u64 * 4;
         let fit = (dev.max_binding() / patch_bytes) as usize;
         if fit == 0 || n > u32::MAX as usize / 2 {
@@ -552,7 +579,7 @@ impl GpuBackend {
             bound: mechanics::PHI_BOUND as f32,
             wall_repulsion: 0.0,
             wall_adhesion: 0.0,
-            pad0: 0,
+            adhesion: 0.0,
             pad1: 0,
             pad2: 0,
         };
@@ -565,6 +592,27 @@ impl GpuBackend {
             copy,
         );
         let w = f64::from(u8::from(walls));
+        // With adhesion, s1 and its Laplacian per lattice node.
+        let adhesion = tissue.params().omega != 0.0;
+        let adh_s1 = storage(
+            "adhesion s1",
+            if adhesion {
+                lattice.len() as u64 * 4
+            } else {
+                16
+            },
+            copy,
+        );
+        let adh_lap = storage(
+            "adhesion laplacian",
+            if adhesion {
+                lattice.len() as u64 * 4
+            } else {
+                16
+            },
+            copy,
+        );
+        let a = f64::from(u8::from(adhesion));
         let params_buf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: std::mem::size_of::<Params>() as u64,
@@ -621,6 +669,8 @@ impl GpuBackend {
             entries.push(storage_entry(b, false));
         }
         entries.push(storage_entry(19, true));
+        entries.push(storage_entry(20, false));
+        entries.push(storage_entry(21, false));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: 18,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -659,14 +709,24 @@ impl GpuBackend {
             bin_clear: pipeline("bin_clear", &[]),
             bin_fill: pipeline("bin_fill", &[]),
             bin_sort: pipeline("bin_sort", &[]),
-            lattice: pipeline("lattice_sums", &[("WALLS", w)]),
-            predict: pipeline("force_update", &[("MODE", 0.0), ("WALLS", w)]),
-            correct: pipeline("force_update", &[("MODE", 1.0), ("WALLS", w)]),
-            correct_last: pipeline("force_update", &[("MODE", 2.0), ("WALLS", w)]),
+            lattice: pipeline("lattice_sums", &[("WALLS", w), ("ADHESION", a)]),
+            adhesion: adhesion.then(|| pipeline("adhesion_lattice", &[])),
+            predict: pipeline(
+                "force_update",
+                &[("MODE", 0.0), ("WALLS", w), ("ADHESION", a)],
+            ),
+            correct: pipeline(
+                "force_update",
+                &[("MODE", 1.0), ("WALLS", w), ("ADHESION", a)],
+            ),
+            correct_last: pipeline(
+                "force_update",
+                &[("MODE", 2.0), ("WALLS", w), ("ADHESION", a)],
+            ),
             count: pipeline("count_step", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 20] = [
+            let bufs: [&wgpu::Buffer; 22] = [
                 &params_buf,
                 x,
                 old,
@@ -687,6 +747,8 @@ impl GpuBackend {
                 &acc[3],
                 &kinds_buf,
                 &wall,
+                &adh_s1,
+                &adh_lap,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -742,6 +804,9 @@ impl GpuBackend {
             kinds_buf,
             wall,
             wall_uploaded: None,
+            walls,
+            adhesion,
+            _adhesion_buffers: [adh_s1, adh_lap],
             lattice,
             shape,
             n_cells: n,
@@ -792,7 +857,9 @@ impl GpuBackend {
             }
             _ => [0.0; 2],
         };
+        let adhesion = mechanics::equations::adhesion_coefficient(p.omega, p.energy.lambda);
         let params = Params {
+            adhesion: adhesion as f32,
             wall_repulsion: wall_repulsion as f32,
             wall_adhesion: wall_adhesion as f32,
             double_well: c.double_well as f32,
@@ -991,6 +1058,11 @@ impl GpuBackend {
                 pass.set_bind_group(0, g, &[]);
                 pass.dispatch_workgroups(nx, ny, 1);
             }
+            // With adhesion, the Laplacian of s1 once the last chunk has written s1.
+            if let Some(adhesion) = &p.adhesion {
+                pass.set_pipeline(adhesion);
+                pass.dispatch_workgroups(nx, ny, 1);
+            }
             pass.set_pipeline(force);
             for g in group {
                 pass.set_bind_group(0, g, &[]);
@@ -1038,6 +1110,11 @@ impl GpuBackend {
     /// a node) that the next reads (32 more): `64 (K − 1)` bytes a lattice node and
     /// evaluation (about 39 B per node-update at 10⁶ cells in 3 chunks). Neighbours of the
     /// stencil and the bins' lists are taken as cached.
+    ///
+    /// The extensions add, per evaluation: walls 8 bytes a patch node (the force pass reads
+    /// (w, ∇²w)) and 8 a lattice node (the lattice pass reads them); adhesion 4 bytes a patch
+    /// node (the force pass reads ∇²s1) and 44 a lattice node (the lattice pass writes s1, the
+    /// adhesion pass reads it, writes ∇²s1 and reads and writes `P, s2, Q`).
     pub fn bytes_per_node_update(&self) -> f64 {
         let predictor = 4.0 + 4.0 + 4.0 + 16.0 + 8.0;
         let corrector = predictor + 8.0;
@@ -1045,8 +1122,14 @@ impl GpuBackend {
         let per_patch_node =
             self.lattice.len() as f64 / (self.n_cells * self.shape.len()).max(1) as f64;
         let chunks = 64.0 * self.chunks.len().saturating_sub(1) as f64;
-        let lattice = (16.0 + chunks) * (1.0 + correctors) * per_patch_node;
-        predictor + correctors * corrector + lattice
+        let (walls, adhesion) = (
+            f64::from(u8::from(self.walls)),
+            f64::from(u8::from(self.adhesion)),
+        );
+        let parts_patch = 8.0 * walls + 4.0 * adhesion;
+        let parts_lattice = 8.0 * walls + 44.0 * adhesion;
+        let lattice = (16.0 + chunks + parts_lattice) * (1.0 + correctors) * per_patch_node;
+        predictor + correctors * corrector + parts_patch * (1.0 + correctors) + lattice
     }
 
     /// The number of chunks the per-cell arrays are split into.
@@ -1138,6 +1221,13 @@ impl<T: Real> Backend<T> for GpuBackend {
             return Err(Self::error(format!(
                 "the backend was built for {} corrector passes, and the step asks for {}",
                 self.npc, params.npc
+            )));
+        }
+        if (tissue.params().omega != 0.0) != self.adhesion {
+            return Err(Self::error(format!(
+                "the backend was built {} adhesion, and the tissue's ω is now {}: build a new backend for it",
+                if self.adhesion { "with" } else { "without" },
+                tissue.params().omega
             )));
         }
         self.set_uniforms(tissue, params.dt);

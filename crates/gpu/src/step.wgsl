@@ -108,6 +108,13 @@ override CHECK: u32 = 0u;
 // derivative, from the static wall field (w, ∇²w per node, `wall`).
 override WALLS: u32 = 0u;
 @group(0) @binding(19) var<storage, read> wall: array<vec2<f32>>;
+// Whether the cells adhere (ω ≠ 0): the lattice pass adds each cell's `c φ ∇²φ` to the
+// pressure's own part and keeps s1 per node (`adh_s1`); the adhesion pass takes the lattice
+// Laplacian of s1 (`adh_lap`) and adds the cross part `−c s1 ∇²s1` to P; the force pass adds
+// the derivative `−c (∇²s1 − ∇²φ_i)`.
+override ADHESION: u32 = 0u;
+@group(0) @binding(20) var<storage, read_write> adh_s1: array<f32>;
+@group(0) @binding(21) var<storage, read_write> adh_lap: array<f32>;
 
 const CELL_STRIDE: u32 = 12u;
 
@@ -211,6 +218,21 @@ fn wall_derivative(phi: f32, w: f32, lap_w: f32) -> f32 {
 // mechanics::equations::wall_pressure, with the coefficients of `prm`
 fn wall_pressure(s1: f32, s2: f32, w: f32, lap_w: f32) -> f32 {
     return prm.wall_repulsion * (w * w) * s2 - prm.wall_adhesion * lap_w * s1;
+}
+
+// mechanics::equations::adhesion_derivative, with c = prm.adhesion
+fn adhesion_derivative(lap_s1: f32, lap_self: f32) -> f32 {
+    return -prm.adhesion * (lap_s1 - lap_self);
+}
+
+// mechanics::equations::adhesion_pressure_cell_part, with c = prm.adhesion
+fn adhesion_pressure_cell_part(phi: f32, lap: f32) -> f32 {
+    return prm.adhesion * phi * lap;
+}
+
+// mechanics::equations::adhesion_pressure, with c = prm.adhesion
+fn adhesion_pressure(s1: f32, lap_s1: f32) -> f32 {
+    return -prm.adhesion * s1 * lap_s1;
 }
 
 // mechanics::equations::heun_predictor
@@ -471,7 +493,11 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
                     s2 += p2;
                     s3 += p2 * p;
                     s4 += p2 * p2;
-                    own += pressure_own_part(p, laplacian(st), af);
+                    let lap = laplacian(st);
+                    own += pressure_own_part(p, lap, af);
+                    if (ADHESION == 1u) {
+                        own += adhesion_pressure_cell_part(p, lap);
+                    }
                     q += p * sh * kc.zeta_weight;
                 }
             }
@@ -483,10 +509,40 @@ fn lattice_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
             let wl = wall[node];
             p += wall_pressure(s1, s2, wl.x, wl.y);
         }
+        if (ADHESION == 1u) {
+            adh_s1[node] = s1;
+        }
         lat_set(node, vec4<f32>(p, s2, q.x, q.y));
     } else {
         acc_set(node, vec4<f32>(s1, s2, s3, s4), vec4<f32>(own, q.x, q.y, 0.0));
     }
+}
+
+// ---- pass 2b, with adhesion: the Laplacian of s1 and the cross part of the pressure ----
+
+@compute @workgroup_size(256)
+fn adhesion_lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let node = gid.x + gid.y * nwg.x * WG;
+    if (node >= prm.lx * prm.ly || halted()) {
+        return;
+    }
+    let x = node / prm.ly;
+    let y = node % prm.ly;
+    let xm = select(x - 1u, prm.lx - 1u, x == 0u);
+    let xp = select(x + 1u, 0u, x + 1u == prm.lx);
+    let ym = select(y - 1u, prm.ly - 1u, y == 0u);
+    let yp = select(y + 1u, 0u, y + 1u == prm.ly);
+    var s: Stencil;
+    s.c = adh_s1[node];
+    s.xm = adh_s1[xm * prm.ly + y];
+    s.xp = adh_s1[xp * prm.ly + y];
+    s.ym = adh_s1[x * prm.ly + ym];
+    s.yp = adh_s1[x * prm.ly + yp];
+    let lap = laplacian(s);
+    adh_lap[node] = lap;
+    var l = lat_get(node);
+    l.x += adhesion_pressure(s.c, lap);
+    lat_set(node, l);
 }
 
 // ---- pass 3: forces, velocities, the right-hand side and the Heun update ----
@@ -532,10 +588,15 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             let b = k % NY;
             let s = stencil(base, a, b);
             let others = fields[j].y - s.c * s.c;
-            var dfdphi = free_energy_derivative(s.c, laplacian(s), af, others);
+            let lap = laplacian(s);
+            var dfdphi = free_energy_derivative(s.c, lap, af, others);
+            let at = ((o.x + a) % prm.lx) * prm.ly + (o.y + b) % prm.ly;
             if (WALLS == 1u) {
-                let wl = wall[((o.x + a) % prm.lx) * prm.ly + (o.y + b) % prm.ly];
+                let wl = wall[at];
                 dfdphi += wall_derivative(s.c, wl.x, wl.y);
+            }
+            if (ADHESION == 1u) {
+                dfdphi += adhesion_derivative(adh_lap[at], lap);
             }
             let r = rhs(v, gradient(s), dfdphi);
             let idx = base + k;

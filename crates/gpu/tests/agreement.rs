@@ -72,6 +72,13 @@ fn walled(tissue: Tissue<f32>) -> Tissue<f32> {
     tissue.with_walls(Walls::new(field, 1.0, 0.002))
 }
 
+/// `tissue` with cell–cell adhesion ω = 0.0075 (half the doublet's): the lattice Laplacian of
+/// `s1` in the derivative, and its cross part in the pressure.
+fn adhering(mut tissue: Tissue<f32>) -> Tissue<f32> {
+    tissue.params_mut().omega = 0.0075;
+    tissue
+}
+
 #[test]
 fn one_evaluation_agrees_with_the_cpu() {
     if common::try_device().is_none() {
@@ -82,6 +89,11 @@ fn one_evaluation_agrees_with_the_cpu() {
         ("ζ = 0.005", paper_tissue(0.005)),
         ("two populations", two_populations(paper_tissue(0.005))),
         ("walls", walled(paper_tissue(0.005))),
+        ("adhesion", adhering(paper_tissue(0.005))),
+        (
+            "adhesion, walls and two populations",
+            adhering(walled(two_populations(paper_tissue(0.005)))),
+        ),
     ];
     for (zeta, tissue) in cases {
         let sp = StepParams::paper();
@@ -93,16 +105,24 @@ fn one_evaluation_agrees_with_the_cpu() {
         assert!(tissue.cells().map().offset.iter().all(|&o| o == [0, 0]));
         let r_cpu: Vec<f64> = ws.rhs().iter().map(|v| v.to_f64()).collect();
         let r_gpu: Vec<f64> = ev.rhs.iter().map(|&v| f64::from(v)).collect();
-        let scale = max_abs(r_cpu.iter().copied());
+        // The scale of R's terms: R itself, and with adhesion its two Laplacian terms, which
+        // cancel inside a cell (`−c (∇²s1 − ∇²φ_i)`, each of up to c max |∇²s1|), so that
+        // their f32 round-off is that of the terms, not of R.
+        let scale = max_abs(r_cpu.iter().copied()) + adhesion_scale(&tissue, &ws);
         let err = max_abs(r_cpu.iter().zip(&r_gpu).map(|(a, b)| a - b));
-        println!("{zeta}: R: max |Δ| = {err:.3e}, max |R| = {scale:.3e}");
+        println!("{zeta}: R: max |Δ| = {err:.3e}, scale {scale:.3e}");
         assert!(err <= 1e-6 * scale, "R differs by {err:e} (max {scale:e})");
         for (k, field) in [SumField::P, SumField::S2, SumField::Qxx, SumField::Qxy]
             .into_iter()
             .enumerate()
         {
             let cpu = ws.sum_field(field);
-            let scale = max_abs(cpu.iter().copied());
+            let scale = max_abs(cpu.iter().copied())
+                + if field == SumField::P {
+                    adhesion_scales(&tissue, &ws)[1]
+                } else {
+                    0.0
+                };
             let err = max_abs(
                 cpu.iter()
                     .zip(&ev.lattice)
@@ -137,6 +157,41 @@ fn one_evaluation_agrees_with_the_cpu() {
         per_cell(&|c| c.velocity.x, 7, "v_x");
         per_cell(&|c| c.velocity.y, 8, "v_y");
     }
+}
+
+/// The scale of adhesion's terms in R (`2 c max t`) and in P (`2 c max s1 t`), with `c` the
+/// adhesion coefficient (zeros without adhesion) and `t` the sum of the magnitudes of the five
+/// terms of the lattice Laplacian of `s1` at a node. The device sums `s1` in f32 and takes its
+/// Laplacian, so the round-off of `∇²s1` is that of its terms (about 8 `s1`), not of its
+/// value; the derivative `−c (∇²s1 − ∇²φ_i)` and the pressure's `−c s1 ∇²s1` carry it.
+fn adhesion_scale<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>) -> f64 {
+    adhesion_scales(tissue, ws)[0]
+}
+
+/// See [`adhesion_scale`]: `[2 c max t, 2 c max s1 t]`.
+fn adhesion_scales<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>) -> [f64; 2] {
+    let p = tissue.params();
+    let c = mechanics::equations::adhesion_coefficient(p.omega, p.energy.lambda).abs();
+    let lattice = tissue.lattice();
+    let (lx, ly) = (lattice.lx, lattice.ly);
+    let s1 = ws.sum_field(SumField::S1);
+    let at = |x: usize, y: usize| s1[(x % lx) * ly + y % ly].abs();
+    let terms: Vec<(f64, f64)> = (0..lx)
+        .flat_map(|x| {
+            (0..ly).map(move |y| {
+                let t = at(x + 1, y)
+                    + at(x + lx - 1, y)
+                    + at(x, y + 1)
+                    + at(x, y + ly - 1)
+                    + 4.0 * at(x, y);
+                (t, at(x, y) * t)
+            })
+        })
+        .collect();
+    [
+        2.0 * c * max_abs(terms.iter().map(|t| t.0)),
+        2.0 * c * max_abs(terms.iter().map(|t| t.1)),
+    ]
 }
 
 /// The largest difference of two states' fields, each cell compared on the lattice (so that
@@ -215,6 +270,16 @@ fn a_hundred_steps_in_a_channel_agree_with_the_cpu() {
     assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
 }
 
+/// Adhesion (`adhering`): 100 active steps agree with the CPU to the minimal model's bounds.
+#[test]
+fn a_hundred_steps_with_adhesion_agree_with_the_cpu() {
+    let Some((dphi, dc)) = steps_agree(adhering(paper_tissue(0.005)), 100) else {
+        return;
+    };
+    println!("adhesion, 100 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
+    assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
+}
+
 /// The per-cell arrays split into chunks (here 25 + 25 + 10 cells, as 10⁶ cells are split
 /// at a binding's 2³¹ bytes) and the lattice arrays into two bindings (at node 6007 of 10⁴,
 /// mid-row) give the state of one array to f32 round-off: only the order in which the
@@ -224,7 +289,8 @@ fn chunked_arrays_agree_with_one_array() {
     if common::try_device().is_none() {
         return;
     }
-    let tissue = paper_tissue(0.005);
+    // With adhesion, whose pass reads the s1 that only the last chunk writes.
+    let tissue = adhering(paper_tissue(0.005));
     let sp = StepParams::paper();
     let whole = GpuBackend::new(&tissue, &sp).unwrap();
     let options = gpu::GpuOptions {
@@ -248,7 +314,9 @@ fn chunked_arrays_agree_with_one_array() {
     let a = split.evaluate(&tissue, sp.dt).unwrap();
     let mut one = GpuBackend::new(&tissue, &sp).unwrap();
     let b = one.evaluate(&tissue, sp.dt).unwrap();
-    let scale = max_abs(b.rhs.iter().map(|&v| f64::from(v)));
+    let mut ws = Workspace::new(tissue.cells());
+    tissue.refresh(&mut ws);
+    let scale = max_abs(b.rhs.iter().map(|&v| f64::from(v))) + adhesion_scale(&tissue, &ws);
     let err = max_abs(a.rhs.iter().zip(&b.rhs).map(|(x, y)| f64::from(x - y)));
     println!("chunks: R: max |Δ| = {err:.3e} of max |R| = {scale:.3e}");
     assert!(err <= 1e-6 * scale, "R differs by {err:e}");
@@ -275,7 +343,7 @@ fn chunked_arrays_agree_with_one_array() {
 fn the_memory_estimate_counts_every_array() {
     let lattice = Lattice::new(12_910, 12_910);
     let shape = PatchShape::new(lattice, 16).unwrap();
-    let m = gpu::GpuMemory::estimate(lattice, &shape, 1_000_000, 1);
+    let m = gpu::GpuMemory::estimate(lattice, &shape, 1_000_000, 1, &[]);
     // 10⁶ patches of 33² f32: 4.36 GB an array, three of them, plus the lattice (48 B a node).
     assert_eq!(m.phi_array, 1_000_000 * 33 * 33 * 4);
     assert_eq!(m.phi_arrays, 3);

@@ -18,7 +18,7 @@ mod common;
 /// v_x, v_y, R_old, R_new, Δt.
 const IN: usize = 16;
 /// Outputs per sample, in the order of `NAMES`.
-const OUT: usize = 19;
+const OUT: usize = 22;
 const NAMES: [&str; OUT] = [
     "area_factor",
     "free_energy_derivative",
@@ -39,6 +39,9 @@ const NAMES: [&str; OUT] = [
     "pressure_own_part",
     "wall_derivative",
     "wall_pressure",
+    "adhesion_derivative",
+    "adhesion_pressure_cell_part",
+    "adhesion_pressure",
 ];
 
 const HARNESS: &str = r#"
@@ -48,7 +51,7 @@ const HARNESS: &str = r#"
 @compute @workgroup_size(64)
 fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= arrayLength(&eq_out) / 19u) {
+    if (i >= arrayLength(&eq_out) / 22u) {
         return;
     }
     // The cell's constants, which the equations read (`use_cell` in the step): the tissue's.
@@ -68,7 +71,7 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r_new = eq_in[x + 14u];
     let dt = eq_in[x + 15u];
     let af = area_factor(area);
-    let o = i * 19u;
+    let o = i * 22u;
     eq_out[o] = af;
     eq_out[o + 1u] = free_energy_derivative(phi, lap, af, others);
     let sh = shape_tensor_density(g);
@@ -101,11 +104,17 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
     // The walls' parts, with w = the `others` input and ∇²w = the Laplacian's.
     eq_out[o + 17u] = wall_derivative(phi, others, lap);
     eq_out[o + 18u] = wall_pressure(s1, s2, others, lap);
+    // Adhesion's parts, with ∇²s1 = the `others` input.
+    eq_out[o + 19u] = adhesion_derivative(others, lap);
+    eq_out[o + 20u] = adhesion_pressure_cell_part(phi, lap);
+    eq_out[o + 21u] = adhesion_pressure(s1, others);
 }
 "#;
 
 /// The walls' coefficients in the harness (`wall_coefficients(1, 0.02, 2.5)`).
 const WALL: [f64; 2] = [0.8, 0.1];
+/// The adhesion coefficient in the harness (`adhesion_coefficient(0.015, 2.5)`).
+const ADHESION: f64 = 0.075;
 
 /// The kernel's uniform block (the shader's `Params`, one definition for Rust and WGSL),
 /// with the coefficients of `coef`.
@@ -121,6 +130,7 @@ fn params_bytes(coef: &EnergyCoefficients, zeta: f32, xi: f32) -> Vec<u8> {
         dt: 0.1,
         wall_repulsion: WALL[0] as f32,
         wall_adhesion: WALL[1] as f32,
+        adhesion: ADHESION as f32,
         ..bytemuck::Zeroable::zeroed()
     };
     bytemuck::bytes_of(&p).to_vec()
@@ -307,6 +317,18 @@ fn reference(
         (
             eq::wall_pressure(WALL, s1, s2, others, lap),
             WALL[0] * (others * others * s2).abs() + WALL[1] * (lap * s1).abs(),
+        ),
+        (
+            eq::adhesion_derivative(ADHESION, others, lap),
+            ADHESION * (others.abs() + lap.abs()),
+        ),
+        (
+            eq::adhesion_pressure_cell_part(ADHESION, phi, lap),
+            ADHESION * (phi * lap).abs(),
+        ),
+        (
+            eq::adhesion_pressure(ADHESION, s1, others),
+            ADHESION * (s1 * others).abs(),
         ),
     ]
 }
