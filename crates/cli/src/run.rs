@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mechanics::{Callback, CallbackError, Observation, Precision};
+use mechanics::{Callback, CallbackError, Needs, Observation, Precision};
 use phasefield::{Cells, Real};
 use rundir::{FinalToo, Interrupt, Outcome, RunDir, RunError};
 use scene::Scene;
@@ -222,5 +222,10 @@ impl<T: Real> Callback<T> for Progress {
             b.finish();
         }
         Ok(())
+    }
+
+    /// The clock, the number of cells and v_rms.
+    fn needs(&self) -> Needs {
+        Needs::Observables
     }
 }

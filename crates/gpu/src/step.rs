@@ -1,6 +1,8 @@
 //! The buffers of the GPU step, its pipelines, and the recording of steps.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use mechanics::backend::Backend;
@@ -313,6 +315,9 @@ struct Pipelines {
     correct: wgpu::ComputePipeline,
     correct_last: wgpu::ComputePipeline,
     count: wgpu::ComputePipeline,
+    /// The observables' tissue velocity and its Σ |v|² per workgroup.
+    velocity_sums: wgpu::ComputePipeline,
+    velocity_reduce: wgpu::ComputePipeline,
 }
 
 /// The bind groups of one step, one per chunk each: which φ array each evaluation reads and
@@ -362,6 +367,10 @@ pub struct GpuBackend {
     adhesion: bool,
     /// s1 and its Laplacian per lattice node, with adhesion (bound, never read by the host).
     _adhesion_buffers: [wgpu::Buffer; 2],
+    /// Σ |v|² per workgroup of the lattice ([`GpuBackend::observables`]).
+    v2_part: wgpu::Buffer,
+    /// Bytes copied from the device to the host so far ([`GpuBackend::bytes_read`]).
+    bytes_read: Arc<AtomicU64>,
     groups_cells: (u32, u32),
     groups_nodes: (u32, u32),
     groups_bins: u32,
@@ -613,6 +622,12 @@ impl GpuBackend {
             copy,
         );
         let a = f64::from(u8::from(adhesion));
+        // Σ |v|² per workgroup of the lattice, for the observables.
+        let v2_part = storage(
+            "v2 per workgroup",
+            u64::from((lattice.len() as u32).div_ceil(WG)) * 4,
+            copy,
+        );
         let params_buf = d.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: std::mem::size_of::<Params>() as u64,
@@ -671,6 +686,7 @@ impl GpuBackend {
         entries.push(storage_entry(19, true));
         entries.push(storage_entry(20, false));
         entries.push(storage_entry(21, false));
+        entries.push(storage_entry(22, false));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: 18,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -724,9 +740,11 @@ impl GpuBackend {
                 &[("MODE", 2.0), ("WALLS", w), ("ADHESION", a)],
             ),
             count: pipeline("count_step", &[]),
+            velocity_sums: pipeline("velocity_sums", &[]),
+            velocity_reduce: pipeline("velocity_reduce", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 22] = [
+            let bufs: [&wgpu::Buffer; 23] = [
                 &params_buf,
                 x,
                 old,
@@ -749,6 +767,7 @@ impl GpuBackend {
                 &wall,
                 &adh_s1,
                 &adh_lap,
+                &v2_part,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -807,6 +826,8 @@ impl GpuBackend {
             walls,
             adhesion,
             _adhesion_buffers: [adh_s1, adh_lap],
+            v2_part,
+            bytes_read: Arc::new(AtomicU64::new(0)),
             lattice,
             shape,
             n_cells: n,
@@ -1148,6 +1169,7 @@ impl GpuBackend {
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
         enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        self.bytes_read.fetch_add(bytes, Ordering::Relaxed);
         self.dev.queue.submit(Some(enc.finish()));
         let (tx, rx) = mpsc::channel();
         staging
@@ -1176,6 +1198,91 @@ impl GpuBackend {
     /// [`GpuError::Lost`].
     pub fn cell_quantities(&mut self) -> Result<Vec<f32>, GpuError> {
         self.flush();
+        self.cell_quantities_now()
+    }
+
+    /// Bytes copied from the device to the host since the backend was made: what a test
+    /// reads to show that the observables bring back no fields.
+    pub fn bytes_read(&self) -> u64 {
+        self.bytes_read.load(Ordering::Relaxed)
+    }
+
+    /// The counter of [`GpuBackend::bytes_read`], to read while a simulation owns the backend.
+    pub fn bytes_read_counter(&self) -> Arc<AtomicU64> {
+        Arc::clone(&self.bytes_read)
+    }
+
+    /// Whether a queued step failed its check or overflowed a bin (read from the status).
+    fn failed(&self) -> Result<bool, GpuError> {
+        let status = self.read(&self.status, 16)?;
+        let [failed, overflow, _, _]: [u32; 4] = bytemuck::pod_read_unaligned(&status);
+        Ok(failed != 0 || overflow != 0)
+    }
+
+    /// The observables of the device's current state ([`mechanics::Observables`], as
+    /// [`Tissue::observe`] computes them on the host): one evaluation of the state, the
+    /// tissue velocity `Σ φ_i v_i` per node and `Σ |v|²` reduced per workgroup, then only the
+    /// per-cell quantities (48 bytes a cell) and the workgroups' sums (4 bytes per 256 nodes)
+    /// come back, never the fields. `None` when a queued step failed, or the evaluation did
+    /// (the sync reports it).
+    ///
+    /// # Errors
+    /// [`GpuError::Lost`].
+    pub fn observables<T: Real>(
+        &mut self,
+        tissue: &Tissue<T>,
+    ) -> Result<Option<mechanics::Observables>, GpuError> {
+        self.flush();
+        if self.failed()? {
+            return Ok(None);
+        }
+        self.set_uniforms(tissue, f64::from(self.params.dt));
+        self.record_passes(true);
+        {
+            let enc = self.encoder.as_mut().expect("just recorded");
+            let p = &self.pipelines;
+            let (nx, ny) = self.groups_nodes;
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("observables"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&p.velocity_sums);
+            for g in &self.groups.predict {
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups(nx, ny, 1);
+            }
+            pass.set_pipeline(&p.velocity_reduce);
+            pass.dispatch_workgroups(nx, ny, 1);
+        }
+        self.flush();
+        if self.failed()? {
+            return Ok(None);
+        }
+        let q = self.cell_quantities_now()?;
+        let (nx, ny) = self.groups_nodes;
+        let parts = self.read(&self.v2_part, u64::from(nx * ny) * 4)?;
+        let v2: f64 = bytemuck::cast_slice::<u8, f32>(&parts)
+            .iter()
+            .map(|&v| f64::from(v))
+            .sum();
+        let o = mechanics::Observables::from_cells(
+            v2 / self.lattice.len() as f64,
+            q.chunks_exact(CELL_STRIDE).map(|c| {
+                let c = |k: usize| f64::from(c[k]);
+                mechanics::CellObservables {
+                    area: c(0),
+                    shape: [c(1), c(2)],
+                    velocity: [c(7), c(8)],
+                    phi_min: c(3),
+                    phi_max: c(4),
+                }
+            }),
+        );
+        Ok(Some(o))
+    }
+
+    /// The per-cell quantities as they are on the device now (after a flush).
+    fn cell_quantities_now(&self) -> Result<Vec<f32>, GpuError> {
         let bytes = self.read(&self.cell, (self.n_cells * CELL_STRIDE * 4) as u64)?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
@@ -1299,6 +1406,11 @@ impl<T: Real> Backend<T> for GpuBackend {
     fn upload(&mut self, tissue: &Tissue<T>) -> Result<(), StepError> {
         self.flush();
         self.upload_state(tissue)
+            .map_err(|e| Self::error(e.to_string()))
+    }
+
+    fn observe(&mut self, tissue: &Tissue<T>) -> Result<Option<mechanics::Observables>, StepError> {
+        self.observables(tissue)
             .map_err(|e| Self::error(e.to_string()))
     }
 }

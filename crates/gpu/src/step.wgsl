@@ -115,6 +115,8 @@ override WALLS: u32 = 0u;
 override ADHESION: u32 = 0u;
 @group(0) @binding(20) var<storage, read_write> adh_s1: array<f32>;
 @group(0) @binding(21) var<storage, read_write> adh_lap: array<f32>;
+// Per workgroup of the lattice: Σ |v|² of the tissue velocity over its nodes (`velocity_reduce`).
+@group(0) @binding(22) var<storage, read_write> v2_part: array<f32>;
 
 const CELL_STRIDE: u32 = 12u;
 
@@ -666,6 +668,74 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
                 old_phi[base + u32(na) * NY + u32(nb)] = vals[j];
             }
         }
+    }
+}
+
+// ---- observables: the tissue velocity v = Σ_i φ_i v_i and Σ |v|², reduced on the device ----
+
+// Per node, chunk by chunk: v = Σ_i φ_i v_i into P's and s2's places of the lattice sums
+// (free once an evaluation's force pass has run), with the cells' velocities of that
+// evaluation; the first chunk writes, the others add. The cells in the bins' order, as the
+// lattice pass adds them.
+@compute @workgroup_size(256)
+fn velocity_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let node = gid.x + gid.y * nwg.x * WG;
+    if (node >= prm.lx * prm.ly || halted()) {
+        return;
+    }
+    let x = node / prm.ly;
+    let y = node % prm.ly;
+    let bx = x * prm.nbx / prm.lx;
+    let by = y * prm.nby / prm.ly;
+    let nx_b = min(prm.nbx, 2u);
+    let ny_b = min(prm.nby, 2u);
+    var v = vec2<f32>(0.0);
+    if (chunk.first == 0u) {
+        v = lat_get(node).xy;
+    }
+    let hi = chunk.lo + chunk.count;
+    for (var dx = 0u; dx < nx_b; dx++) {
+        let cx = (bx + prm.nbx - dx) % prm.nbx;
+        for (var dy = 0u; dy < ny_b; dy++) {
+            let cy = (by + prm.nby - dy) % prm.nby;
+            let b = cx * prm.nby + cy;
+            let n = min(atomicLoad(&bin_count[b]), CAP);
+            for (var j = 0u; j < n; j++) {
+                let i = bin_cells[b * CAP + j];
+                if (i < chunk.lo || i >= hi) {
+                    continue;
+                }
+                let o = origin[i];
+                let a = (x + prm.lx - o.x) % prm.lx;
+                let bb = (y + prm.ly - o.y) % prm.ly;
+                if (a < NX && bb < NY) {
+                    let p = x_phi[(i - chunk.lo) * PLEN + a * NY + bb];
+                    let c = i * CELL_STRIDE;
+                    v += p * vec2<f32>(cell[c + 7u], cell[c + 8u]);
+                }
+            }
+        }
+    }
+    lat_set(node, vec4<f32>(v, 0.0, 0.0));
+}
+
+// Per workgroup of 256 nodes: Σ |v|², a fixed tree (the host adds the workgroups' sums).
+@compute @workgroup_size(256)
+fn velocity_reduce(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(local_invocation_id) lid3: vec3<u32>,
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+) {
+    let node = gid.x + gid.y * nwg.x * WG;
+    var v2 = 0.0;
+    if (node < prm.lx * prm.ly) {
+        let v = lat_get(node).xy;
+        v2 = dot(v, v);
+    }
+    let total = reduce(lid3.x, vec4<f32>(v2, 0.0, 0.0, 0.0));
+    if (lid3.x == 0u) {
+        v2_part[wid.x + wid.y * nwg.x] = total.x;
     }
 }
 

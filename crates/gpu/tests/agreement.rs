@@ -8,7 +8,7 @@ mod common;
 use mechanics::prelude::*;
 use mechanics::terms::{Population, Populations};
 use mechanics::walls::Walls;
-use mechanics::{CellState, SumField};
+use mechanics::{CellState, Needs, Observables, SumField};
 use phasefield::{init, Cells, Lattice, PatchShape, Real, WallField, WallShape};
 
 /// 60 cells on 100² at margin 12, relaxed 40 TU on the CPU: the paper's scene at a stage
@@ -278,6 +278,106 @@ fn a_hundred_steps_with_adhesion_agree_with_the_cpu() {
     };
     println!("adhesion, 100 steps: max |Δφ| = {dphi:.3e}, max |Δc| = {dc:.3e}");
     assert!(dphi <= 1e-5 && dc <= 1e-4, "{dphi:e} {dc:e}");
+}
+
+/// What a series-like callback records: the step, the observables, and the bytes the device
+/// had sent back by then.
+struct Rows {
+    rows: std::sync::Arc<std::sync::Mutex<Vec<(u64, Observables, u64)>>>,
+    read: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
+}
+
+impl Callback<f32> for Rows {
+    fn call(&mut self, obs: &mut Observation<'_, f32>) -> Result<(), CallbackError> {
+        let o = obs.observables();
+        let read = self
+            .read
+            .as_ref()
+            .map_or(0, |r| r.load(std::sync::atomic::Ordering::Relaxed));
+        self.rows.lock().unwrap().push((obs.iteration(), o, read));
+        Ok(())
+    }
+
+    fn needs(&self) -> Needs {
+        Needs::Observables
+    }
+}
+
+/// Observables on the device (issue 40, item 2): a callback that needs only the observables
+/// (as a series row) gets them reduced on the device, equal to the CPU's to the round-off of
+/// 100 steps, and what comes back for each is the per-cell quantities and the lattice's
+/// partial sums: a few kilobytes, never the fields (150 kB here). With the steps' own
+/// observables, two populations and walls, so that every per-cell constant is in play.
+#[test]
+fn series_rows_read_back_the_observables_not_the_fields() {
+    if common::try_device().is_none() {
+        return;
+    }
+    let tissue = walled(two_populations(paper_tissue(0.005)));
+    let sp = StepParams::paper();
+    let gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
+    let counter = gpu.bytes_read_counter();
+    let before = gpu.bytes_read();
+    let rows = |read| {
+        let rows = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        (
+            Rows {
+                rows: rows.clone(),
+                read,
+            },
+            rows,
+        )
+    };
+    let (g_cb, g_rows) = rows(Some(counter));
+    let mut sim = Simulation::new(tissue.clone(), sp)
+        .with_backend(Box::new(gpu))
+        .stop_iteration(tissue.iteration() + 100);
+    sim.add_callback("rows", Schedule::IterationInterval(10), g_cb);
+    sim.run().unwrap();
+    let (c_cb, c_rows) = rows(None);
+    let mut sim = Simulation::new(tissue.clone(), sp).stop_iteration(tissue.iteration() + 100);
+    sim.add_callback("rows", Schedule::IterationInterval(10), c_cb);
+    sim.run().unwrap();
+    let (g, c) = (g_rows.lock().unwrap(), c_rows.lock().unwrap());
+    assert_eq!(g.len(), c.len());
+    assert!(g.len() >= 10, "{} rows", g.len());
+    let phi_bytes = (tissue.n_cells() * tissue.cells().patch_len() * 4) as u64;
+    let mut last = before;
+    for ((step, go, read), (cstep, co, _)) in g.iter().zip(c.iter()) {
+        assert_eq!(step, cstep);
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+        println!(
+            "step {step}: v_rms {:.6e} / {:.6e}, s_rms {:.6e} / {:.6e}, read {} B",
+            go.v_rms,
+            co.v_rms,
+            go.s_rms,
+            co.s_rms,
+            read - last
+        );
+        for (name, a, b) in [
+            ("v_rms", go.v_rms, co.v_rms),
+            ("s_rms", go.s_rms, co.s_rms),
+            ("area_mean", go.area_mean, co.area_mean),
+            ("area_min", go.area_min, co.area_min),
+            ("area_max", go.area_max, co.area_max),
+            ("cell_speed_rms", go.cell_speed_rms, co.cell_speed_rms),
+        ] {
+            assert!(
+                rel(a, b) <= 1e-4,
+                "step {step}: {name} {a} on the GPU, {b} on the CPU"
+            );
+        }
+        assert!((go.phi_min - co.phi_min).abs() <= 1e-5);
+        assert!((go.phi_max - co.phi_max).abs() <= 1e-5);
+        // What came back for this row (the first row is the starting state, which the
+        // host has): far less than one copy of the fields.
+        assert!(
+            read - last < phi_bytes / 10,
+            "step {step}: {} bytes came back for a row, the fields are {phi_bytes}",
+            read - last
+        );
+        last = *read;
+    }
 }
 
 /// The per-cell arrays split into chunks (here 25 + 25 + 10 cells, as 10⁶ cells are split

@@ -10,6 +10,7 @@
 use phasefield::Real;
 
 use crate::extensions::Part;
+use crate::observables::Observables;
 use crate::params::StepParams;
 use crate::tissue::Tissue;
 use crate::StepError;
@@ -51,6 +52,18 @@ pub trait Backend<T: Real>: Send {
     /// # Errors
     /// [`StepError::Backend`] when the device cannot hold it.
     fn upload(&mut self, tissue: &Tissue<T>) -> Result<(), StepError>;
+
+    /// The observables of the device's current state ([`Tissue::observe`]), reduced there so
+    /// that only the numbers come back, not the fields; `tissue` gives the clock and the
+    /// parameters. `None` when the backend cannot, or when a queued step failed: the driver
+    /// then syncs, which reports the failure. The default is `None`.
+    ///
+    /// # Errors
+    /// [`StepError::Backend`] when the device fails.
+    fn observe(&mut self, tissue: &Tissue<T>) -> Result<Option<Observables>, StepError> {
+        let _ = tissue;
+        Ok(None)
+    }
 }
 
 impl<T: Real> Tissue<T> {
@@ -98,4 +111,152 @@ pub fn unsupported<T: Real>(tissue: &Tissue<T>, supported: &[Part]) -> Vec<Strin
         .filter(|p| !supported.contains(p))
         .map(Part::describe)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::{Arc, Mutex};
+
+    use phasefield::{init, Lattice, PatchShape};
+
+    use super::*;
+    use crate::simulation::{Callback, CallbackError, Needs, Observation, Schedule, Simulation};
+    use crate::workspace::Workspace;
+    use crate::ModelParams;
+
+    /// What the driver asked of [`HostBackend`].
+    #[derive(Debug, Default, Clone, Copy, PartialEq)]
+    struct Asked {
+        syncs: usize,
+        observes: usize,
+    }
+
+    /// A backend that steps its own copy of the tissue on the host, counts what the driver
+    /// asks of it, and reduces the observables itself when `observes` (as a device would).
+    struct HostBackend {
+        own: Tissue<f64>,
+        ws: Workspace<f64>,
+        observes: bool,
+        asked: Arc<Mutex<Asked>>,
+    }
+
+    impl Backend<f64> for HostBackend {
+        fn name(&self) -> &str {
+            "host"
+        }
+        fn supports(&self, _: Part) -> bool {
+            true
+        }
+        fn step(&mut self, _: &Tissue<f64>, params: &StepParams) -> Result<(), StepError> {
+            self.own.step(&mut self.ws, params)
+        }
+        fn sync(&mut self, tissue: &mut Tissue<f64>) -> Result<(), StepError> {
+            self.asked.lock().unwrap().syncs += 1;
+            *tissue = self.own.clone();
+            Ok(())
+        }
+        fn upload(&mut self, tissue: &Tissue<f64>) -> Result<(), StepError> {
+            self.own = tissue.clone();
+            Ok(())
+        }
+        fn observe(&mut self, _: &Tissue<f64>) -> Result<Option<Observables>, StepError> {
+            self.asked.lock().unwrap().observes += 1;
+            Ok(self.observes.then(|| self.own.observe(&mut self.ws)))
+        }
+    }
+
+    /// Records the observables it is called with, reading what `needs` says it reads.
+    struct Reader {
+        needs: Needs,
+        seen: Arc<Mutex<Vec<Option<Observables>>>>,
+    }
+
+    impl Callback<f64> for Reader {
+        fn call(&mut self, obs: &mut Observation<'_, f64>) -> Result<(), CallbackError> {
+            let o = (self.needs != Needs::Clock).then(|| obs.observables());
+            self.seen.lock().unwrap().push(o);
+            Ok(())
+        }
+        fn needs(&self) -> Needs {
+            self.needs
+        }
+    }
+
+    fn tissue() -> Tissue<f64> {
+        let lattice = Lattice::new(40, 40);
+        let shape = PatchShape::new(lattice, 8).expect("margin 8 fits 40²");
+        let centres = [[10.0, 12.0], [24.0, 14.0], [18.0, 28.0]];
+        let cells = init::discs(lattice, shape, &centres, 6.0, 2.0);
+        Tissue::new(cells, ModelParams::paper(0.02))
+    }
+
+    /// Runs 20 steps on a [`HostBackend`] with a callback of `needs` every 5 steps; what the
+    /// backend was asked, and what the callback saw.
+    fn run(needs: Needs, observes: bool) -> (Asked, Vec<Option<Observables>>) {
+        let t = tissue();
+        let asked = Arc::new(Mutex::new(Asked::default()));
+        let backend = HostBackend {
+            ws: Workspace::new(t.cells()),
+            own: t.clone(),
+            observes,
+            asked: asked.clone(),
+        };
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let mut sim = Simulation::new(t, StepParams::paper())
+            .with_backend(Box::new(backend))
+            .stop_iteration(20);
+        let reader = Reader {
+            needs,
+            seen: seen.clone(),
+        };
+        sim.add_callback("reader", Schedule::IterationInterval(5), reader);
+        sim.run().unwrap();
+        let asked = *asked.lock().unwrap();
+        let seen = seen.lock().unwrap().clone();
+        (asked, seen)
+    }
+
+    /// The driver brings back from a backend only what the callbacks due need: nothing for
+    /// the clock, the reduced observables for [`Needs::Observables`] (the state only when the
+    /// backend cannot reduce them), the state for [`Needs::State`]; and the observables are
+    /// the same whichever way they came. (Calls at steps 0, 5, 10, 15, 20; the run's end
+    /// syncs once.)
+    #[test]
+    fn the_driver_brings_back_only_what_the_callbacks_need() {
+        let (clock, _) = run(Needs::Clock, true);
+        assert_eq!(
+            clock,
+            Asked {
+                syncs: 1,
+                observes: 0
+            }
+        );
+        let (reduced, seen_reduced) = run(Needs::Observables, true);
+        assert_eq!(
+            reduced,
+            Asked {
+                syncs: 1,
+                observes: 4
+            }
+        );
+        let (fallback, seen_fallback) = run(Needs::Observables, false);
+        assert_eq!(
+            fallback,
+            Asked {
+                syncs: 5,
+                observes: 4
+            }
+        );
+        let (state, seen_state) = run(Needs::State, true);
+        assert_eq!(
+            state,
+            Asked {
+                syncs: 5,
+                observes: 0
+            }
+        );
+        assert_eq!(seen_reduced.len(), 5);
+        assert_eq!(seen_reduced, seen_state);
+        assert_eq!(seen_fallback, seen_state);
+    }
 }

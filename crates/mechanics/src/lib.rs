@@ -78,11 +78,11 @@ pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
 pub use kernels::thread_scratch_bytes;
 pub use nalgebra::Vector2;
-pub use observables::Observables;
+pub use observables::{CellObservables, Observables};
 pub use params::{ModelParams, Precision, PressureKind, StepParams, ACTIVITY_DT};
 pub use simulation::{
-    Callback, CallbackError, Fix, Observation, RunInfo, Schedule, Simulation, SimulationError,
-    DEFAULT_SORT_EVERY,
+    Callback, CallbackError, Fix, Needs, Observation, RunInfo, Schedule, Simulation,
+    SimulationError, DEFAULT_SORT_EVERY,
 };
 pub use step::{CheckPoint, StateCheck, StepCheck, PHI_BOUND};
 pub use tissue::Tissue;
@@ -91,7 +91,7 @@ pub use workspace::{CellState, SumField, Workspace};
 /// The types most programs need: `use mechanics::prelude::*;`.
 pub mod prelude {
     pub use crate::{
-        Callback, CallbackError, Fix, ModelParams, Observables, Observation, Precision,
+        Callback, CallbackError, Fix, ModelParams, Needs, Observables, Observation, Precision,
         PressureKind, Schedule, Simulation, StepParams, Tissue, TissueFields, TracelessTensor,
         Vector2, Workspace,
     };

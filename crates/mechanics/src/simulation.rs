@@ -168,6 +168,22 @@ pub enum SimulationError {
     NoStop,
 }
 
+/// What a callback reads of the state when it is called ([`Callback::needs`]): with the steps
+/// on a device ([`crate::Simulation::with_backend`]) it decides what is brought back to the
+/// host before the callback runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Needs {
+    /// The clock, the parameters and what the host keeps of the tissue (the number of cells,
+    /// the identities, the proliferation clock): nothing comes back from the device.
+    Clock,
+    /// That, and [`Observation::observables`]: the device reduces them and sends back the
+    /// numbers ([`crate::backend::Backend::observe`]), not the fields.
+    Observables,
+    /// The fields (the tissue's state, the workspace, [`Observation::fields`]): the device's
+    /// state is copied to the host first ([`crate::backend::Backend::sync`]).
+    State,
+}
+
 /// Something called on a schedule during a run: a diagnostic, an output writer, a progress
 /// report (after Oceananigans' `Callback` and ripgrep's `Sink`). Only [`Callback::call`] is
 /// required; closures `FnMut(&mut Observation<T>) -> Result<(), CallbackError>` are callbacks.
@@ -177,6 +193,13 @@ pub trait Callback<T: Real>: Send {
     /// # Errors
     /// Whatever stops the run (e.g. a failed write).
     fn call(&mut self, obs: &mut Observation<'_, T>) -> Result<(), CallbackError>;
+
+    /// What [`Callback::call`] reads of the state ([`Needs`]; the default, [`Needs::State`],
+    /// is always right). A callback that says less must read no more: with the steps on a
+    /// device, the host's fields are then those of an earlier step.
+    fn needs(&self) -> Needs {
+        Needs::State
+    }
 
     /// Called once before the run, with the starting state (before the schedules fire).
     ///
@@ -233,6 +256,9 @@ where
 /// The state as a callback sees it: the tissue (read-only), the clock and derived quantities
 /// computed on demand and cached for this iteration.
 pub struct Observation<'a, T: Real> {
+    /// Whether the host's fields are those of an earlier step (the steps are on a device and
+    /// only the clock or the observables came back: see [`Needs`]).
+    stale: bool,
     tissue: &'a Tissue<T>,
     ws: &'a mut Workspace<T>,
     observables: &'a mut Option<Observables>,
@@ -273,6 +299,10 @@ impl<'a, T: Real> Observation<'a, T> {
     /// ([`Tissue::observe`]) and cached for the other callbacks.
     pub fn observables(&mut self) -> Observables {
         if self.observables.is_none() {
+            debug_assert!(
+                !self.stale,
+                "a callback that needs only the clock read the observables"
+            );
             *self.observables = Some(self.tissue.observe(self.ws));
         }
         self.observables.expect("just computed")
@@ -282,12 +312,20 @@ impl<'a, T: Real> Observation<'a, T> {
     /// measured centres of the current state (evaluated on first use, as
     /// [`Observation::observables`]).
     pub fn workspace(&mut self) -> &Workspace<T> {
+        debug_assert!(
+            !self.stale,
+            "a callback that needs no state read the workspace"
+        );
         self.observables();
         self.ws
     }
 
     /// The lattice fields of the current state ([`Tissue::fields`]). Allocates.
     pub fn fields(&mut self) -> TissueFields {
+        debug_assert!(
+            !self.stale,
+            "a callback that needs no state read the fields"
+        );
         self.tissue.fields(self.ws)
     }
 
@@ -654,7 +692,20 @@ impl<T: Real> Simulation<T> {
     /// Runs `hook` of the callbacks, then of the writers (`call` only where the schedule
     /// fires).
     fn fire(&mut self, start: Instant, hook: Hook, stop: &mut bool) -> Result<(), SimulationError> {
-        let mut observables = None;
+        self.fire_with(start, hook, stop, None, false)
+    }
+
+    /// [`Simulation::fire`] with the observables already known (a device's), and whether
+    /// the host's fields are stale.
+    fn fire_with(
+        &mut self,
+        start: Instant,
+        hook: Hook,
+        stop: &mut bool,
+        known: Option<Observables>,
+        stale: bool,
+    ) -> Result<(), SimulationError> {
+        let mut observables = known;
         let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
         for entry in self.callbacks.iter_mut().chain(self.writers.iter_mut()) {
             let go = match hook {
@@ -665,6 +716,7 @@ impl<T: Real> Simulation<T> {
                 continue;
             }
             let mut obs = Observation {
+                stale,
                 tissue: &self.tissue,
                 ws: &mut self.workspace,
                 observables: &mut observables,
@@ -740,15 +792,32 @@ impl<T: Real> Simulation<T> {
     ) -> Result<(), SimulationError> {
         let (iteration, time) = (self.tissue.iteration(), self.tissue.time());
         let fix_due = self.fixes.iter().any(|(_, t, _)| t.due(iteration, time));
-        let call_due = self
+        // What the callbacks due now read: the most any of them needs.
+        let needs = self
             .callbacks
             .iter()
             .chain(&self.writers)
-            .any(|e| e.timer.due(iteration, time));
+            .filter(|e| e.timer.due(iteration, time))
+            .map(|e| e.callback.needs())
+            .max();
+        let call_due = needs.is_some();
         let Some(backend) = self.backend.as_mut() else {
             return Ok(());
         };
-        if fix_due || call_due {
+        // The observables reduced on the device, when nothing due reads the fields (a series
+        // row, a progress line); `None` from a backend that cannot (or whose queued steps
+        // failed, which the sync then reports).
+        let mut known = None;
+        if !fix_due && needs == Some(Needs::Observables) {
+            known = backend.observe(&self.tissue)?;
+        }
+        let synced = fix_due
+            || match needs {
+                Some(Needs::State) => true,
+                Some(Needs::Observables) => known.is_none(),
+                Some(Needs::Clock) | None => false,
+            };
+        if synced {
             backend.sync(&mut self.tissue)?;
         }
         if fix_due {
@@ -765,7 +834,7 @@ impl<T: Real> Simulation<T> {
             backend.upload(&self.tissue)?;
         }
         if call_due {
-            self.fire(start, Hook::Call, stop)?;
+            self.fire_with(start, Hook::Call, stop, known, !synced)?;
         }
         Ok(())
     }

@@ -23,7 +23,7 @@ use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use mechanics::{
-    Callback, CallbackError, Observation, RunInfo, Schedule, Simulation, SimulationError,
+    Callback, CallbackError, Needs, Observation, RunInfo, Schedule, Simulation, SimulationError,
 };
 use phasefield::{Cells, Real};
 use scene::Scene;
@@ -637,6 +637,12 @@ impl<T: Real> Callback<T> for StopOnSignal {
             obs.request_stop();
         }
         Ok(())
+    }
+
+    /// It reads nothing of the state: on a device, it costs no copy (it is called every
+    /// step; with the default it brought the whole state back after every step).
+    fn needs(&self) -> Needs {
+        Needs::Clock
     }
 }
 

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use mechanics::{Callback, CallbackError, Observation, Schedule, Simulation};
+use mechanics::{Callback, CallbackError, Needs, Observation, Schedule, Simulation};
 use phasefield::Real;
 use scene::OutputSchedules;
 
@@ -126,6 +126,10 @@ impl<T: Real, W: Callback<T>> Callback<T> for FinalToo<W> {
         self.inner.call(obs)
     }
 
+    fn needs(&self) -> Needs {
+        self.inner.needs()
+    }
+
     fn finalize(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
         if self.last != Some(obs.iteration()) {
             self.call(obs)?;
@@ -142,6 +146,12 @@ impl<T: Real> Callback<T> for SeriesRows {
         let o = obs.observables();
         self.0.row(obs.tissue(), &o)?;
         Ok(())
+    }
+
+    /// A row is the clock, ζ, the number of cells and the observables: on a device, only
+    /// the reduced numbers come back for it.
+    fn needs(&self) -> Needs {
+        Needs::Observables
     }
 }
 
