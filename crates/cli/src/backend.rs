@@ -77,6 +77,13 @@ fn check_gpu(scene: &Scene) -> Result<()> {
             tables.join(", ")
         );
     }
+    let kinds = scene.populations().kinds().len();
+    if kinds > gpu::MAX_KINDS {
+        anyhow::bail!(
+            "[integrator] backend = \"gpu\": the GPU backend holds at most {} populations, and [[population]] has {kinds}; merge some [[population]] tables, or set backend = \"cpu\"",
+            gpu::MAX_KINDS
+        );
+    }
     Ok(())
 }
 

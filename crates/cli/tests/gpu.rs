@@ -201,6 +201,43 @@ fn the_gpu_refuses_what_it_does_not_run_by_name() {
     }
 }
 
+/// More populations than the device's table holds (`gpu::MAX_KINDS`) are refused by the
+/// `[[population]]` key before anything is written, with or without an adapter.
+#[test]
+fn the_gpu_refuses_more_populations_than_it_holds_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = std::fs::read_to_string(scene_path("sorting.toml")).unwrap();
+    let (head, _) = text.split_at(text.find("[[population]]").unwrap());
+    let mut scene = head.to_string();
+    // 17 populations of the scene's 240 cells: 16 of 14 and one of 16.
+    let n = gpu::MAX_KINDS + 1;
+    for k in 0..n {
+        let count = if k + 1 == n { 240 - 14 * (n - 1) } else { 14 };
+        scene.push_str(&format!(
+            "[[population]]\nname = \"p{k}\"\ncount = {count}\n\n"
+        ));
+    }
+    text = scene;
+    let path = dir.path().join("many.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.path().join("out");
+    let o = bin()
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(&out)
+        .args(["--set", "integrator.backend=gpu", "--quiet"])
+        .output()
+        .unwrap();
+    let e = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        e.contains("[[population]]") && e.contains("at most 16") && e.contains("backend = \"cpu\""),
+        "names the key, the limit and the fix: {e}"
+    );
+    assert!(!out.exists(), "nothing written");
+}
+
 /// Scenes with the extensions the GPU runs, populations (`sorting.toml`: two populations of
 /// opposite ζ), walls (`channel.toml`; `wound.toml`, whose wall goes when the activity
 /// starts; here without its `[polarity]`, which the GPU does not run yet) and adhesion
