@@ -33,8 +33,8 @@ use std::sync::Arc;
 
 use nalgebra::Vector2;
 
-pub use noise::NoiseKey;
-pub use polarity::{Align, Polarity, Propulsion};
+pub use noise::{normal_of_words, philox4x32_10, uniform_of_word, NoiseKey};
+pub use polarity::{alignment_rate, alignment_target, propulsion, Align, Polarity, Propulsion};
 pub use populations::{CellConstants, Population, Populations};
 
 use crate::workspace::CellState;
@@ -66,7 +66,7 @@ pub struct CellContext<'a> {
 /// adds. A term holds parameters only; its per-cell state is kept by the [`Terms`] it is
 /// added to. Implementations must be deterministic functions of their arguments (noise comes
 /// through [`CellTerm::noise`], drawn by the driver from counter-based keys).
-pub trait CellTerm: Send + Sync + fmt::Debug {
+pub trait CellTerm: Send + Sync + fmt::Debug + std::any::Any {
     /// A short name, unique within a tissue: the prefix of its state in outputs and
     /// checkpoints.
     fn name(&self) -> &str;
@@ -254,6 +254,21 @@ impl Terms {
     /// The terms, in the order added.
     pub fn iter(&self) -> impl Iterator<Item = &dyn CellTerm> {
         self.entries.iter().map(|e| &*e.term)
+    }
+
+    /// The number of terms.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// The built-in [`Polarity`] with its place among the terms (the place its noise keys
+    /// carry), if it is one of them: what a backend that runs only the built-in terms (the
+    /// GPU's) looks for.
+    pub fn polarity(&self) -> Option<(usize, &Polarity)> {
+        self.entries.iter().enumerate().find_map(|(t, e)| {
+            let any: &dyn std::any::Any = &*e.term;
+            any.downcast_ref::<Polarity>().map(|p| (t, p))
+        })
     }
 
     /// The term named `name`.

@@ -3,10 +3,22 @@
 //! on the order in which cells are visited, a rejected adaptive step draws the same noise
 //! again, and a resumed run continues the same sequence without storing a generator's state.
 //!
-//! The key is hashed by four rounds of the SplitMix64 finaliser (Steele, Lea & Flood,
-//! OOPSLA 2014; the mixer of `java.util.SplittableRandom`), each round absorbing one part of
-//! the key, which passes the avalanche test on every bit of every part; two hashes of the key
-//! give two uniforms on (0, 1) and the Box–Muller transform one normal deviate.
+//! The generator is Philox4x32-10 (Salmon, Moraes, Dror & Shaw, "Parallel random numbers:
+//! as easy as 1, 2, 3", SC 2011; the generator of cuRAND and Random123), which needs only
+//! 32-bit integer arithmetic: the GPU backend draws the same numbers with the same function
+//! in WGSL (`gpu`'s `step.wgsl`), so that both backends give a cell the same noise. It maps a
+//! 128-bit counter and a 64-bit key to four 32-bit words through ten rounds of two 32 × 32 →
+//! 64-bit products, and passes the BigCrush battery on every one of its outputs.
+//!
+//! The key is the run's seed. The counter is `(cell, step low word, step high word,
+//! stage)`, where the cell and the stage, each a `u64`, are folded to 32 bits (their high
+//! word xor their low word): every stage in use (`terms`, `division`, `populations`) and
+//! every cell identity below 2³² folds to a distinct word. Two words give a uniform with 53
+//! random bits ([`NoiseKey::uniform`]); the other two, each a uniform with 32 bits, give a
+//! normal deviate by the Box–Muller transform ([`NoiseKey::normal`], `|N| ≤ 6.8`).
+//!
+//! (Until 2026-12 the key was hashed by SplitMix64's 64-bit finaliser, which a GPU opened
+//! without 64-bit integers cannot compute: every draw changed once with the switch.)
 
 /// The key of one random draw.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -21,47 +33,141 @@ pub struct NoiseKey {
     pub stage: u64,
 }
 
-/// SplitMix64's finaliser: a bijection of u64 with full avalanche.
+/// Philox4x32's multipliers and key increments (Salmon et al. 2011, Random123's
+/// `PHILOX_M4x32_0`, `PHILOX_M4x32_1`, `PHILOX_W32_0`, `PHILOX_W32_1`).
+const M0: u32 = 0xD251_1F53;
+const M1: u32 = 0xCD9E_8D57;
+const W0: u32 = 0x9E37_79B9;
+const W1: u32 = 0xBB67_AE85;
+
+/// The high and low words of the 64-bit product `a b`.
 #[inline]
-fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
+fn mul_hi_lo(a: u32, b: u32) -> (u32, u32) {
+    let p = u64::from(a) * u64::from(b);
+    ((p >> 32) as u32, p as u32)
 }
 
-const GOLDEN: u64 = 0x9e37_79b9_7f4a_7c15;
+/// Philox4x32-10: four 32-bit words from a 128-bit counter and a 64-bit key, a bijection of
+/// the counter for each key (Random123's `philox4x32(ctr, key)` with 10 rounds).
+pub fn philox4x32_10(counter: [u32; 4], key: [u32; 2]) -> [u32; 4] {
+    let (mut c, mut k) = (counter, key);
+    for round in 0..10 {
+        if round > 0 {
+            k = [k[0].wrapping_add(W0), k[1].wrapping_add(W1)];
+        }
+        let (hi0, lo0) = mul_hi_lo(M0, c[0]);
+        let (hi1, lo1) = mul_hi_lo(M1, c[2]);
+        c = [hi1 ^ c[1] ^ k[0], lo1, hi0 ^ c[3] ^ k[1], lo0];
+    }
+    c
+}
+
+/// A `u64` folded to 32 bits: its high word xor its low word.
+#[inline]
+fn fold(x: u64) -> u32 {
+    (x as u32) ^ ((x >> 32) as u32)
+}
+
+/// A word as a uniform on the open interval (0, 1): `(x + ½) 2⁻³²`.
+#[inline]
+pub fn uniform_of_word(x: u32) -> f64 {
+    (f64::from(x) + 0.5) * (1.0 / 4_294_967_296.0)
+}
+
+/// The Box–Muller normal deviate of the words `x2`, `x3` (each as [`uniform_of_word`]):
+/// `√(−2 ln u₂) cos(2π u₃)`.
+#[inline]
+pub fn normal_of_words(x2: u32, x3: u32) -> f64 {
+    let (u1, u2) = (uniform_of_word(x2), uniform_of_word(x3));
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
 
 impl NoiseKey {
-    /// The key's hash, with a salt for the second word a draw needs.
-    #[inline]
-    fn hash(&self, salt: u64) -> u64 {
-        let mut h = mix(self.seed.wrapping_add(GOLDEN).wrapping_add(salt));
-        h = mix(h ^ self.cell.wrapping_mul(GOLDEN));
-        h = mix(h ^ self.step.wrapping_add(0x6a09_e667_f3bc_c909));
-        mix(h ^ self.stage.wrapping_mul(0xd1b5_4a32_d192_ed03))
+    /// Philox's counter and key for this key (module docs).
+    pub fn counter_and_key(&self) -> ([u32; 4], [u32; 2]) {
+        (
+            [
+                fold(self.cell),
+                self.step as u32,
+                (self.step >> 32) as u32,
+                fold(self.stage),
+            ],
+            [self.seed as u32, (self.seed >> 32) as u32],
+        )
     }
 
-    /// A uniform deviate on the open interval (0, 1), 53 random bits.
+    /// The four words of the key.
+    pub fn words(&self) -> [u32; 4] {
+        let (counter, key) = self.counter_and_key();
+        philox4x32_10(counter, key)
+    }
+
+    /// A uniform deviate on the open interval (0, 1), 53 random bits (the first two words).
     pub fn uniform(&self) -> f64 {
-        uniform_open(self.hash(0))
+        let [x0, x1, ..] = self.words();
+        let bits = (u64::from(x0) << 21) | u64::from(x1 >> 11);
+        (bits as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
     }
 
-    /// A standard normal deviate (Box–Muller on two uniforms of the key).
+    /// A standard normal deviate: Box–Muller on the last two words ([`normal_of_words`]).
     pub fn normal(&self) -> f64 {
-        let (u1, u2) = (uniform_open(self.hash(1)), uniform_open(self.hash(2)));
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        let [_, _, x2, x3] = self.words();
+        normal_of_words(x2, x3)
     }
-}
-
-/// 53 bits of `h` as a number in (0, 1): never 0, so that its logarithm is finite.
-#[inline]
-fn uniform_open(h: u64) -> f64 {
-    ((h >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Random123's known-answer vectors for Philox4x32-10 (its `tests/kat_vectors`): zeros,
+    /// all ones, and the digits of π.
+    #[test]
+    fn philox_gives_random123s_known_answers() {
+        let cases = [
+            (
+                [0u32; 4],
+                [0u32; 2],
+                [0x6627_e8d5, 0xe169_c58d, 0xbc57_ac4c, 0x9b00_dbd8],
+            ),
+            (
+                [u32::MAX; 4],
+                [u32::MAX; 2],
+                [0x408f_276d, 0x41c8_3b0e, 0xa20b_c7c6, 0x6d54_51fd],
+            ),
+            (
+                [0x243f_6a88, 0x85a3_08d3, 0x1319_8a2e, 0x0370_7344],
+                [0xa409_3822, 0x299f_31d0],
+                [0xd16c_fe09, 0x94fd_cceb, 0x5001_e420, 0x2412_6ea1],
+            ),
+        ];
+        for (counter, key, expected) in cases {
+            assert_eq!(
+                philox4x32_10(counter, key),
+                expected,
+                "{counter:x?} {key:x?}"
+            );
+        }
+    }
+
+    /// Every stage the crate draws from folds to its own word, so no two kinds of draw share
+    /// a counter.
+    #[test]
+    fn the_stages_in_use_fold_to_distinct_words() {
+        let mut stages: Vec<u64> = Vec::new();
+        for t in 0..4u64 {
+            for k in 0..4u64 {
+                stages.push((t << 16) + k);
+                stages.push((1 << 62) + (t << 16) + k);
+            }
+        }
+        stages.extend((0..4).map(|k| (1u64 << 61) + k));
+        stages.push(1 << 60);
+        let mut folded: Vec<u32> = stages.iter().map(|&s| fold(s)).collect();
+        folded.sort_unstable();
+        folded.dedup();
+        assert_eq!(folded.len(), stages.len());
+    }
 
     fn key(cell: u64, step: u64) -> NoiseKey {
         NoiseKey {

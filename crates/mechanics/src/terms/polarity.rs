@@ -143,17 +143,75 @@ impl Polarity {
     }
 
     /// The alignment target of a cell whose polarity is `p`.
-    fn target(&self, cell: &CellContext<'_>, p: Vector2<f64>) -> Vector2<f64> {
-        match self.align {
-            Align::None => Vector2::zeros(),
-            Align::Velocity => cell.state.velocity,
-            Align::Force => cell.state.force,
-            Align::Shape => {
-                let (magnitude, axis) = cell.state.shape.axis();
-                let axis = if axis.dot(&p) < 0.0 { -axis } else { axis };
-                magnitude * axis
+    fn target(&self, cell: &CellContext<'_>, theta: f64) -> [f64; 2] {
+        let s = cell.state;
+        alignment_target(
+            self.align,
+            [s.velocity.x, s.velocity.y],
+            [s.force.x, s.force.y],
+            s.shape.components(),
+            theta,
+        )
+    }
+}
+
+/// The alignment target of a cell whose polarity angle is `theta` ([`Align`]): its velocity
+/// `v`, its interface force `f`, or its long axis `|S| n` (`S = [S_xx, S_xy]`, traceless:
+/// the eigenvalue `|S| = √(S_xx² + S_xy²)` along `n = (cos φ, sin φ)`, `φ = ½ atan2(S_xy,
+/// S_xx)`, turned to the end nearer the polarity); zero for [`Align::None`]. The GPU's
+/// `polarity_target` is checked against this.
+pub fn alignment_target(
+    align: Align,
+    v: [f64; 2],
+    f: [f64; 2],
+    s: [f64; 2],
+    theta: f64,
+) -> [f64; 2] {
+    match align {
+        Align::None => [0.0; 2],
+        Align::Velocity => v,
+        Align::Force => f,
+        Align::Shape => {
+            let magnitude = s[0].hypot(s[1]);
+            if magnitude == 0.0 {
+                return [0.0; 2];
             }
+            let (sin, cos) = (0.5 * s[1].atan2(s[0])).sin_cos();
+            let p = direction(theta);
+            let m = if cos * p.x + sin * p.y < 0.0 {
+                -magnitude
+            } else {
+                magnitude
+            };
+            [m * cos, m * sin]
         }
+    }
+}
+
+/// The propulsion `m p` of a cell whose polarity angle is `theta`, from its magnitude
+/// `magnitude` (`α`, or `α A_i` spread as a density) and its interface force `f`: with
+/// contact inhibition `eta > 0` the magnitude stalls to `m = magnitude exp(−η max(0, −f·p) /
+/// |magnitude|)`. The GPU's `polarity_force` is checked against this.
+pub fn propulsion(magnitude: f64, eta: f64, f: [f64; 2], theta: f64) -> [f64; 2] {
+    let p = direction(theta);
+    let mut m = magnitude;
+    if eta > 0.0 && m != 0.0 {
+        let against = (-(f[0] * p.x + f[1] * p.y)).max(0.0);
+        m *= (-eta * against / m.abs()).exp();
+    }
+    [m * p.x, m * p.y]
+}
+
+/// The alignment rate `dθ/dt = −J |t| Δ(t, p)` of a polarity angle `theta` towards the
+/// target `t` at rate `rate` (`J`), zero for a zero target. The GPU's `polarity_rate` is
+/// checked against this.
+pub fn alignment_rate(rate: f64, t: [f64; 2], theta: f64) -> f64 {
+    let t = Vector2::from(t);
+    let norm = t.norm();
+    if norm > 0.0 {
+        -rate * norm * signed_angle(t, direction(theta))
+    } else {
+        0.0
     }
 }
 
@@ -196,16 +254,12 @@ impl CellTerm for Polarity {
             return [0.0; 2];
         }
         let [alpha, ..] = self.values(cell.population);
-        let mut magnitude = match self.propulsion {
+        let magnitude = match self.propulsion {
             Propulsion::Cell => alpha,
             Propulsion::Density => alpha * cell.state.area,
         };
-        let p = direction(x[0]);
-        if self.contact_inhibition > 0.0 && magnitude != 0.0 {
-            let against = (-cell.state.force.dot(&p)).max(0.0);
-            magnitude *= (-self.contact_inhibition * against / magnitude.abs()).exp();
-        }
-        [magnitude * p.x, magnitude * p.y]
+        let f = cell.state.force;
+        propulsion(magnitude, self.contact_inhibition, [f.x, f.y], x[0])
     }
 
     fn rate(&self, cell: &CellContext<'_>, x: &[f64], out: &mut [f64]) {
@@ -214,12 +268,7 @@ impl CellTerm for Polarity {
         if !cell.active || self.align == Align::None || rate == 0.0 {
             return;
         }
-        let p = direction(x[0]);
-        let f = self.target(cell, p);
-        let norm = f.norm();
-        if norm > 0.0 {
-            out[0] = -rate * norm * signed_angle(f, p);
-        }
+        out[0] = alignment_rate(rate, self.target(cell, x[0]), x[0]);
     }
 
     fn stiffness(&self, cell: &CellContext<'_>, x: &[f64]) -> f64 {
@@ -228,7 +277,8 @@ impl CellTerm for Polarity {
             return 0.0;
         }
         // dθ/dt = −J|f| Δ(f, p): near alignment a relaxation at the rate J|f|.
-        rate * self.target(cell, direction(x[0])).norm()
+        let [tx, ty] = self.target(cell, x[0]);
+        rate * tx.hypot(ty)
     }
 
     fn noise(&self, cell: &CellContext<'_>, out: &mut [f64]) {

@@ -15,6 +15,11 @@
 use phasefield::EnergyCoefficients;
 
 use super::NoiseKey;
+
+/// The `stage` of the keys of the shuffle that assigns cells to populations: apart from the
+/// terms' and the division clock's (which had used `1 << 61` too, so that with one seed a
+/// cell's population and its cycle time were drawn from the same numbers).
+const SHUFFLE_STAGE: u64 = 1 << 60;
 use crate::ModelParams;
 
 /// The parameters one population overrides; `None` takes the tissue's.
@@ -119,7 +124,7 @@ impl Populations {
                 seed,
                 cell: i as u64,
                 step: 0,
-                stage: 1 << 61,
+                stage: SHUFFLE_STAGE,
             }
             .uniform();
             let j = ((u * (i + 1) as f64) as usize).min(i);
