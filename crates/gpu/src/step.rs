@@ -17,6 +17,7 @@ use crate::device::{Device, GpuError};
 /// field); a tissue with any other part of [`mechanics::Part::ALL`] is refused by
 /// [`GpuBackend::check`], naming it.
 pub const SUPPORTED: &[mechanics::Part] = &[
+    mechanics::Part::Terms,
     mechanics::Part::Adhesion,
     mechanics::Part::Populations,
     mechanics::Part::Walls,
@@ -28,6 +29,8 @@ const WG: u32 = 256;
 const MAX_GROUPS: u32 = 65_535;
 /// Floats per cell in the cell buffer (the shader's `CELL_STRIDE`).
 const CELL_STRIDE: usize = 12;
+/// Floats per cell of the polarity's buffer (`pol` in step.wgsl).
+const POL_STRIDE: usize = 8;
 /// Steps recorded before they are submitted.
 const BATCH: usize = 16;
 
@@ -37,6 +40,19 @@ const SOURCE: &str = include_str!("step.wgsl");
 /// `cap` cells per bin: the file `step.wgsl` after its constants.
 pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String {
     shader_source_split(shape, kind, cap, u32::MAX)
+}
+
+/// The code of what a polarity aligns to in the kernels (`Params::pol_align`); `None` for a
+/// rule they do not know.
+fn align_code(align: mechanics::terms::Align) -> Option<u32> {
+    use mechanics::terms::Align;
+    match align {
+        Align::None => Some(0),
+        Align::Velocity => Some(1),
+        Align::Force => Some(2),
+        Align::Shape => Some(3),
+        _ => None,
+    }
 }
 
 /// [`shader_source`] with the lattice arrays split into two bindings at node `split`.
@@ -146,10 +162,29 @@ shared_struct! {
         /// The cells' adhesion coefficient `c = 2ωλ`
         /// ([`mechanics::equations::adhesion_coefficient`]; 0 without adhesion).
         adhesion: f32,
+        /// What the polarity aligns to (`POLARITY`): 0 nothing, 1 the velocity, 2 the
+        /// interface force, 3 the long axis ([`mechanics::terms::Align`]).
+        pol_align: u32,
+        /// 1 when the propulsion is a density (`α A_i`), 0 a whole-cell force (`α`).
+        pol_density: u32,
+        /// Contact inhibition of locomotion η ([`mechanics::terms::Polarity`]).
+        pol_inhibition: f32,
+        /// 1 while activity is on (the active terms act only then).
+        pol_active: u32,
+        /// The seed of the terms' noise, low and high words (Philox's key).
+        seed_lo: u32,
+        /// The seed's high word.
+        seed_hi: u32,
+        /// The iteration of the state on the device when it was last synced or uploaded,
+        /// low and high words: a step's noise is drawn for `step + status.steps`.
+        step_lo: u32,
+        /// Its high word.
+        step_hi: u32,
+        /// The polarity's noise stage, folded to 32 bits (`terms::NoiseKey`: its place `t`
+        /// among the terms, `t << 16`).
+        pol_stage: u32,
         /// Padding to 16 bytes.
-        pad1: u32,
-        /// Padding to 16 bytes.
-        pad2: u32,
+        pad0: u32,
     }
 }
 
@@ -170,10 +205,18 @@ shared_struct! {
         /// The weight of its `S_i` in the active stress (its ζ when the populations' ζ differ,
         /// 1 otherwise).
         zeta_weight: f32,
+        /// Its propulsion `α` (0 without polarity).
+        alpha: f32,
+        /// The amplitude `√(2 D_r)` of its polarity's noise.
+        noise: f32,
+        /// Its alignment rate `J`.
+        align_rate: f32,
         /// Padding to 16 bytes.
         pad0: u32,
         /// Padding to 16 bytes.
         pad1: u32,
+        /// Padding to 16 bytes.
+        pad2: u32,
     }
 }
 
@@ -213,7 +256,7 @@ pub struct GpuMemory {
 impl GpuMemory {
     /// The device memory of `n_cells` cells on patches of `shape` on `lattice`, stepped with
     /// `npc` corrector passes, with the extensions `parts` (walls and adhesion hold 8 bytes a
-    /// lattice node each).
+    /// lattice node each, polarity 32 bytes a cell).
     pub fn estimate(
         lattice: Lattice,
         shape: &PatchShape,
@@ -229,11 +272,17 @@ impl GpuMemory {
                 _ => 0,
             })
             .sum();
+        // The polarity's row of each cell.
+        let per_cell_parts = if parts.contains(&mechanics::Part::Terms) {
+            POL_STRIDE as u64 * 4
+        } else {
+            0
+        };
         let phi_array = n * shape.len() as u64 * 4;
         let phi_arrays = if npc >= 2 { 4 } else { 3 };
         let (nb, cap) = bins(lattice, shape, n_cells);
         let total = phi_arrays * phi_array
-            + n * (CELL_STRIDE as u64 * 4 + 8)
+            + n * (CELL_STRIDE as u64 * 4 + 8 + per_cell_parts)
             + lattice.len() as u64 * (16 + 32 + per_node_parts)
             + u64::from(nb) * (4 + 4 * u64::from(cap))
             + (lattice.lx + lattice.ly) as u64 * 8;
@@ -313,6 +362,8 @@ struct Pipelines {
     adhesion: Option<wgpu::ComputePipeline>,
     predict: wgpu::ComputePipeline,
     correct: wgpu::ComputePipeline,
+    /// With polarity, the angle's predictor and corrector (`polarity_update`).
+    polarity: Option<[wgpu::ComputePipeline; 2]>,
     correct_last: wgpu::ComputePipeline,
     count: wgpu::ComputePipeline,
     /// The observables' tissue velocity and its Σ |v|² per workgroup.
@@ -369,6 +420,9 @@ pub struct GpuBackend {
     _adhesion_buffers: [wgpu::Buffer; 2],
     /// Σ |v|² per workgroup of the lattice ([`GpuBackend::observables`]).
     v2_part: wgpu::Buffer,
+    /// With polarity, each cell's angle and its step's scratch (`POL_STRIDE` floats a slot).
+    pol: wgpu::Buffer,
+    polarity: bool,
     /// Bytes copied from the device to the host so far ([`GpuBackend::bytes_read`]).
     bytes_read: Arc<AtomicU64>,
     groups_cells: (u32, u32),
@@ -408,7 +462,24 @@ impl GpuBackend {
     /// # Errors
     /// [`GpuError::Unsupported`] or [`GpuError::Setting`].
     pub fn check<T: Real>(tissue: &Tissue<T>, step: &StepParams) -> Result<(), GpuError> {
-        let ext = mechanics::backend::unsupported(tissue, SUPPORTED);
+        let mut ext = mechanics::backend::unsupported(tissue, SUPPORTED);
+        // Of the physics terms, the device runs the built-in polarity (`polarity_update` and
+        // the propulsion in the force pass); a term written in Rust or Python runs on the host.
+        let terms = tissue.terms();
+        let polarity = terms.polarity().map(|(t, _)| t);
+        for (t, term) in terms.iter().enumerate() {
+            if Some(t) != polarity {
+                ext.push(format!(
+                    "the physics term {:?} (a CellTerm of your own, which runs on the host)",
+                    term.name()
+                ));
+            }
+        }
+        if let Some((_, p)) = terms.polarity() {
+            if align_code(p.align).is_none() {
+                ext.push(format!("polarity aligning to {:?}", p.align));
+            }
+        }
         if !ext.is_empty() {
             return Err(GpuError::Unsupported(ext.join(", ")));
         }
@@ -589,8 +660,16 @@ impl GpuBackend {
             wall_repulsion: 0.0,
             wall_adhesion: 0.0,
             adhesion: 0.0,
-            pad1: 0,
-            pad2: 0,
+            pol_align: 0,
+            pol_density: 0,
+            pol_inhibition: 0.0,
+            pol_active: 0,
+            seed_lo: 0,
+            seed_hi: 0,
+            step_lo: 0,
+            step_hi: 0,
+            pol_stage: 0,
+            pad0: 0,
         };
         // The wall field (w, ∇²w per node), written by `set_uniforms` whenever the field in
         // effect changes (a wound opens when the activity starts); a placeholder without walls.
@@ -622,6 +701,18 @@ impl GpuBackend {
             copy,
         );
         let a = f64::from(u8::from(adhesion));
+        // With polarity, each cell's angle and its step's scratch (`POL_STRIDE` floats).
+        let polarity = tissue.terms().polarity().is_some();
+        let pol = storage(
+            "polarity",
+            if polarity {
+                (n * POL_STRIDE * 4) as u64
+            } else {
+                16
+            },
+            copy,
+        );
+        let pf = f64::from(u8::from(polarity));
         // Σ |v|² per workgroup of the lattice, for the observables.
         let v2_part = storage(
             "v2 per workgroup",
@@ -687,6 +778,7 @@ impl GpuBackend {
         entries.push(storage_entry(20, false));
         entries.push(storage_entry(21, false));
         entries.push(storage_entry(22, false));
+        entries.push(storage_entry(23, false));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: 18,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -729,22 +821,43 @@ impl GpuBackend {
             adhesion: adhesion.then(|| pipeline("adhesion_lattice", &[])),
             predict: pipeline(
                 "force_update",
-                &[("MODE", 0.0), ("WALLS", w), ("ADHESION", a)],
+                &[
+                    ("MODE", 0.0),
+                    ("WALLS", w),
+                    ("ADHESION", a),
+                    ("POLARITY", pf),
+                ],
             ),
             correct: pipeline(
                 "force_update",
-                &[("MODE", 1.0), ("WALLS", w), ("ADHESION", a)],
+                &[
+                    ("MODE", 1.0),
+                    ("WALLS", w),
+                    ("ADHESION", a),
+                    ("POLARITY", pf),
+                ],
             ),
             correct_last: pipeline(
                 "force_update",
-                &[("MODE", 2.0), ("WALLS", w), ("ADHESION", a)],
+                &[
+                    ("MODE", 2.0),
+                    ("WALLS", w),
+                    ("ADHESION", a),
+                    ("POLARITY", pf),
+                ],
             ),
+            polarity: polarity.then(|| {
+                [
+                    pipeline("polarity_update", &[("MODE", 0.0)]),
+                    pipeline("polarity_update", &[("MODE", 1.0)]),
+                ]
+            }),
             count: pipeline("count_step", &[]),
             velocity_sums: pipeline("velocity_sums", &[]),
             velocity_reduce: pipeline("velocity_reduce", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 23] = [
+            let bufs: [&wgpu::Buffer; 24] = [
                 &params_buf,
                 x,
                 old,
@@ -768,6 +881,7 @@ impl GpuBackend {
                 &adh_s1,
                 &adh_lap,
                 &v2_part,
+                &pol,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -827,6 +941,8 @@ impl GpuBackend {
             adhesion,
             _adhesion_buffers: [adh_s1, adh_lap],
             v2_part,
+            pol,
+            polarity,
             bytes_read: Arc::new(AtomicU64::new(0)),
             lattice,
             shape,
@@ -868,10 +984,25 @@ impl GpuBackend {
                 inv_target_area: c.coef.inv_target_area as f32,
                 xi: c.xi as f32,
                 zeta_weight: c.zeta_weight as f32,
+                alpha: 0.0,
+                noise: 0.0,
+                align_rate: 0.0,
                 pad0: 0,
                 pad1: 0,
+                pad2: 0,
             };
         }
+        let polarity = tissue.terms().polarity();
+        if let Some((_, pol)) = polarity {
+            for (k, kind) in kinds.iter_mut().enumerate().take(constants.len()) {
+                let [alpha, d_r, rate] = pol.values(k);
+                kind.alpha = alpha as f32;
+                kind.noise = (2.0 * d_r).sqrt() as f32;
+                kind.align_rate = rate as f32;
+            }
+        }
+        let seed = tissue.terms().seed();
+        let (iteration, _) = self.base;
         let [wall_repulsion, wall_adhesion] = match (tissue.walls(), tissue.wall_field()) {
             (Some(w), Some(_)) => {
                 mechanics::equations::wall_coefficients(w.kappa, w.omega, p.energy.lambda)
@@ -891,6 +1022,17 @@ impl GpuBackend {
             zeta: zeta as f32,
             xi: p.xi as f32,
             dt: dt as f32,
+            pol_align: polarity.and_then(|(_, p)| align_code(p.align)).unwrap_or(0),
+            pol_density: polarity.map_or(0, |(_, p)| {
+                u32::from(p.propulsion == mechanics::terms::Propulsion::Density)
+            }),
+            pol_inhibition: polarity.map_or(0.0, |(_, p)| p.contact_inhibition as f32),
+            pol_active: u32::from(tissue.active()),
+            seed_lo: seed as u32,
+            seed_hi: (seed >> 32) as u32,
+            step_lo: iteration as u32,
+            step_hi: (iteration >> 32) as u32,
+            pol_stage: polarity.map_or(0, |(t, _)| (t as u32) << 16),
             ..self.params
         };
         (params, kinds)
@@ -980,11 +1122,22 @@ impl GpuBackend {
             row[11] = f32::from_bits(pops.population(id) as u32);
         }
         q.write_buffer(&self.cell, 0, bytemuck::cast_slice(&per_cell));
+        // The polarity's angle of each slot and its identity (the noise's key); the area of
+        // the last evaluation starts at zero, as a host's workspace does.
+        if self.polarity {
+            let theta = polarity_angles(tissue);
+            let mut rows = vec![0.0f32; self.n_cells * POL_STRIDE];
+            for (row, &id) in rows.chunks_exact_mut(POL_STRIDE).zip(ids) {
+                row[0] = theta[id] as f32;
+                row[5] = f32::from_bits(id as u32);
+            }
+            q.write_buffer(&self.pol, 0, bytemuck::cast_slice(&rows));
+        }
+        self.base = (tissue.iteration(), tissue.time());
+        self.queued.clear();
         let dt = f64::from(self.params.dt);
         self.params.dt = f32::NAN; // written whatever it was
         self.set_uniforms(tissue, dt);
-        self.base = (tissue.iteration(), tissue.time());
-        self.queued.clear();
         Ok(())
     }
 
@@ -1089,6 +1242,14 @@ impl GpuBackend {
                 pass.set_bind_group(0, g, &[]);
                 pass.dispatch_workgroups(cx, cy, 1);
             }
+            // The polarity's predictor after the first evaluation, its corrector after the
+            // others; not in an evaluation alone.
+            if let (Some(polarity), false) = (&p.polarity, evaluate_only) {
+                let first = std::ptr::eq(force, &p.predict);
+                pass.set_pipeline(&polarity[usize::from(!first)]);
+                pass.set_bind_group(0, &group[0], &[]);
+                pass.dispatch_workgroups((self.n_cells as u32).div_ceil(WG), 1, 1);
+            }
         }
         if !evaluate_only {
             pass.set_pipeline(&p.count);
@@ -1135,7 +1296,8 @@ impl GpuBackend {
     /// The extensions add, per evaluation: walls 8 bytes a patch node (the force pass reads
     /// (w, ∇²w)) and 8 a lattice node (the lattice pass reads them); adhesion 4 bytes a patch
     /// node (the force pass reads ∇²s1) and 44 a lattice node (the lattice pass writes s1, the
-    /// adhesion pass reads it, writes ∇²s1 and reads and writes `P, s2, Q`).
+    /// adhesion pass reads it, writes ∇²s1 and reads and writes `P, s2, Q`); polarity 68
+    /// bytes a cell and evaluation (0.15 B a node-update on patches of 30²).
     pub fn bytes_per_node_update(&self) -> f64 {
         let predictor = 4.0 + 4.0 + 4.0 + 16.0 + 8.0;
         let corrector = predictor + 8.0;
@@ -1150,7 +1312,14 @@ impl GpuBackend {
         let parts_patch = 8.0 * walls + 4.0 * adhesion;
         let parts_lattice = 8.0 * walls + 44.0 * adhesion;
         let lattice = (16.0 + chunks + parts_lattice) * (1.0 + correctors) * per_patch_node;
-        predictor + correctors * corrector + parts_patch * (1.0 + correctors) + lattice
+        // The polarity: per cell and evaluation, the force pass reads 3 floats and writes 1,
+        // and its update reads 9 and writes up to 4: 68 bytes a cell, counted per patch node.
+        let polarity = if self.polarity {
+            68.0 * (1.0 + correctors) / self.shape.len() as f64
+        } else {
+            0.0
+        };
+        predictor + correctors * corrector + parts_patch * (1.0 + correctors) + lattice + polarity
     }
 
     /// The number of chunks the per-cell arrays are split into.
@@ -1366,6 +1535,24 @@ impl<T: Real> Backend<T> for GpuBackend {
             tissue.centres().to_vec()
         };
         tissue.set_state_from_device(&phi, &origins, &centres);
+        let pol: Vec<f32> = if self.polarity {
+            let bytes = self
+                .read(&self.pol, (self.n_cells * POL_STRIDE * 4) as u64)
+                .map_err(|e| Self::error(e.to_string()))?;
+            bytemuck::cast_slice(&bytes).to_vec()
+        } else {
+            Vec::new()
+        };
+        if self.polarity {
+            let mut theta = polarity_angles(tissue);
+            for (row, &id) in pol.chunks_exact(POL_STRIDE).zip(tissue.cell_ids()) {
+                theta[id] = f64::from(row[0]);
+            }
+            tissue
+                .terms_mut()
+                .set_variable("polarity/theta", &theta)
+                .map_err(Self::error)?;
+        }
         let done = steps as usize;
         let time = self.base.1 + self.queued.iter().take(done).sum::<f64>();
         let iteration = self.base.0 + done as u64;
@@ -1384,6 +1571,16 @@ impl<T: Real> Backend<T> for GpuBackend {
             let slot = cell as usize;
             let q = &quantities[slot * CELL_STRIDE..(slot + 1) * CELL_STRIDE];
             let (lo, hi) = (f64::from(q[3]), f64::from(q[4]));
+            if failed == 3 {
+                return Err(StepError::TermUnstable {
+                    step: iteration,
+                    time,
+                    term: "polarity".into(),
+                    cell: tissue.cell_ids()[slot],
+                    stiffness: f64::from(pol[slot * POL_STRIDE + 6]),
+                    dt,
+                });
+            }
             return Err(if failed == 2 {
                 StepError::NonFinite {
                     step: iteration,
@@ -1413,6 +1610,15 @@ impl<T: Real> Backend<T> for GpuBackend {
         self.observables(tissue)
             .map_err(|e| Self::error(e.to_string()))
     }
+}
+
+/// The polarity's angle of every identity, as the host holds it.
+fn polarity_angles<T: Real>(tissue: &Tissue<T>) -> Vec<f64> {
+    tissue
+        .terms()
+        .state("polarity")
+        .map(<[f64]>::to_vec)
+        .unwrap_or_default()
 }
 
 impl GpuBackend {

@@ -55,7 +55,7 @@ fn equations(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     // The cell's constants, which the equations read (`use_cell` in the step): the tissue's.
-    kc = Kind(prm.double_well, prm.gradient, prm.area, prm.inv_target_area, prm.xi, 1.0, 0u, 0u);
+    kc = Kind(prm.double_well, prm.gradient, prm.area, prm.inv_target_area, prm.xi, 1.0, 0.0, 0.0, 0.0, 0u, 0u, 0u);
     let x = i * 16u;
     let phi = eq_in[x];
     let lap = eq_in[x + 1u];
@@ -144,33 +144,50 @@ fn run_kernel(
     xi: f32,
     input: &[f32],
 ) -> Vec<f32> {
-    let (d, q) = device.raw();
     let shape = PatchShape::new(Lattice::new(64, 64), 8).unwrap();
     let source = gpu::shader_source(&shape, kind, 32) + HARNESS;
+    let params = params_bytes(coef, zeta, xi);
+    let out = run_harness(
+        device,
+        &source,
+        "equations",
+        Some(&params),
+        bytemuck::cast_slice(input),
+        input.len() / IN * OUT,
+    );
+    bytemuck::cast_slice(&out).to_vec()
+}
+
+/// Runs the entry point `entry` of `source` over its input array (`@group(1) @binding(0)`)
+/// into `out_words` 32-bit words (`@group(1) @binding(1)`), one invocation per 64 words out
+/// and fewer, with `params` as the uniform block `prm` where the kernel reads it.
+fn run_harness(
+    device: &gpu::Device,
+    source: &str,
+    entry: &str,
+    params: Option<&[u8]>,
+    input: &[u8],
+    out_words: usize,
+) -> Vec<u32> {
+    let (d, q) = device.raw();
     let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("equations"),
+        label: Some(entry),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("equations"),
+        label: Some(entry),
         layout: None,
         module: &module,
-        entry_point: Some("equations"),
+        entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
     });
-    let n = input.len() / IN;
-    let prm = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: &params_bytes(coef, zeta, xi),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
     let inp = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: None,
-        contents: bytemuck::cast_slice(input),
+        contents: input,
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let bytes = (n * OUT * 4) as u64;
+    let bytes = (out_words * 4) as u64;
     let out = d.create_buffer(&wgpu::BufferDescriptor {
         label: None,
         size: bytes,
@@ -183,13 +200,20 @@ fn run_kernel(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: prm.as_entire_binding(),
-        }],
+    let g0 = params.map(|params| {
+        let prm = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: params,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: prm.as_entire_binding(),
+            }],
+        })
     });
     let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
@@ -209,9 +233,11 @@ fn run_kernel(
     {
         let mut pass = enc.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &g0, &[]);
+        if let Some(g0) = &g0 {
+            pass.set_bind_group(0, g0, &[]);
+        }
         pass.set_bind_group(1, &g1, &[]);
-        pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
+        pass.dispatch_workgroups((out_words as u32).div_ceil(64), 1, 1);
     }
     enc.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
     q.submit(Some(enc.finish()));
@@ -394,5 +420,198 @@ fn every_wgsl_equation_matches_its_rust_reference() {
         for (name, w) in NAMES.iter().zip(worst) {
             println!("{kind:?}: {name}: worst error {w:.2e} of its scale (bound {ULPS:.1e})");
         }
+    }
+}
+
+/// The polarity's functions and Philox's (`mechanics::terms`): per sample, in 32-bit words,
+/// θ, f, v, S, a magnitude, η and J (as f32 bits), then Philox's counter and key.
+const POLARITY_IN: usize = 16;
+/// Per sample: the propulsion (2), the alignment targets for the velocity, the force and the
+/// shape (2 each), the rate towards each (3), Philox's four words and the normal deviate of
+/// the last two.
+const POLARITY_OUT: usize = 16;
+
+const POLARITY_HARNESS: &str = r#"
+@group(1) @binding(0) var<storage, read> pol_in: array<u32>;
+@group(1) @binding(1) var<storage, read_write> pol_out: array<u32>;
+
+@compute @workgroup_size(64)
+fn polarity_equations(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= arrayLength(&pol_out) / 16u) {
+        return;
+    }
+    let x = i * 16u;
+    let w = function_inputs(x);
+    let theta = w[0];
+    let f = vec2<f32>(w[1], w[2]);
+    let v = vec2<f32>(w[3], w[4]);
+    let s = vec2<f32>(w[5], w[6]);
+    let o = i * 16u;
+    let fp = polarity_force(w[7], w[8], f, theta);
+    pol_out[o] = bitcast<u32>(fp.x);
+    pol_out[o + 1u] = bitcast<u32>(fp.y);
+    for (var a = 1u; a <= 3u; a++) {
+        let t = polarity_target(a, v, f, s, theta);
+        pol_out[o + 2u * a] = bitcast<u32>(t.x);
+        pol_out[o + 2u * a + 1u] = bitcast<u32>(t.y);
+        pol_out[o + 7u + a] = bitcast<u32>(polarity_rate(w[9], t, theta));
+    }
+    let words = philox4x32_10(
+        vec4<u32>(pol_in[x + 10u], pol_in[x + 11u], pol_in[x + 12u], pol_in[x + 13u]),
+        vec2<u32>(pol_in[x + 14u], pol_in[x + 15u]),
+    );
+    pol_out[o + 11u] = words.x;
+    pol_out[o + 12u] = words.y;
+    pol_out[o + 13u] = words.z;
+    pol_out[o + 14u] = words.w;
+    pol_out[o + 15u] = bitcast<u32>(normal_of_words(words.z, words.w));
+}
+
+fn function_inputs(x: u32) -> array<f32, 10> {
+    var w: array<f32, 10>;
+    for (var k = 0u; k < 10u; k++) {
+        w[k] = bitcast<f32>(pol_in[x + k]);
+    }
+    return w;
+}
+"#;
+
+/// The polarity's WGSL functions (`polarity_force`, `polarity_target`, `polarity_rate`)
+/// against `mechanics::terms::{propulsion, alignment_target, alignment_rate}`, and Philox and
+/// the normal deviate against the host's, on random inputs: Philox to the bit (the same
+/// integer arithmetic), the rest to f32 round-off of their scale. Angles up to ±40 rad (a
+/// polarity's angle is not wrapped), forces and velocities of both signs, contact inhibition
+/// from none to strong.
+#[test]
+fn the_polarity_and_its_noise_match_their_rust_references() {
+    use mechanics::terms::{self, Align};
+    let Some(device) = common::try_device() else {
+        return;
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let n = 4096;
+    let mut input: Vec<u32> = Vec::with_capacity(n * POLARITY_IN);
+    for _ in 0..n {
+        let floats = [
+            rng.random_range(-40.0f32..40.0),
+            rng.random_range(-0.05f32..0.05),
+            rng.random_range(-0.05f32..0.05),
+            rng.random_range(-0.05f32..0.05),
+            rng.random_range(-0.05f32..0.05),
+            rng.random_range(-0.3f32..0.3),
+            rng.random_range(-0.3f32..0.3),
+            rng.random_range(-0.1f32..0.1),
+            if rng.random_bool(0.25) {
+                0.0
+            } else {
+                rng.random_range(0.0f32..3.0)
+            },
+            rng.random_range(0.0f32..2.0),
+        ];
+        input.extend(floats.iter().map(|v| v.to_bits()));
+        input.extend((0..6).map(|_| rng.random::<u32>()));
+    }
+    let shape = PatchShape::new(Lattice::new(64, 64), 8).unwrap();
+    let source = gpu::shader_source(&shape, PressureKind::Paper, 32) + POLARITY_HARNESS;
+    let out = run_harness(
+        &device,
+        &source,
+        "polarity_equations",
+        None,
+        bytemuck::cast_slice(&input),
+        n * POLARITY_OUT,
+    );
+    let mut worst = [0.0f64; 5];
+    for (x, o) in input
+        .chunks_exact(POLARITY_IN)
+        .zip(out.chunks_exact(POLARITY_OUT))
+    {
+        let w: Vec<f64> = x[..10]
+            .iter()
+            .map(|&b| f64::from(f32::from_bits(b)))
+            .collect();
+        let got = |k: usize| f64::from(f32::from_bits(o[k]));
+        let (theta, f, v, s) = (w[0], [w[1], w[2]], [w[3], w[4]], [w[5], w[6]]);
+        // f32 round-off of a quantity of scale `scale`, after a few operations and the
+        // reduction of an angle of up to 40 rad (ε·40 in the angle).
+        let check = |what: &str, k: usize, want: f64, scale: f64, worst: &mut f64| {
+            let bound = 64.0 * f64::from(f32::EPSILON) * scale;
+            let err = (got(k) - want).abs();
+            *worst = worst.max(err / scale.max(f64::MIN_POSITIVE));
+            assert!(
+                err <= bound,
+                "{what}: {} on the GPU, {want:e} in Rust ({err:.2e} > {bound:.2e}; inputs {w:?})",
+                got(k)
+            );
+        };
+        // The angle is reduced to [−π, π] in f32 first: an error of ε |θ| in the direction,
+        // which contact inhibition's exponent `η max(0, −f·p)/|m|` amplifies by its slope.
+        let reduced = 1.0 + theta.abs() / std::f64::consts::PI;
+        let fp = terms::propulsion(w[7], w[8], f, theta);
+        let exponent = 1.0 + w[8] * f[0].hypot(f[1]) / w[7].abs().max(f64::MIN_POSITIVE);
+        for (k, want) in fp.into_iter().enumerate() {
+            let scale = w[7].abs() * reduced * exponent;
+            check("polarity_force", k, want, scale, &mut worst[0]);
+        }
+        for (a, align) in [Align::Velocity, Align::Force, Align::Shape]
+            .into_iter()
+            .enumerate()
+        {
+            let t = terms::alignment_target(align, v, f, s, theta);
+            let scale = t[0].hypot(t[1]);
+            // Near a shape's degenerate axis (S ≈ 0) or a polarity at right angles to the
+            // axis (the end chosen by a sign) the target is ill-conditioned: skipped there.
+            let ambiguous = align == Align::Shape && {
+                let (sin, cos) = (0.5 * s[1].atan2(s[0])).sin_cos();
+                (cos * theta.cos() + sin * theta.sin()).abs() < 1e-3
+            };
+            if ambiguous {
+                continue;
+            }
+            for c in 0..2 {
+                check(
+                    "polarity_target",
+                    2 + 2 * a + c,
+                    t[c],
+                    scale * reduced,
+                    &mut worst[1],
+                );
+            }
+            let rate = terms::alignment_rate(w[9], t, theta);
+            check(
+                "polarity_rate",
+                8 + a,
+                rate,
+                w[9] * scale * 4.0,
+                &mut worst[2],
+            );
+        }
+        let mut counter = [0u32; 4];
+        counter.copy_from_slice(&x[10..14]);
+        let words = terms::philox4x32_10(counter, [x[14], x[15]]);
+        assert_eq!(&o[11..15], &words, "philox4x32_10 of {counter:x?}");
+        let normal = terms::normal_of_words(words[2], words[3]);
+        // The deviate's round-off: f32's in ln u₁ (relative, `minus_log_uniform`) and in the
+        // cosine's argument (absolute, about 2π ε).
+        let bound = 64.0 * f64::from(f32::EPSILON) * (1.0 + normal.abs());
+        let err = (got(15) - normal).abs();
+        worst[3] = worst[3].max(err);
+        assert!(
+            err <= bound,
+            "normal_of_words: {} on the GPU, {normal} in Rust",
+            got(15)
+        );
+    }
+    for (name, w) in [
+        "polarity_force",
+        "polarity_target",
+        "polarity_rate",
+        "normal_of_words (absolute)",
+    ]
+    .iter()
+    .zip(worst)
+    {
+        println!("{name}: worst error {w:.2e} of its scale");
     }
 }
