@@ -63,18 +63,14 @@ fn check_gpu(scene: &Scene) -> Result<()> {
 
 #[cfg(feature = "gpu")]
 fn check_gpu(scene: &Scene) -> Result<()> {
-    let unsupported: Vec<mechanics::Part> = scene
-        .parts()
-        .into_iter()
-        .filter(|p| !gpu::SUPPORTED.contains(p))
-        .collect();
+    let unsupported = gpu::unsupported(
+        &scene.configured_extensions(),
+        &scene.model_params(scene.zeta()),
+    );
     if !unsupported.is_empty() {
-        let named: Vec<String> = unsupported.iter().map(|p| p.describe()).collect();
-        let tables: Vec<&str> = unsupported.iter().map(|p| p.scene_table()).collect();
         anyhow::bail!(
-            "[integrator] backend = \"gpu\": the GPU backend does not run {} yet; remove {} to run on the GPU, or set backend = \"cpu\"",
-            named.join(", "),
-            tables.join(", ")
+            "[integrator] backend = \"gpu\": the GPU backend does not run {} yet; remove them from the scene to run on the GPU, or set backend = \"cpu\"",
+            unsupported.join(", ")
         );
     }
     let kinds = scene.populations().kinds().len();

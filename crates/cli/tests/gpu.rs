@@ -175,7 +175,6 @@ fn a_checkpoint_resumes_on_the_other_backend() {
 fn the_gpu_refuses_what_it_does_not_run_by_name() {
     let dir = tempfile::tempdir().unwrap();
     for (scene, set, says) in [
-        ("walker.toml", "run.time=1", "[polarity]"),
         ("proliferation.toml", "run.time=1", "[division]"),
         ("paper.toml", "integrator.adaptive=true", "adaptive"),
         ("paper.toml", "integrator.npc=0", "npc"),
@@ -238,33 +237,27 @@ fn the_gpu_refuses_more_populations_than_it_holds_before_writing() {
     assert!(!out.exists(), "nothing written");
 }
 
-/// Scenes with the extensions the GPU runs, populations (`sorting.toml`: two populations of
-/// opposite ζ), walls (`channel.toml`; `wound.toml`, whose wall goes when the activity
-/// starts; here without its `[polarity]`, which the GPU does not run yet) and adhesion
-/// (`doublet.toml`, two cells that adhere), run on the GPU and
-/// follow the CPU's run: every row of `series.csv` agrees in
-/// v_rms, S_rms and the mean area to 1e-3 of its value (f32 round-off amplified over the
-/// steps, as across a resume).
+/// Every shipped scene the GPU runs (all but those with `[division]`): the paper's model
+/// (`paper.toml` is the bit-identity test's), populations (`sorting.toml`, two populations of
+/// opposite ζ), walls (`channel.toml`), adhesion (`doublet.toml`, two cells that adhere) and
+/// polarity (`polar.toml`; `walker.toml`, one cell; `disc.toml`, aligning to the velocity in
+/// a disc wall; `wound.toml`, whose wall goes when the activity starts), run on the GPU and
+/// follow the CPU's run: every row of `series.csv` agrees in v_rms, S_rms and the mean area
+/// to 1e-3 of its value (f32 round-off amplified over the steps, as across a resume). The
+/// polar scenes' noise is the same on both (Philox from the same keys).
 #[test]
-fn scenes_with_populations_walls_and_adhesion_run_on_the_gpu_as_on_the_cpu() {
+fn shipped_scenes_run_on_the_gpu_as_on_the_cpu() {
     let dir = tempfile::tempdir().unwrap();
-    // The wound without its [polarity] table.
-    let wound = std::fs::read_to_string(scene_path("wound.toml")).unwrap();
-    let (head, tail) = wound.split_at(wound.find("[polarity]").unwrap());
-    let rest = tail.find("\n\n").map_or("", |k| &tail[k..]);
-    let still = dir.path().join("wound-without-polarity-scene.toml");
-    std::fs::write(&still, format!("{head}{rest}")).unwrap();
     for scene in [
         "sorting.toml",
         "channel.toml",
-        "wound-without-polarity.toml",
         "doublet.toml",
+        "polar.toml",
+        "walker.toml",
+        "disc.toml",
+        "wound.toml",
     ] {
-        let path = if scene.starts_with("wound") {
-            still.clone()
-        } else {
-            scene_path(scene)
-        };
+        let path = scene_path(scene);
         let run = |backend: &str| {
             let out = dir.path().join(scene).join(backend);
             let o = bin()
@@ -291,8 +284,12 @@ fn scenes_with_populations_walls_and_adhesion_run_on_the_gpu_as_on_the_cpu() {
         for name in ["v_rms", "s_rms", "area_mean"] {
             let k = head.iter().position(|h| h == name).unwrap();
             for (a, b) in g.iter().zip(&c) {
+                // Plus, for S_rms, 1e-6: f32 round-off of the deformation tensor's terms
+                // (of order 1, 1e-7 in one evaluation), which cancel in a round cell
+                // (walker.toml's S_rms is 1.6e-6).
+                let floor = if name == "s_rms" { 1e-6 } else { 0.0 };
                 assert!(
-                    (a[k] - b[k]).abs() <= 1e-3 * b[k].abs(),
+                    (a[k] - b[k]).abs() <= 1e-3 * b[k].abs() + floor,
                     "{scene}: {name} at t = {}: {} on the GPU, {} on the CPU",
                     b[1],
                     a[k],

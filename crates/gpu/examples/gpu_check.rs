@@ -47,7 +47,7 @@ fn scene(n: usize, part: &str) -> Result<Scene, String> {
     let l = side(n);
     let extra = match part {
         "minimal" => String::new(),
-        "polarity" => "[polarity]\nalpha = 0.02\nrotational_diffusion = 4.5e-4\n".into(),
+        "polarity" => "[polarity]\nalpha = 0.02\nrotational_diffusion = 4.5e-4\nalign = \"velocity\"\nalign_rate = 1.0\n".into(),
         "populations" => format!(
             "[[population]]\nname = \"a\"\ncount = {}\nzeta = 0.01\n\n[[population]]\nname = \"b\"\ncount = {}\nzeta = -0.01\n",
             n / 2,

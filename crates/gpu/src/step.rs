@@ -42,6 +42,36 @@ pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String
     shader_source_split(shape, kind, cap, u32::MAX)
 }
 
+/// What of the extensions `ext` (with the model's `params`) the GPU backend does not run, each
+/// named: the parts it does not declare ([`SUPPORTED`], with [`mechanics::Part::describe`]),
+/// and of the physics terms every one but the built-in polarity (a `CellTerm` of a user's runs
+/// on the host), or a polarity rule the kernels do not know. Empty: it runs them all. The one
+/// refusal, for a tissue ([`GpuBackend::check`]) and for a scene before anything is written
+/// (the CLI's).
+pub fn unsupported(ext: &mechanics::Extensions, params: &mechanics::ModelParams) -> Vec<String> {
+    let mut out: Vec<String> = mechanics::Part::ALL
+        .into_iter()
+        .filter(|&p| ext.has(p, params) && !SUPPORTED.contains(&p))
+        .map(mechanics::Part::describe)
+        .collect();
+    let terms = ext.terms();
+    let polarity = terms.polarity();
+    for (t, term) in terms.iter().enumerate() {
+        if polarity.map(|(k, _)| k) != Some(t) {
+            out.push(format!(
+                "the physics term {:?} (a CellTerm of your own, which runs on the host)",
+                term.name()
+            ));
+        }
+    }
+    if let Some((_, p)) = polarity {
+        if align_code(p.align).is_none() {
+            out.push(format!("polarity aligning to {:?}", p.align));
+        }
+    }
+    out
+}
+
 /// The code of what a polarity aligns to in the kernels (`Params::pol_align`); `None` for a
 /// rule they do not know.
 fn align_code(align: mechanics::terms::Align) -> Option<u32> {
@@ -462,24 +492,7 @@ impl GpuBackend {
     /// # Errors
     /// [`GpuError::Unsupported`] or [`GpuError::Setting`].
     pub fn check<T: Real>(tissue: &Tissue<T>, step: &StepParams) -> Result<(), GpuError> {
-        let mut ext = mechanics::backend::unsupported(tissue, SUPPORTED);
-        // Of the physics terms, the device runs the built-in polarity (`polarity_update` and
-        // the propulsion in the force pass); a term written in Rust or Python runs on the host.
-        let terms = tissue.terms();
-        let polarity = terms.polarity().map(|(t, _)| t);
-        for (t, term) in terms.iter().enumerate() {
-            if Some(t) != polarity {
-                ext.push(format!(
-                    "the physics term {:?} (a CellTerm of your own, which runs on the host)",
-                    term.name()
-                ));
-            }
-        }
-        if let Some((_, p)) = terms.polarity() {
-            if align_code(p.align).is_none() {
-                ext.push(format!("polarity aligning to {:?}", p.align));
-            }
-        }
+        let ext = unsupported(tissue.extensions(), tissue.params());
         if !ext.is_empty() {
             return Err(GpuError::Unsupported(ext.join(", ")));
         }
