@@ -27,7 +27,9 @@
 #   the adapter; the copy bandwidth; agreement with the CPU (AGREE_CELLS, default 960, after
 #   AGREE_STEPS, default 100); determinism (the state hashed after DET_STEPS, default 100, at
 #   DET_CELLS, default 10⁴, twice); the minimal model's throughput at SIZES (default 10⁴ 10⁵
-#   10⁶); the gpu crate's tests; each extension's throughput at SIZES (or its refusal).
+#   10⁶); the shared-patch variant of the kernels against the plain ones (agreement at
+#   DET_CELLS after DET_STEPS, and the minimal model's throughput at SIZES); the gpu crate's
+#   tests; each extension's throughput at SIZES (or its refusal).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 DIR=$(realpath -m "${GPU_CHECK_DIR:-gpu-check}")
@@ -142,6 +144,11 @@ run() {
     step 120 "$r" "$bin" determinism "${DET_CELLS:-10000}" "${DET_STEPS:-100}"
     local sizes=${SIZES:-10000 100000 1000000}
     for n in $sizes; do step 150 "$r" "$bin" throughput "$n" minimal "${STEPS:-20}"; done
+    # The faster variant against the plain kernels, which only a device can time.
+    step 120 "$r" "$bin" variants "${DET_CELLS:-10000}" "${DET_STEPS:-100}"
+    for n in $sizes; do
+        step 150 "$r" "$bin" throughput "$n" minimal "${STEPS:-20}" shared-patch
+    done
     for t in "$DIR"/bin/test-*; do
         echo "== $(basename "$t")" >>"$out/tests.txt"
         MONOLAYER_GPU_REQUIRED=1 step 120 "$out/tests.txt" "$t" --test-threads 1
@@ -173,13 +180,16 @@ for r in rows:
         rate, b = float(r["node_updates_per_s"]), float(r["bytes_per_node_update"])
         roof = f', {rate * b / (bw * 1e9):.2f} of the copy roof' if bw else ""
         s = float(r["s_per_step"])
-        lines.append(f'{r["part"]:>11} {int(r["cells"]):>8} cells, {r["chunks"]} chunk(s): {rate:.2e} node-updates/s, '
+        lines.append(f'{r["part"]:>11} {r.get("variant", "plain"):>12} {int(r["cells"]):>8} cells, {r["chunks"]} chunk(s): {rate:.2e} node-updates/s, '
                      f'{b} B each{roof}; {s * 1e3:.2f} ms a step, 10^4 TU at dt 0.2 in {s * 5e4 / 60:.1f} min')
     elif c == "throughput":
         lines.append(f'{r["part"]:>11} {int(r["cells"]):>8} cells: refused ({r.get("refused", "?")})')
     elif c == "agree":
         lines.append(f'agreement with the CPU, {r["cells"]} cells, {r["steps"]} steps: max |dphi| {r["max_dphi"]} '
                      f'(bound {r["bound_phi"]}), centres {r["max_dcentre"]} (bound {r["bound_centre"]}): {r["agree"]}')
+    elif c == "variants":
+        lines.append(f'shared-patch against plain, {r["cells"]} cells, {r["steps"]} steps: max |dphi| {r["max_dphi"]} '
+                     f'(bound {r["bound_phi"]}), the same bits: {r["identical"]}; agree: {r["agree"]}')
     elif c == "determinism":
         lines.append(f'determinism, {r["cells"]} cells, {r["steps"]} steps: {r["hash_1"]} {r["hash_2"]}: {r["identical"]}')
     else:
@@ -212,11 +222,18 @@ if one("agree").get("agree", "yes") != "yes":
     bad.append("the GPU does not agree with the CPU")
 if one("determinism").get("identical", "yes") != "yes":
     bad.append("two runs differ")
+if one("variants").get("agree", "yes") != "yes":
+    bad.append("the shared-patch variant does not agree with the plain kernels")
 for p in parts:
     for n in sizes:
-        r = one("throughput", part=p, cells=n)
+        r = one("throughput", part=p, cells=n, variant="plain")
         if r and "node_updates_per_s" not in r and (p == "minimal" or "refused" not in r):
             bad.append(f"throughput {p} {n}: {r}")
+for n in sizes:
+    # The variant may be refused (a device with too little workgroup memory), not fail.
+    r = one("throughput", part="minimal", cells=n, variant="shared-patch")
+    if r and "node_updates_per_s" not in r and "refused" not in r:
+        bad.append(f"throughput minimal shared-patch {n}: {r}")
 tests = open(out + "/tests.txt").read()
 if "test result: ok" not in tests or "FAILED" in tests or "timed out" in tests:
     bad.append("the tests did not all pass (tests.txt)")

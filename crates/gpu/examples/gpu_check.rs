@@ -4,10 +4,13 @@
 //! ```text
 //! gpu_check adapter                     the adapter wgpu chose, and its limits
 //! gpu_check bandwidth MIB               device-to-device copy bandwidth (read + write)
-//! gpu_check throughput N PART [STEPS]   seconds per step at N cells, PART = minimal, polarity,
-//!                                       populations, walls, adhesion or division
+//! gpu_check throughput N PART [STEPS] [VARIANT]
+//!                                       seconds per step at N cells, PART = minimal, polarity,
+//!                                       populations, walls, adhesion or division, in the
+//!                                       kernels' VARIANT (plain, the default, or shared-patch)
 //! gpu_check agree N STEPS               GPU against the CPU after STEPS steps
 //! gpu_check determinism N STEPS         a hash of the state after STEPS steps, twice
+//! gpu_check variants N STEPS            the shared-patch variant against the plain kernels
 //! ```
 //!
 //! The scene is the paper's (`scenes/paper.toml`, embedded: nothing is read from disk),
@@ -26,7 +29,7 @@ const PAPER: &str = include_str!("../../../scenes/paper.toml");
 
 fn usage() -> ! {
     eprintln!(
-        "usage: gpu_check adapter | bandwidth MIB | throughput N PART [STEPS] | agree N STEPS | determinism N STEPS"
+        "usage: gpu_check adapter | bandwidth MIB | throughput N PART [STEPS] [VARIANT] | agree N STEPS | determinism N STEPS | variants N STEPS"
     );
     std::process::exit(2)
 }
@@ -110,9 +113,13 @@ fn main() {
             arg(&args, 1),
             args.get(2).map_or("minimal", String::as_str),
             args.get(3).map_or(20, |_| arg(&args, 3)),
+            args.get(4)
+                .map_or(Some(gpu::Variant::Plain), |v| gpu::Variant::from_name(v))
+                .unwrap_or_else(|| usage()),
         ),
         Some("agree") => agree(arg(&args, 1), arg(&args, 2)),
         Some("determinism") => determinism(arg(&args, 1), arg(&args, 2)),
+        Some("variants") => variants(arg(&args, 1), arg(&args, 2)),
         _ => usage(),
     };
     match line {
@@ -142,8 +149,26 @@ fn bandwidth(mib: u64) -> Result<String, String> {
     ))
 }
 
-fn throughput(n: usize, part: &str, steps: usize) -> Result<String, String> {
-    let head = format!("check=throughput part={part} cells={n} lattice={}", side(n));
+/// The backend for `t` in the kernels' `variant`, on a device of its own.
+fn backend(
+    t: &Tissue<f32>,
+    sp: &mechanics::StepParams,
+    variant: gpu::Variant,
+) -> Result<gpu::GpuBackend, gpu::GpuError> {
+    gpu::GpuBackend::check(t, sp)?;
+    let options = gpu::GpuOptions {
+        variant,
+        ..Default::default()
+    };
+    gpu::GpuBackend::with_options(gpu::Device::open()?, t, sp, options)
+}
+
+fn throughput(n: usize, part: &str, steps: usize, variant: gpu::Variant) -> Result<String, String> {
+    let head = format!(
+        "check=throughput part={part} variant={} cells={n} lattice={}",
+        variant.name(),
+        side(n)
+    );
     // A part the backend does not run is refused whatever the size: asked at 60 cells, so
     // that a refusal at 10⁶ does not cost the host a minute of building.
     if n > 60 {
@@ -159,9 +184,13 @@ fn throughput(n: usize, part: &str, steps: usize) -> Result<String, String> {
     let (mut t, sp) = tissue(n, part)?;
     let build = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
-    let mut gpu = match gpu::GpuBackend::new(&t, &sp) {
+    let mut gpu = match backend(&t, &sp, variant) {
         Ok(g) => g,
-        Err(e @ (gpu::GpuError::Unsupported(_) | gpu::GpuError::TooLarge(_))) => {
+        Err(
+            e @ (gpu::GpuError::Unsupported(_)
+            | gpu::GpuError::TooLarge(_)
+            | gpu::GpuError::Setting(_)),
+        ) => {
             return Ok(format!(
                 "{head} refused=\"{}\"",
                 e.to_string().replace('"', "'")
@@ -253,5 +282,37 @@ fn determinism(n: usize, steps: usize) -> Result<String, String> {
         hashes[0],
         hashes[1],
         if hashes[0] == hashes[1] { "yes" } else { "no" }
+    ))
+}
+
+/// The shared-patch variant against the plain kernels after `steps` steps from the same
+/// state: the largest difference of the fields (bound 1e-5, the agreement's with the CPU), and
+/// whether the states are the same bits (they are on lavapipe, where the two compute the same
+/// arithmetic on the same values; a driver may contract a multiply and an add differently in
+/// the two).
+fn variants(n: usize, steps: usize) -> Result<String, String> {
+    let (start, sp) = tissue(n, "minimal")?;
+    let mut states = Vec::new();
+    for variant in [gpu::Variant::Plain, gpu::Variant::SharedPatch] {
+        let mut t = start.clone();
+        let mut gpu = backend(&t, &sp, variant).map_err(|e| e.to_string())?;
+        for _ in 0..steps {
+            gpu.step(&t, &sp).map_err(|e| e.to_string())?;
+        }
+        gpu.sync(&mut t).map_err(|e| e.to_string())?;
+        states.push(t);
+    }
+    let dphi = states[0]
+        .cells()
+        .phi()
+        .iter()
+        .zip(states[1].cells().phi())
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    let (h0, h1) = (hash(&states[0]), hash(&states[1]));
+    Ok(format!(
+        "check=variants cells={n} steps={steps} max_dphi={dphi:.3e} bound_phi=1e-5 identical={} agree={}",
+        if h0 == h1 { "yes" } else { "no" },
+        if f64::from(dphi) <= 1e-5 { "yes" } else { "no" }
     ))
 }

@@ -30,8 +30,8 @@ mod step;
 
 pub use device::{adapter_info, Device, GpuError};
 pub use step::{
-    unsupported, Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Kind, Params, MAX_KINDS,
-    SUPPORTED,
+    unsupported, Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Kind, Params, Variant,
+    MAX_KINDS, SUPPORTED,
 };
 
 /// The WGSL source of the step's kernels, with the constants of a patch shape and pressure

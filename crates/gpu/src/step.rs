@@ -39,7 +39,7 @@ const SOURCE: &str = include_str!("step.wgsl");
 /// The WGSL source of the step for patches of `shape` and the pressure form `kind`, with
 /// `cap` cells per bin: the file `step.wgsl` after its constants.
 pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String {
-    shader_source_split(shape, kind, cap, u32::MAX)
+    shader_source_split(shape, kind, cap, u32::MAX, Variant::Plain)
 }
 
 /// What of the extensions `ext` (with the model's `params`) the GPU backend does not run, each
@@ -85,22 +85,66 @@ fn align_code(align: mechanics::terms::Align) -> Option<u32> {
     }
 }
 
-/// [`shader_source`] with the lattice arrays split into two bindings at node `split`.
-fn shader_source_split(shape: &PatchShape, kind: PressureKind, cap: u32, split: u32) -> String {
+/// [`shader_source`] with the lattice arrays split into two bindings at node `split`, in the
+/// kernels' `variant`.
+fn shader_source_split(
+    shape: &PatchShape,
+    kind: PressureKind,
+    cap: u32,
+    split: u32,
+    variant: Variant,
+) -> String {
     let (nx, ny) = (shape.nx as u32, shape.ny as u32);
     let plen = nx * ny;
     let margin = shape.margin.unwrap_or(0) as u32;
+    let local = variant == Variant::SharedPatch;
     format!(
         "const NX: u32 = {nx}u;\nconst NY: u32 = {ny}u;\nconst PLEN: u32 = {plen}u;\n\
          const NPT: u32 = {npt}u;\nconst MARGIN: u32 = {margin}u;\nconst CAP: u32 = {cap}u;\n\
          const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n\
-         const MAX_KINDS: u32 = {MAX_KINDS}u;\n{params}{kind}{chunk}{SOURCE}",
+         const MAX_KINDS: u32 = {MAX_KINDS}u;\nconst LOCAL_PATCH: u32 = {lp}u;\n\
+         const LOCAL_LEN: u32 = {ll}u;\n{params}{kind}{chunk}{SOURCE}",
         params = Params::WGSL,
         kind = Kind::WGSL,
         chunk = Chunk::WGSL,
         npt = plen.div_ceil(WG),
         paper = u32::from(kind == PressureKind::Paper),
+        lp = u32::from(local),
+        ll = if local { plen } else { 1 },
     )
+}
+
+/// Which form of the kernels a backend runs ([`GpuOptions::variant`]): each computes the same
+/// numbers; which is faster only a device can say (`docs/gpu_check.sh` times both).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum Variant {
+    /// Every stencil reads its five values from the φ array in device memory.
+    #[default]
+    Plain,
+    /// The cell and force passes load each cell's patch into workgroup memory once and read
+    /// their stencils there: one read of device memory per patch node and pass where the plain
+    /// kernels make five (most of them cached), for `4 · PLEN` bytes of workgroup memory
+    /// (3.6 kB at margin 12, 6.6 kB at margin 16). The same arithmetic on the same values:
+    /// the same bits.
+    SharedPatch,
+}
+
+impl Variant {
+    /// Its name, as `gpu_check` takes it: `plain` or `shared-patch`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Plain => "plain",
+            Variant::SharedPatch => "shared-patch",
+        }
+    }
+
+    /// The variant named `name` ([`Variant::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Variant::Plain, Variant::SharedPatch]
+            .into_iter()
+            .find(|v| v.name() == name)
+    }
 }
 
 /// One evaluation on the device ([`GpuBackend::evaluate`]).
@@ -347,6 +391,8 @@ pub struct GpuOptions {
     /// bytes, a lattice of 11 585² or about 800 k cells at the paper's density). A smaller
     /// figure splits a small lattice, which tests the split.
     pub max_lattice_nodes: Option<usize>,
+    /// The form of the kernels ([`Variant`]; the plain one by default).
+    pub variant: Variant,
 }
 
 /// The split of cells `0..n` into chunks of at most `per` cells: `(lo, count)` each.
@@ -562,6 +608,20 @@ impl GpuBackend {
             .unwrap_or(fit)
             .clamp(1, fit)
             .min(n.max(1));
+        // The shared-patch variant's workgroup memory: the patch, beside the reduction's
+        // 256 vec4s and a few words.
+        if options.variant == Variant::SharedPatch {
+            let need = patch_bytes + 16 * u64::from(WG) + 64;
+            let have = u64::from(dev.limits.max_compute_workgroup_storage_size);
+            if need > have {
+                return Err(GpuError::Setting(format!(
+                    "the shared-patch variant needs {need} bytes of workgroup memory for patches of {}×{}, and the device ({}) has {have}: use the plain variant, or reduce [integrator] margin",
+                    shape.nx,
+                    shape.ny,
+                    dev.describe()
+                )));
+            }
+        }
         let chunks = chunks(n, per_chunk);
         let nodes = lattice.len();
         let split = options
@@ -748,7 +808,14 @@ impl GpuBackend {
         let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("step.wgsl"),
             source: wgpu::ShaderSource::Wgsl(
-                shader_source_split(&shape, tissue.params().pressure, cap, split as u32).into(),
+                shader_source_split(
+                    &shape,
+                    tissue.params().pressure,
+                    cap,
+                    split as u32,
+                    options.variant,
+                )
+                .into(),
             ),
         });
         let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {

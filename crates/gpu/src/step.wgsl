@@ -401,6 +401,41 @@ fn stencil(base: u32, a: u32, b: u32) -> Stencil {
     return s;
 }
 
+// The variant with each cell's patch in workgroup memory (`Variant::SharedPatch`): the cell and
+// force passes load the cell's patch once (`load_patch`), and their stencils read it there
+// (`cell_stencil`) instead of five times from the φ array. The host sets LOCAL_PATCH (0 or 1)
+// and LOCAL_LEN (PLEN, or 1 for the plain variant, which then holds no patch).
+var<workgroup> wg_patch: array<f32, LOCAL_LEN>;
+
+// Loads the patch at `base` of `x_phi` into `wg_patch` (every invocation of the workgroup).
+fn load_patch(base: u32, lid: u32) {
+    if (LOCAL_PATCH == 1u) {
+        for (var k = lid; k < PLEN; k += WG) {
+            wg_patch[k] = x_phi[base + k];
+        }
+        workgroupBarrier();
+    }
+}
+
+// `stencil` of the workgroup's own cell: from `wg_patch` in the shared-patch variant, the
+// same values.
+fn cell_stencil(base: u32, a: u32, b: u32) -> Stencil {
+    if (LOCAL_PATCH == 0u) {
+        return stencil(base, a, b);
+    }
+    let am = select(a - 1u, NX - 1u, a == 0u);
+    let ap = select(a + 1u, 0u, a + 1u == NX);
+    let bm = select(b - 1u, NY - 1u, b == 0u);
+    let bp = select(b + 1u, 0u, b + 1u == NY);
+    var s: Stencil;
+    s.c = wg_patch[a * NY + b];
+    s.xm = wg_patch[am * NY + b];
+    s.xp = wg_patch[ap * NY + b];
+    s.ym = wg_patch[a * NY + bm];
+    s.yp = wg_patch[a * NY + bp];
+    return s;
+}
+
 // The five-point Laplacian as a sum of differences, each exact in f32 where the neighbours are
 // within a factor 2 of the centre (Sterbenz): its rounding error is that of a small result,
 // where `xm + xp + ym + yp − 4c` loses the digits of values near 1.
@@ -467,6 +502,7 @@ fn cell_sums(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id
     }
     let i = chunk.lo + li;
     let base = li * PLEN;
+    load_patch(base, lid);
     var acc = vec4<f32>(0.0);
     var lo = 3.0e38;
     var hi = -3.0e38;
@@ -474,7 +510,7 @@ fn cell_sums(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id
     for (var k = lid; k < PLEN; k += WG) {
         let a = k / NY;
         let b = k % NY;
-        let s = stencil(base, a, b);
+        let s = cell_stencil(base, a, b);
         let sh = shape_tensor_density(gradient(s));
         acc += vec4<f32>(s.c * s.c, sh.x, sh.y, 0.0);
         lo = min(lo, s.c);
@@ -688,6 +724,7 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
     }
     let i = chunk.lo + li;
     let base = li * PLEN;
+    load_patch(base, lid);
     let o = origin[i];
     let c = i * CELL_STRIDE;
     use_cell(c);
@@ -702,7 +739,7 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             let gy = (o.y + b) % prm.ly;
             let f = lat_get(gx * prm.ly + gy);
             fields[j] = f;
-            let s = stencil(base, a, b);
+            let s = cell_stencil(base, a, b);
             let p = f.x - pressure_self_part(s.c);
             let fd = force_density(p, prm.zeta, f.zw, gradient(s));
             acc += vec4<f32>(fd, 0.0, 0.0);
@@ -724,7 +761,7 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         if (k < PLEN) {
             let a = k / NY;
             let b = k % NY;
-            let s = stencil(base, a, b);
+            let s = cell_stencil(base, a, b);
             let others = fields[j].y - s.c * s.c;
             let lap = laplacian(s);
             var dfdphi = free_energy_derivative(s.c, lap, af, others);

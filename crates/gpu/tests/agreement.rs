@@ -521,6 +521,7 @@ fn chunked_arrays_agree_with_one_array() {
     let options = gpu::GpuOptions {
         max_chunk_cells: Some(25),
         max_lattice_nodes: Some(6_007),
+        ..Default::default()
     };
     let mut split =
         GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap();
@@ -621,6 +622,7 @@ fn a_split_lattice_is_the_same_to_the_bit() {
     let options = gpu::GpuOptions {
         max_chunk_cells: None,
         max_lattice_nodes: Some(6_007),
+        ..Default::default()
     };
     let open = |options| {
         GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap()
@@ -636,4 +638,47 @@ fn a_split_lattice_is_the_same_to_the_bit() {
     );
     let (x, y) = (gpu_steps(a, &tissue, sp, 20), gpu_steps(b, &tissue, sp, 20));
     assert!(x.cells().phi() == y.cells().phi(), "20 steps");
+}
+
+/// The shared-patch variant (issue 40, item 5: each cell's patch in workgroup memory) computes
+/// the same numbers as the plain kernels, to the bit: one evaluation and 20 steps, with every
+/// part the device runs (polarity, adhesion, walls, two populations) and the state in three
+/// chunks, so that every stencil of the cell and force passes is read from the shared patch.
+#[test]
+fn the_shared_patch_variant_is_the_plain_one_to_the_bit() {
+    if common::try_device().is_none() {
+        return;
+    }
+    let tissue = polar(
+        adhering(walled(two_populations(paper_tissue(0.005)))),
+        Align::Velocity,
+        Propulsion::Cell,
+    );
+    let sp = StepParams::paper();
+    let open = |variant| {
+        let options = gpu::GpuOptions {
+            max_chunk_cells: Some(25),
+            variant,
+            ..Default::default()
+        };
+        GpuBackend::with_options(gpu::Device::open().unwrap(), &tissue, &sp, options).unwrap()
+    };
+    let (mut a, mut b) = (open(gpu::Variant::SharedPatch), open(gpu::Variant::Plain));
+    assert_eq!(a.n_chunks(), 3);
+    let (ea, eb) = (
+        a.evaluate(&tissue, sp.dt).unwrap(),
+        b.evaluate(&tissue, sp.dt).unwrap(),
+    );
+    assert!(
+        ea.rhs == eb.rhs && ea.lattice == eb.lattice && ea.cells == eb.cells,
+        "one evaluation"
+    );
+    let (x, y) = (gpu_steps(a, &tissue, sp, 20), gpu_steps(b, &tissue, sp, 20));
+    assert!(x.cells().phi() == y.cells().phi(), "20 steps: the fields");
+    assert_eq!(x.centres(), y.centres(), "20 steps: the centres");
+    assert_eq!(
+        x.terms().state("polarity"),
+        y.terms().state("polarity"),
+        "20 steps: the angles"
+    );
 }
