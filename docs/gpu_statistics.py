@@ -6,13 +6,16 @@ CPU backend statistically?
     python3 docs/gpu_statistics.py --self-test         # the rule on synthetic data (CI runs it)
 
 The statistic of a run: the time average after its relaxation and SKIP TU more of v_rms,
-area_mean and s_rms. The rule, per quantity, from the difference of the seed means
-Δ = m_gpu − m_cpu and its standard error se = √(s_cpu²/n + s_gpu²/n) (s the sample standard
-deviations over the n seeds of each):
-  - DIFFER when |Δ| > 3 se (Welch's t beyond 3: about 2 % by chance with 5 seeds a side);
-  - AGREE when |Δ| + 2.3 se ≤ 5 % of the CPU's mean (the 95 % bound on the difference,
-    t at 8 degrees of freedom, inside an equivalence margin of 5 %);
-  - NOT ESTABLISHED otherwise (the seeds are too few, or the runs too short, to decide).
+area_mean and s_rms. Seed s starts both backends from the same state, so the comparison is
+paired: per quantity, the differences d_s = gpu_s − cpu_s over the n seeds, their mean d̄ and
+its standard error se = sd(d)/√n. (A scene that is not chaotic over the run keeps each pair
+within round-off, and se is tiny; a chaotic one decorrelates them, and se is about the seed
+spread. The pairing is valid either way.) The rule:
+  - DIFFER when |d̄| > 4 se and |d̄| > 1e-6 of the CPU's mean (beyond chance: t at 4
+    degrees of freedom exceeds 4 in 1.6 % of draws; and beyond f32 round-off);
+  - AGREE when |d̄| + 2.8 se ≤ 5 % of the CPU's mean (the 95 % bound on the difference, t at 4
+    degrees of freedom, inside an equivalence margin of 5 %);
+  - NOT ESTABLISHED otherwise (too few seeds, or runs too short, to decide).
 The verdict: the backends differ when one quantity differs, agree when all three agree, and
 it is not established otherwise.
 """
@@ -22,10 +25,12 @@ import random
 import sys
 
 NAMES = ["v_rms", "area_mean", "s_rms"]
-# The equivalence margin, relative to the CPU's mean, and the two thresholds in standard errors.
+# The equivalence margin and the floor of a difference (relative to the CPU's mean), and the
+# two thresholds in standard errors (t at n − 1 = 4 degrees of freedom).
 MARGIN = 0.05
-T_DIFFER = 3.0
-T_BOUND = 2.3
+FLOOR = 1e-6
+T_DIFFER = 4.0
+T_BOUND = 2.8
 
 
 def mean_sd(v):
@@ -34,20 +39,20 @@ def mean_sd(v):
 
 
 def compare(cpu, gpu):
-    """One quantity's seed values on each backend -> (outcome, line), the outcome "agree",
-    "differ" or "not established"."""
+    """One quantity's values on each backend, seed by seed (paired) -> (outcome, line), the
+    outcome "agree", "differ" or "not established"."""
     (mc, sc), (mg, sg) = mean_sd(cpu), mean_sd(gpu)
-    delta = mg - mc
-    se = math.sqrt(sc**2 / len(cpu) + sg**2 / len(gpu))
-    if abs(delta) > T_DIFFER * se:
+    d, sd = mean_sd([g - c for c, g in zip(cpu, gpu)])
+    se = sd / math.sqrt(len(cpu))
+    if abs(d) > T_DIFFER * se and abs(d) > FLOOR * abs(mc):
         outcome = "differ"
-    elif abs(delta) + T_BOUND * se <= MARGIN * abs(mc):
+    elif abs(d) + T_BOUND * se <= MARGIN * abs(mc):
         outcome = "agree"
     else:
         outcome = "not established"
     return outcome, (
         f"cpu {mc:.5g} ± {sc:.2g}, gpu {mg:.5g} ± {sg:.2g} (mean ± sd over {len(cpu)} seeds); "
-        f"Δ = {delta:.2g} ({delta / mc:+.2%}), se {se:.2g}: {outcome.upper()}"
+        f"paired difference {d:.2g} ({d / mc:+.2%}) ± se {se:.2g}: {outcome.upper()}"
     )
 
 
@@ -95,27 +100,37 @@ def main(out, seeds, skip):
 
 
 def self_test():
-    """Each outcome on synthetic seeds, 5 a side, 200 draws each:
-    - the same distribution with a small spread (sd 1 % of the mean): agree in most draws;
-    - a shift of 8 % with that spread (outside the margin; Δ/se ≈ 13): differ in all but a few;
-    - the same distribution with a large spread (sd 10 %: 2.3 se alone passes the margin):
-      not established in most, and never differ in more than a few."""
+    """Each outcome on synthetic seeds, 5 pairs, 200 draws each. A seed's value is drawn
+    around 100 with the seed spread (sd 10), and the GPU's is the CPU's plus its own part:
+    - pairs within round-off (a scene that is not chaotic: 1e-8): agree in all;
+    - decorrelated pairs of the same distribution with a small spread (sd 1, the GPU's its own
+      draw): agree in most, differ in few;
+    - a shift of 8 % (outside the margin) on decorrelated pairs of sd 1: differ in all;
+    - decorrelated pairs of a large spread (sd 10 each): not established in most."""
     rng = random.Random(29)
-    draws = lambda mu, sd: [rng.gauss(mu, sd) for _ in range(5)]
-    def count(mu_gpu, sd):
+    def count(shift, own, sd, paired):
         tally = {"agree": 0, "differ": 0, "not established": 0}
         for _ in range(200):
-            tally[compare(draws(100.0, sd), draws(mu_gpu, sd))[0]] += 1
+            cpu = [rng.gauss(100.0, sd) for _ in range(5)]
+            if paired:
+                gpu = [c + shift + rng.gauss(0.0, own) for c in cpu]
+            else:
+                gpu = [rng.gauss(100.0 + shift, sd) for _ in range(5)]
+            tally[compare(cpu, gpu)[0]] += 1
         return tally
-    same, shifted, noisy = count(100.0, 1.0), count(108.0, 1.0), count(100.0, 10.0)
-    assert same["agree"] >= 180 and same["differ"] <= 10, f"same distribution: {same}"
-    assert shifted["differ"] >= 190 and shifted["agree"] == 0, f"an 8 % shift: {shifted}"
+    close = count(0.0, 1e-8, 10.0, True)
+    same = count(0.0, 0.0, 1.0, False)
+    shifted = count(8.0, 0.0, 1.0, False)
+    noisy = count(0.0, 0.0, 10.0, False)
+    assert close["agree"] == 200, f"pairs within round-off: {close}"
+    assert same["agree"] >= 170 and same["differ"] <= 10, f"same distribution: {same}"
+    assert shifted["differ"] == 200, f"an 8 % shift: {shifted}"
     assert noisy["not established"] >= 180 and noisy["differ"] <= 10, f"a large spread: {noisy}"
     for outcomes, want in [(["agree"] * 3, "agree"), (["agree", "differ", "agree"], "differ"),
                            (["agree", "not established", "agree"], "not established")]:
         assert verdict(outcomes)[0] == want, (outcomes, want)
-    print(f"gpu_statistics self-test: same distribution {same}; an 8 % shift {shifted}; "
-          f"a 10 % spread {noisy}")
+    print(f"gpu_statistics self-test: pairs within round-off {close}; same distribution {same}; "
+          f"an 8 % shift {shifted}; a 10 % spread {noisy}")
 
 
 if __name__ == "__main__":

@@ -1202,14 +1202,14 @@ impl GpuBackend {
             row[11] = f32::from_bits(pops.population(id) as u32);
         }
         q.write_buffer(&self.cell, 0, bytemuck::cast_slice(&per_cell));
-        // The polarity's angle of each slot and its identity (the noise's key); the area of
-        // the last evaluation starts at zero, as a host's workspace does.
+        // The polarity's angle of each slot and its identity (the noise's key); what the last
+        // evaluation computed starts at zero, as the host's does for a run that starts.
         if self.polarity {
             let theta = polarity_angles(tissue);
             let mut rows = vec![0.0f32; self.n_cells * POL_STRIDE];
             for (row, &id) in rows.chunks_exact_mut(POL_STRIDE).zip(ids) {
                 row[0] = theta[id] as f32;
-                row[5] = f32::from_bits(id as u32);
+                row[7] = f32::from_bits(id as u32);
             }
             q.write_buffer(&self.pol, 0, bytemuck::cast_slice(&rows));
         }
@@ -1376,8 +1376,8 @@ impl GpuBackend {
     /// The extensions add, per evaluation: walls 8 bytes a patch node (the force pass reads
     /// (w, ∇²w)) and 8 a lattice node (the lattice pass reads them); adhesion 4 bytes a patch
     /// node (the force pass reads ∇²s1) and 44 a lattice node (the lattice pass writes s1, the
-    /// adhesion pass reads it, writes ∇²s1 and reads and writes `P, s2, Q`); polarity 68
-    /// bytes a cell and evaluation (0.15 B a node-update on patches of 30²).
+    /// adhesion pass reads it, writes ∇²s1 and reads and writes `P, s2, Q`); polarity 88
+    /// bytes a cell and evaluation (0.2 B a node-update on patches of 30²).
     pub fn bytes_per_node_update(&self) -> f64 {
         let predictor = 4.0 + 4.0 + 4.0 + 16.0 + 8.0;
         let corrector = predictor + 8.0;
@@ -1392,10 +1392,10 @@ impl GpuBackend {
         let parts_patch = 8.0 * walls + 4.0 * adhesion;
         let parts_lattice = 8.0 * walls + 44.0 * adhesion;
         let lattice = (16.0 + chunks + parts_lattice) * (1.0 + correctors) * per_patch_node;
-        // The polarity: per cell and evaluation, the force pass reads 3 floats and writes 1,
-        // and its update reads 9 and writes up to 4: 68 bytes a cell, counted per patch node.
+        // The polarity: per cell and evaluation, the force pass reads 4 floats, and its update
+        // reads up to 11 and writes up to 7: 88 bytes a cell, counted per patch node.
         let polarity = if self.polarity {
-            68.0 * (1.0 + correctors) / self.shape.len() as f64
+            88.0 * (1.0 + correctors) / self.shape.len() as f64
         } else {
             0.0
         };
@@ -1657,7 +1657,7 @@ impl<T: Real> Backend<T> for GpuBackend {
                     time,
                     term: "polarity".into(),
                     cell: tissue.cell_ids()[slot],
-                    stiffness: f64::from(pol[slot * POL_STRIDE + 6]),
+                    stiffness: f64::from(pol[slot * POL_STRIDE + 2]),
                     dt,
                 });
             }

@@ -125,9 +125,11 @@ const CELL_STRIDE: u32 = 12u;
 // `polarity_update` steps each cell's angle by Heun's method after each evaluation of a step,
 // with the noise drawn by Philox from the same key as the host's (`mechanics::terms::NoiseKey`).
 override POLARITY: u32 = 0u;
-// Per cell, POL_STRIDE floats: θ, θ at the step's start, the rate there, the noise kick b·N,
-// the area of the last evaluation (a density propulsion's), the cell's identity (a u32's
-// bits), and the stiffness that stopped a step (for the host's message), one unused.
+// Per cell, POL_STRIDE floats: θ, θ at the step's start, the rate there (or the stiffness
+// that stopped the step, for the host's message), the noise kick b·N, what the last evaluation
+// of a step computed for the cell (its area and interface force: the propulsion's inputs, as
+// the host's `Terms` keeps them by identity, so that an observation's evaluation between
+// steps changes nothing), and the cell's identity (a u32's bits).
 @group(0) @binding(23) var<storage, read_write> pol: array<f32>;
 const POL_STRIDE: u32 = 8u;
 
@@ -353,10 +355,10 @@ fn normal_of_words(x2: u32, x3: u32) -> f32 {
     return -sqrt(2.0 * minus_log_uniform(x2)) * cos(TAU * (u2 - 0.5));
 }
 
-// The propulsion of cell `i` (row `c` of `cell`) in this evaluation, from its angle and what
-// the last evaluation left: its interface force (still in the row) and its area (kept in
-// `pol`), as the host's `Polarity::force` reads `CellContext::state`.
-fn propulsion_of(i: u32, c: u32) -> vec2<f32> {
+// The propulsion of cell `i` in this evaluation, from its angle and what the last evaluation
+// of a step computed for it (its area and interface force, kept in `pol` by
+// `polarity_update`), as the host's `Polarity::force` reads `CellContext::state`.
+fn propulsion_of(i: u32) -> vec2<f32> {
     if (prm.pol_active == 0u) {
         return vec2<f32>(0.0);
     }
@@ -365,7 +367,7 @@ fn propulsion_of(i: u32, c: u32) -> vec2<f32> {
     if (prm.pol_density == 1u) {
         m *= pol[b + 4u];
     }
-    return polarity_force(m, prm.pol_inhibition, vec2<f32>(cell[c + 5u], cell[c + 6u]), pol[b]);
+    return polarity_force(m, prm.pol_inhibition, vec2<f32>(pol[b + 5u], pol[b + 6u]), pol[b]);
 }
 
 fn heun_predictor(phi_old: f32, dt: f32, r_old: f32) -> f32 {
@@ -745,11 +747,9 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             acc += vec4<f32>(fd, 0.0, 0.0);
         }
     }
-    // The propulsion, read before the row's force is overwritten below (the barrier).
     var fp = vec2<f32>(0.0);
     if (POLARITY == 1u) {
-        fp = propulsion_of(i, c);
-        storageBarrier();
+        fp = propulsion_of(i);
     }
     let force = reduce(lid, acc).xy;
     let v = velocity(force + fp, kc.xi);
@@ -796,9 +796,6 @@ fn force_update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         cell[c + 6u] = force.y;
         cell[c + 7u] = v.x;
         cell[c + 8u] = v.y;
-        if (POLARITY == 1u) {
-            pol[i * POL_STRIDE + 4u] = cell[c];
-        }
     }
     if (MODE == 2u) {
         // The centre of mass by Fourier phase (phasefield::ComTable::centre_of_mass), then the
@@ -884,7 +881,7 @@ fn polarity_update(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (atomicMax(&status.failed, 3u) == 0u) {
                 atomicStore(&status.cell, i);
             }
-            pol[b + 6u] = stiffness;
+            pol[b + 2u] = stiffness;
             return;
         }
         var kick = 0.0;
@@ -893,7 +890,7 @@ fn polarity_update(@builtin(global_invocation_id) gid: vec3<u32>) {
             let lo = prm.step_lo + done;
             let hi = prm.step_hi + select(0u, 1u, lo < done);
             let w = philox4x32_10(
-                vec4<u32>(bitcast<u32>(pol[b + 5u]), lo, hi, prm.pol_stage),
+                vec4<u32>(bitcast<u32>(pol[b + 7u]), lo, hi, prm.pol_stage),
                 vec2<u32>(prm.seed_lo, prm.seed_hi),
             );
             kick = kc.noise * normal_of_words(w.z, w.w);
@@ -905,6 +902,10 @@ fn polarity_update(@builtin(global_invocation_id) gid: vec3<u32>) {
     } else {
         pol[b] = pol[b + 1u] + 0.5 * h * (pol[b + 2u] + r) + sqrt(h) * pol[b + 3u];
     }
+    // What this evaluation computed, for the propulsion of the next.
+    pol[b + 4u] = cell[c];
+    pol[b + 5u] = cell[c + 5u];
+    pol[b + 6u] = cell[c + 6u];
 }
 
 // ---- observables: the tissue velocity v = Σ_i φ_i v_i and Σ |v|², reduced on the device ----

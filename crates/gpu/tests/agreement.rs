@@ -682,3 +682,44 @@ fn the_shared_patch_variant_is_the_plain_one_to_the_bit() {
         "20 steps: the angles"
     );
 }
+
+/// An observation between steps (a series row, evaluated on the device) changes nothing the
+/// polarity's propulsion reads: a run observed every 3 steps ends in the same bits as one
+/// observed never, with contact inhibition and a density propulsion (which read the last step
+/// evaluation's force and area, kept per cell by `polarity_update`). It fails when the force
+/// pass reads them from the cell buffer, which an observation overwrites.
+#[test]
+fn observing_a_polar_run_on_the_device_changes_nothing() {
+    if common::try_device().is_none() {
+        return;
+    }
+    let tissue = polar(paper_tissue(0.005), Align::Shape, Propulsion::Density);
+    let sp = StepParams::paper();
+    let run = |observe: bool| {
+        let gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
+        let mut sim = Simulation::new(tissue.clone(), sp)
+            .with_backend(Box::new(gpu))
+            .stop_iteration(tissue.iteration() + 30);
+        let rows = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+        if observe {
+            let cb = Rows {
+                rows: rows.clone(),
+                read: None,
+            };
+            sim.add_callback("rows", Schedule::IterationInterval(3), cb);
+        }
+        sim.run().unwrap();
+        assert_eq!(rows.lock().unwrap().len(), if observe { 10 } else { 0 });
+        sim.into_parts().0
+    };
+    let (watched, unwatched) = (run(true), run(false));
+    assert!(
+        watched.cells().phi() == unwatched.cells().phi(),
+        "the fields"
+    );
+    assert_eq!(
+        watched.terms().state("polarity"),
+        unwatched.terms().state("polarity"),
+        "the angles"
+    );
+}

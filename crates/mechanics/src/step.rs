@@ -231,6 +231,7 @@ impl<T: Real> Tissue<T> {
             time: self.time + stage,
             stage,
             cells,
+            by_id: None,
             ids: &self.cell_id,
             centres: &self.centre,
             centre_of: None,

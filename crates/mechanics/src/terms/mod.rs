@@ -48,9 +48,11 @@ pub struct CellContext<'a> {
     /// Its centre of mass, as the step placed its patch.
     pub centre: [f64; 2],
     /// What the evaluation the term is called after computed for it. In
-    /// [`CellTerm::force`], which is called *before* an evaluation, this is the previous
-    /// evaluation's (at the start of a run, zero): a whole-cell force should depend on the
-    /// term's own state.
+    /// [`CellTerm::force`], which is called *before* an evaluation, this is what the last
+    /// evaluation of a step computed for this cell, kept by identity (at the start of a run,
+    /// after a resume and for a new cell, zero): an observation's evaluation between steps, or
+    /// a re-sort of the slots, does not change it. A whole-cell force should depend mostly on
+    /// the term's own state.
     pub state: &'a CellState,
     /// The cell's population (0 without populations).
     pub population: usize,
@@ -190,6 +192,12 @@ pub struct Terms {
     seed: u64,
     /// Cells whose state is allocated (0 before the terms are attached to a tissue).
     n: usize,
+    /// What the last evaluation of a step computed for each identity (`CellContext::state`
+    /// in [`CellTerm::force`]), kept here by identity when the step's stages begin and
+    /// correct, so that an observation's evaluation between steps, or a re-sort of the slots,
+    /// changes nothing the terms see. Zero for an identity no step has evaluated yet (a new
+    /// run, a resumed one, a new cell).
+    last: Vec<CellState>,
 }
 
 /// The `stage` of a key of an initial state: far from the terms' stages of a step.
@@ -235,6 +243,7 @@ impl Terms {
         });
         // The new term's state for the identities there are; the others keep theirs.
         let (n, seed, t) = (self.n, self.seed, self.entries.len() - 1);
+        self.last.resize(n, CellState::default());
         self.entries
             .last_mut()
             .expect("just pushed")
@@ -385,6 +394,7 @@ impl Terms {
                 v.clear();
             }
         }
+        self.last.clear();
         self.n = 0;
         self.extend_to(n);
     }
@@ -396,6 +406,7 @@ impl Terms {
             self.n = self.n.max(n_new);
             return;
         }
+        self.last.resize(n_new, CellState::default());
         let (n, seed) = (self.n, self.seed);
         for (t, e) in self.entries.iter_mut().enumerate() {
             e.extend(t, seed, n, n_new);
@@ -415,12 +426,18 @@ impl Terms {
                     + e.scratch.capacity())
                     * 8
             })
-            .sum()
+            .sum::<usize>()
+            + self.last.capacity() * std::mem::size_of::<CellState>()
     }
 
     /// The whole-cell forces of the current state into `out` (by slot): each term's
     /// [`CellTerm::forces`], summed from zero in the terms' order.
     pub(crate) fn forces(&self, view: &CellsView<'_>, out: &mut [[f64; 2]]) {
+        // What the terms see of each cell: the last step evaluation's, by identity.
+        let view = &CellsView {
+            by_id: Some(&self.last),
+            ..*view
+        };
         let batch = CellBatch { view };
         let mut terms = self.entries.iter();
         let Some(first) = terms.next() else {
@@ -463,6 +480,7 @@ impl Terms {
     /// The start of a step from `view.iteration`: keeps the state, its rate and the step's
     /// noise for [`Terms::predict`] and [`Terms::correct`].
     pub(crate) fn begin(&mut self, view: &CellsView<'_>) {
+        self.remember(view);
         let iteration = view.iteration;
         let seed = self.seed;
         for (t, e) in self.entries.iter_mut().enumerate() {
@@ -511,6 +529,7 @@ impl Terms {
     /// A corrector: `x = x_old + h/2 (r_1 + r(x)) + √h b N`, with `r(x)` from the evaluation
     /// of the predicted state that `view` holds.
     pub(crate) fn correct(&mut self, view: &CellsView<'_>, h: f64) {
+        self.remember(view);
         let sqrt_h = h.sqrt();
         for e in &mut self.entries {
             let len = e.len;
@@ -525,6 +544,16 @@ impl Terms {
                     e.x[i] = e.old[i] + 0.5 * h * (e.rate1[i] + e.scratch[k]) + sqrt_h * e.kick[i];
                 }
             }
+        }
+    }
+
+    /// Keeps what the evaluation `view` holds for each cell, by identity ([`Terms::last`]).
+    fn remember(&mut self, view: &CellsView<'_>) {
+        if self.entries.is_empty() {
+            return;
+        }
+        for (slot, &id) in view.ids.iter().enumerate() {
+            self.last[id] = view.cells[slot];
         }
     }
 
@@ -544,6 +573,9 @@ pub(crate) struct CellsView<'a> {
     /// corrector.
     pub(crate) stage: f64,
     pub(crate) cells: &'a [CellState],
+    /// What a term's `CellContext::state` is, by identity, where it is not `cells` by slot
+    /// (the terms' forces: the last step evaluation's, [`Terms::last`]).
+    pub(crate) by_id: Option<&'a [CellState]>,
     pub(crate) ids: &'a [usize],
     pub(crate) centres: &'a [[f64; 2]],
     /// The centre of mass of the cell in a slot in the state evaluated, measured on demand
@@ -567,10 +599,14 @@ impl std::fmt::Debug for CellsView<'_> {
 
 impl<'a> CellsView<'a> {
     fn context(&self, slot: usize) -> CellContext<'a> {
+        let id = self.ids[slot];
         CellContext {
-            id: self.ids[slot],
+            id,
             centre: self.centres[slot],
-            state: &self.cells[slot],
+            state: match self.by_id {
+                Some(states) => &states[id],
+                None => &self.cells[slot],
+            },
             population: self.populations.population(self.ids[slot]),
             active: self.active,
         }

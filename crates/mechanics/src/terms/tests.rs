@@ -270,6 +270,66 @@ fn terms_are_independent_of_threads_and_slots() {
     }
 }
 
+/// What a term sees of a cell before an evaluation (`CellContext::state`: what the last
+/// evaluation of a step computed for it, kept by identity) is the same whether the run is
+/// observed between steps and whether its slots are re-sorted. Contact inhibition and a
+/// density propulsion read it: observed after every step, the run gives the same angles and
+/// centres to the bit; re-sorted half way, to the round-off of the reordered lattice sums (as
+/// in `terms_are_independent_of_threads_and_slots`). Before, the next step's forces read the
+/// observation's evaluation, and after a re-sort another cell's force and area by slot.
+#[test]
+fn what_a_term_sees_does_not_depend_on_observation_or_slot_order() {
+    let run = |observe: bool, sort: bool| {
+        let lattice = Lattice::new(64, 64);
+        let shape = PatchShape::new(lattice, 10).unwrap();
+        // Not in the order of the re-sort, so that it moves cells between slots.
+        let centres = [
+            [40.0, 40.0],
+            [12.0, 12.0],
+            [40.0, 12.0],
+            [12.0, 40.0],
+            [26.0, 27.0],
+        ];
+        let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
+        let pol = Polarity::new(0.002)
+            .with_propulsion(Propulsion::Density)
+            .with_rotational_diffusion(0.05)
+            .with_contact_inhibition(2.0);
+        let mut t =
+            Tissue::new(cells, ModelParams::paper(0.005)).with_terms(Terms::new(11).with(pol));
+        let mut ws = Workspace::new(t.cells());
+        let mut scratch = Vec::new();
+        let mut moved = false;
+        for k in 0..40 {
+            if sort && k == 20 {
+                let before = t.cell_ids().to_vec();
+                t.sort_cells(&mut scratch);
+                moved = t.cell_ids() != before.as_slice();
+            }
+            t.step(&mut ws, &StepParams::default()).unwrap();
+            if observe {
+                t.observe(&mut ws);
+            }
+        }
+        assert_eq!(moved, sort, "the re-sort moved cells");
+        let slots = t.slots();
+        let centres: Vec<[f64; 2]> = slots.iter().map(|&s| t.centres()[s]).collect();
+        (t.terms().state("polarity").unwrap().to_vec(), centres)
+    };
+    let reference = run(false, false);
+    assert_eq!(run(true, false), reference, "observed after every step");
+    let sorted = run(false, true);
+    for (a, b) in sorted.0.iter().zip(&reference.0) {
+        assert!((a - b).abs() < 1e-9, "re-sorted: {a} {b}");
+    }
+    for (a, b) in sorted.1.iter().zip(&reference.1) {
+        assert!(
+            (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9,
+            "re-sorted: {a:?} {b:?}"
+        );
+    }
+}
+
 /// The discrete adhesion energy `F_adh = ωλ Σ_{i≠j} Σ_x ∇⁺φ_i·∇⁺φ_j` (forward differences, on
 /// the periodic lattice) of full-domain fields `phi` (cell after cell).
 fn adhesion_energy(omega: f64, lambda: f64, phi: &[f64], lx: usize, ly: usize) -> f64 {
