@@ -175,7 +175,6 @@ fn a_checkpoint_resumes_on_the_other_backend() {
 fn the_gpu_refuses_what_it_does_not_run_by_name() {
     let dir = tempfile::tempdir().unwrap();
     for (scene, set, says) in [
-        ("proliferation.toml", "run.time=1", "[division]"),
         ("paper.toml", "integrator.adaptive=true", "adaptive"),
         ("paper.toml", "integrator.npc=0", "npc"),
         ("paper.toml", "integrator.margin=0", "margin"),
@@ -237,35 +236,62 @@ fn the_gpu_refuses_more_populations_than_it_holds_before_writing() {
     assert!(!out.exists(), "nothing written");
 }
 
-/// Every shipped scene the GPU runs (all but those with `[division]`): the paper's model
-/// (`paper.toml` is the bit-identity test's), populations (`sorting.toml`, two populations of
-/// opposite ζ), walls (`channel.toml`), adhesion (`doublet.toml`, two cells that adhere) and
-/// polarity (`polar.toml`; `walker.toml`, one cell; `disc.toml`, aligning to the velocity in
-/// a disc wall; `wound.toml`, whose wall goes when the activity starts), run on the GPU and
-/// follow the CPU's run: every row of `series.csv` agrees in v_rms, S_rms and the mean area
-/// to 1e-3 of its value (f32 round-off amplified over the steps, as across a resume). The
-/// polar scenes' noise is the same on both (Philox from the same keys).
+/// Every shipped scene: the paper's model (`paper.toml` is the bit-identity test's),
+/// populations (`sorting.toml`, two populations of opposite ζ), walls (`channel.toml`),
+/// adhesion (`doublet.toml`, two cells that adhere), polarity (`polar.toml`; `walker.toml`,
+/// one cell; `disc.toml`, aligning to the velocity in a disc wall; `wound.toml`, whose wall
+/// goes when the activity starts) and division (`colony.toml`, from one cell;
+/// `proliferation.toml`), run on the GPU and follow the CPU's run: every row of `series.csv`
+/// has the same number of cells, and agrees in v_rms, S_rms and the mean area to 1e-3 of its
+/// value (f32 round-off amplified over the steps, as across a resume). The polar scenes'
+/// noise and the division clock's draws are the same on both (Philox from the same keys).
 #[test]
 fn shipped_scenes_run_on_the_gpu_as_on_the_cpu() {
     let dir = tempfile::tempdir().unwrap();
-    for scene in [
-        "sorting.toml",
-        "channel.toml",
-        "doublet.toml",
-        "polar.toml",
-        "walker.toml",
-        "disc.toml",
-        "wound.toml",
+    // The division scenes on a short clock, so that cells divide within the run (the colony
+    // from one cell, the proliferating tissue from 240 cells to its 600).
+    let short_clock: &[&str] = &[
+        "division.cycle_time=3",
+        "division.cycle_spread=1",
+        "division.growth_time=1",
+        "run.time=14",
+    ];
+    for (scene, extra) in [
+        ("sorting.toml", &[][..]),
+        ("channel.toml", &[]),
+        ("doublet.toml", &[]),
+        ("polar.toml", &[]),
+        ("walker.toml", &[]),
+        ("disc.toml", &[]),
+        ("wound.toml", &[]),
+        ("colony.toml", short_clock),
+        // (Without its extrusion rule: its initial discs, relaxed here for 2 TU instead of
+        // its 100, would all be extruded when the activity starts.)
+        (
+            "proliferation.toml",
+            &[
+                "division.cycle_time=3",
+                "division.cycle_spread=1",
+                "division.growth_time=1",
+                "division.extrusion=0",
+                "run.time=8",
+            ][..],
+        ),
     ] {
         let path = scene_path(scene);
         let run = |backend: &str| {
             let out = dir.path().join(scene).join(backend);
-            let o = bin()
-                .arg("run")
-                .arg(&path)
-                .arg("--out")
-                .arg(&out)
-                .args(["--set", "run.relax_time=2", "--set", "run.time=4"])
+            let mut cmd = bin();
+            cmd.arg("run").arg(&path).arg("--out").arg(&out).args([
+                "--set",
+                "run.relax_time=2",
+                "--set",
+                "run.time=4",
+            ]);
+            for set in extra {
+                cmd.args(["--set", set]);
+            }
+            let o = cmd
                 .args(["--set", &format!("integrator.backend={backend}"), "--quiet"])
                 .env("XDG_RUNTIME_DIR", std::env::temp_dir())
                 .output()
@@ -281,6 +307,13 @@ fn shipped_scenes_run_on_the_gpu_as_on_the_cpu() {
         ok(&o);
         let ((head, g), (_, c)) = (series(&gpu), series(&cpu));
         assert_eq!(g.len(), c.len(), "{scene}: the same rows");
+        let k = head.iter().position(|h| h == "cells").unwrap();
+        let counts = |rows: &[Vec<f64>]| rows.iter().map(|r| r[k]).collect::<Vec<_>>();
+        assert_eq!(counts(&g), counts(&c), "{scene}: the same number of cells");
+        if !extra.is_empty() {
+            let (first, last) = (c[0][k], c[c.len() - 1][k]);
+            assert!(last > first, "{scene}: cells divided ({first} → {last})");
+        }
         for name in ["v_rms", "s_rms", "area_mean"] {
             let k = head.iter().position(|h| h == name).unwrap();
             for (a, b) in g.iter().zip(&c) {

@@ -19,7 +19,7 @@ pub enum GpuError {
     #[error("{0}")]
     TooLarge(String),
     /// The tissue has a part that the GPU backend does not compute.
-    #[error("the GPU backend runs the paper's model, polarity, adhesion, populations and walls only, and this scene has {0}; run it with [integrator] backend = \"cpu\"")]
+    #[error("the GPU backend runs the paper's model and every extension of it but a physics term of your own, and this scene has {0}; run it with [integrator] backend = \"cpu\"")]
     Unsupported(String),
     /// A step setting the GPU backend does not support.
     #[error("{0}")]

@@ -21,6 +21,7 @@ pub const SUPPORTED: &[mechanics::Part] = &[
     mechanics::Part::Adhesion,
     mechanics::Part::Populations,
     mechanics::Part::Walls,
+    mechanics::Part::Division,
 ];
 
 /// Invocations per workgroup (the shader's `WG`).
@@ -257,8 +258,18 @@ shared_struct! {
         /// The polarity's noise stage, folded to 32 bits (`terms::NoiseKey`: its place `t`
         /// among the terms, `t << 16`).
         pol_stage: u32,
+        /// The division clock's growth time `T_g` (`GROWTH`; 0 without a growth phase).
+        growth_time: f32,
+        /// The model time of the state on the device when it was last synced, less the
+        /// growth's origin (the time of the last upload): a step's time is this plus
+        /// `status.steps · dt`.
+        growth_now: f32,
         /// Padding to 16 bytes.
         pad0: u32,
+        /// Padding to 16 bytes.
+        pad1: u32,
+        /// Padding to 16 bytes.
+        pad2: u32,
     }
 }
 
@@ -499,6 +510,18 @@ pub struct GpuBackend {
     /// With polarity, each cell's angle and its step's scratch (`POL_STRIDE` floats a slot).
     pol: wgpu::Buffer,
     polarity: bool,
+    /// With a growth phase, each slot's growth start less `growth_origin`.
+    growth_buf: wgpu::Buffer,
+    growth: bool,
+    /// The model time the growth starts are measured from (the last upload's).
+    growth_origin: f64,
+    /// The most cells the buffers hold (`[division] max_cells` with division).
+    capacity: usize,
+    /// Each chunk's uniform, rewritten when the number of cells changes.
+    chunk_info: Vec<wgpu::Buffer>,
+    /// The chunks of the cells there are now, `(lo, count)`: the first `active.len()` of
+    /// `chunks`, the last of them perhaps partly filled.
+    active: Vec<(usize, usize)>,
     /// Bytes copied from the device to the host so far ([`GpuBackend::bytes_read`]).
     bytes_read: Arc<AtomicU64>,
     groups_cells: (u32, u32),
@@ -590,7 +613,12 @@ impl GpuBackend {
     ) -> Result<Self, GpuError> {
         Self::check(tissue, step)?;
         let cells = tissue.cells();
-        let (lattice, shape, n) = (cells.lattice(), cells.shape().clone(), cells.n_cells());
+        let (lattice, shape, n_now) = (cells.lattice(), cells.shape().clone(), cells.n_cells());
+        // With division, every per-cell buffer holds the clock's most cells (`max_cells`):
+        // the events change the number of cells between steps, not the buffers.
+        let n = tissue
+            .proliferation()
+            .map_or(n_now, |c| c.max_cells.max(n_now));
         let mem = GpuMemory::estimate(lattice, &shape, n, step.npc, &tissue.parts());
         let patch_bytes = shape.len() as u64 * 4;
         let fit = (dev.max_binding() / patch_bytes) as usize;
@@ -692,7 +720,7 @@ impl GpuBackend {
                 d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("chunk"),
                     contents: bytemuck::bytes_of(&v),
-                    usage: wgpu::BufferUsages::UNIFORM,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 })
             })
             .collect();
@@ -742,7 +770,11 @@ impl GpuBackend {
             step_lo: 0,
             step_hi: 0,
             pol_stage: 0,
+            growth_time: 0.0,
+            growth_now: 0.0,
             pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         // The wall field (w, ∇²w per node), written by `set_uniforms` whenever the field in
         // effect changes (a wound opens when the activity starts); a placeholder without walls.
@@ -786,6 +818,10 @@ impl GpuBackend {
             copy,
         );
         let pf = f64::from(u8::from(polarity));
+        // With a growth phase before divisions, each slot's growth start (`growth`).
+        let growth = tissue.proliferation().is_some_and(|c| c.growth_time > 0.0);
+        let growth_buf = storage("growth", if growth { n as u64 * 4 } else { 16 }, copy);
+        let gf = f64::from(u8::from(growth));
         // Σ |v|² per workgroup of the lattice, for the observables.
         let v2_part = storage(
             "v2 per workgroup",
@@ -859,6 +895,7 @@ impl GpuBackend {
         entries.push(storage_entry(21, false));
         entries.push(storage_entry(22, false));
         entries.push(storage_entry(23, false));
+        entries.push(storage_entry(24, true));
         entries.push(wgpu::BindGroupLayoutEntry {
             binding: 18,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -897,7 +934,10 @@ impl GpuBackend {
             bin_clear: pipeline("bin_clear", &[]),
             bin_fill: pipeline("bin_fill", &[]),
             bin_sort: pipeline("bin_sort", &[]),
-            lattice: pipeline("lattice_sums", &[("WALLS", w), ("ADHESION", a)]),
+            lattice: pipeline(
+                "lattice_sums",
+                &[("WALLS", w), ("ADHESION", a), ("GROWTH", gf)],
+            ),
             adhesion: adhesion.then(|| pipeline("adhesion_lattice", &[])),
             predict: pipeline(
                 "force_update",
@@ -906,6 +946,7 @@ impl GpuBackend {
                     ("WALLS", w),
                     ("ADHESION", a),
                     ("POLARITY", pf),
+                    ("GROWTH", gf),
                 ],
             ),
             correct: pipeline(
@@ -915,6 +956,7 @@ impl GpuBackend {
                     ("WALLS", w),
                     ("ADHESION", a),
                     ("POLARITY", pf),
+                    ("GROWTH", gf),
                 ],
             ),
             correct_last: pipeline(
@@ -924,12 +966,13 @@ impl GpuBackend {
                     ("WALLS", w),
                     ("ADHESION", a),
                     ("POLARITY", pf),
+                    ("GROWTH", gf),
                 ],
             ),
             polarity: polarity.then(|| {
                 [
-                    pipeline("polarity_update", &[("MODE", 0.0)]),
-                    pipeline("polarity_update", &[("MODE", 1.0)]),
+                    pipeline("polarity_update", &[("MODE", 0.0), ("GROWTH", gf)]),
+                    pipeline("polarity_update", &[("MODE", 1.0), ("GROWTH", gf)]),
                 ]
             }),
             count: pipeline("count_step", &[]),
@@ -937,7 +980,7 @@ impl GpuBackend {
             velocity_reduce: pipeline("velocity_reduce", &[]),
         };
         let group = |k: usize, x: &wgpu::Buffer, old: &wgpu::Buffer, out: &wgpu::Buffer| {
-            let bufs: [&wgpu::Buffer; 24] = [
+            let bufs: [&wgpu::Buffer; 25] = [
                 &params_buf,
                 x,
                 old,
@@ -962,6 +1005,7 @@ impl GpuBackend {
                 &adh_lap,
                 &v2_part,
                 &pol,
+                &growth_buf,
             ];
             let entries: Vec<wgpu::BindGroupEntry<'_>> = bufs
                 .iter()
@@ -1023,10 +1067,16 @@ impl GpuBackend {
             v2_part,
             pol,
             polarity,
+            growth_buf,
+            growth,
+            growth_origin: 0.0,
+            capacity: n,
+            chunk_info,
+            active: Vec::new(),
             bytes_read: Arc::new(AtomicU64::new(0)),
             lattice,
             shape,
-            n_cells: n,
+            n_cells: n_now,
             npc: step.npc,
             params,
             groups_cells,
@@ -1113,6 +1163,8 @@ impl GpuBackend {
             step_lo: iteration as u32,
             step_hi: (iteration >> 32) as u32,
             pol_stage: polarity.map_or(0, |(t, _)| (t as u32) << 16),
+            growth_time: tissue.proliferation().map_or(0.0, |c| c.growth_time as f32),
+            growth_now: (self.base.1 - self.growth_origin) as f32,
             ..self.params
         };
         (params, kinds)
@@ -1156,12 +1208,36 @@ impl GpuBackend {
 
     fn upload_state<T: Real>(&mut self, tissue: &Tissue<T>) -> Result<(), GpuError> {
         let cells = tissue.cells();
-        if cells.n_cells() != self.n_cells || cells.shape().len() != self.shape.len() {
+        if cells.n_cells() > self.capacity || cells.shape().len() != self.shape.len() {
             return Err(GpuError::Setting(format!(
-                "the backend was built for {} cells, and the tissue has {}: build a new backend",
-                self.n_cells,
+                "the backend was built for at most {} cells, and the tissue has {}: build a new backend",
+                self.capacity,
                 cells.n_cells()
             )));
+        }
+        self.n_cells = cells.n_cells();
+        self.params.n_cells = self.n_cells as u32;
+        // The chunks the cells fill now, and their uniforms (the last filled one ends the
+        // lattice pass's sums).
+        self.active = self
+            .chunks
+            .iter()
+            .map(|&(lo, cap)| (lo, cap.min(self.n_cells.saturating_sub(lo))))
+            .take_while(|&(_, count)| count > 0)
+            .collect();
+        if self.active.is_empty() {
+            self.active.push((0, 0));
+        }
+        for (k, &(lo, count)) in self.active.iter().enumerate() {
+            let v = Chunk {
+                lo: lo as u32,
+                count: count as u32,
+                first: u32::from(k == 0),
+                last: u32::from(k + 1 == self.active.len()),
+            };
+            self.dev
+                .queue
+                .write_buffer(&self.chunk_info[k], 0, bytemuck::bytes_of(&v));
         }
         let plen = self.shape.len();
         let mut values = vec![0.0f32; self.n_cells * plen];
@@ -1179,7 +1255,7 @@ impl GpuBackend {
             .map(|o| [o[0] as u32, o[1] as u32])
             .collect();
         let q = &self.dev.queue;
-        for (&(lo, count), buf) in self.chunks.iter().zip(&self.phi) {
+        for (&(lo, count), buf) in self.active.iter().zip(&self.phi) {
             q.write_buffer(
                 buf,
                 0,
@@ -1202,16 +1278,37 @@ impl GpuBackend {
             row[11] = f32::from_bits(pops.population(id) as u32);
         }
         q.write_buffer(&self.cell, 0, bytemuck::cast_slice(&per_cell));
-        // The polarity's angle of each slot and its identity (the noise's key); what the last
-        // evaluation computed starts at zero, as the host's does for a run that starts.
+        // The polarity's angle of each slot, what the last step evaluation computed for the
+        // cell as the host's terms keep it (zero for a run that starts), and its identity (the
+        // noise's key).
         if self.polarity {
             let theta = polarity_angles(tissue);
             let mut rows = vec![0.0f32; self.n_cells * POL_STRIDE];
             for (row, &id) in rows.chunks_exact_mut(POL_STRIDE).zip(ids) {
                 row[0] = theta[id] as f32;
+                if let Some(last) = tissue.terms().last_evaluation(id) {
+                    row[4] = last.area as f32;
+                    row[5] = last.force.x as f32;
+                    row[6] = last.force.y as f32;
+                }
                 row[7] = f32::from_bits(id as u32);
             }
             q.write_buffer(&self.pol, 0, bytemuck::cast_slice(&rows));
+        }
+        // Each slot's growth start (its birth plus its cycle, from the clock's lineage), from
+        // this upload's time, which the steps' times are counted from.
+        self.growth_origin = tissue.time();
+        if self.growth {
+            let clock = tissue.proliferation().expect("a growth phase has a clock");
+            let starts: Vec<f32> = ids
+                .iter()
+                .map(|&id| {
+                    clock
+                        .growth_start(id)
+                        .map_or(f32::INFINITY, |g| (g - self.growth_origin) as f32)
+                })
+                .collect();
+            q.write_buffer(&self.growth_buf, 0, bytemuck::cast_slice(&starts));
         }
         self.base = (tissue.iteration(), tissue.time());
         self.queued.clear();
@@ -1274,6 +1371,8 @@ impl GpuBackend {
         let g = &self.groups;
         let (cx, cy) = self.groups_cells;
         let (nx, ny) = self.groups_nodes;
+        // The chunks the cells fill now.
+        let na = self.active.len();
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("step"),
             timestamp_writes: None,
@@ -1302,6 +1401,7 @@ impl GpuBackend {
         ) {
             // Each pass over every chunk before the next pass: the lattice sums need every
             // cell's area and shape, the forces every node's sums (chunk by chunk, in order).
+            let group = &group[..na];
             pass.set_pipeline(cell);
             for g in group {
                 pass.set_bind_group(0, g, &[]);
@@ -1342,7 +1442,7 @@ impl GpuBackend {
     /// Copies a per-chunk array (`per_cell` floats a cell) to the host, chunk after chunk.
     fn read_chunks(&self, arrays: &[wgpu::Buffer], per_cell: usize) -> Result<Vec<u8>, GpuError> {
         let mut out = Vec::with_capacity(self.n_cells * per_cell * 4);
-        for (&(_, count), buf) in self.chunks.iter().zip(arrays) {
+        for (&(_, count), buf) in self.active.iter().zip(arrays) {
             out.extend(self.read(buf, (count * per_cell * 4) as u64)?);
         }
         Ok(out)
@@ -1384,7 +1484,7 @@ impl GpuBackend {
         let correctors = self.npc as f64;
         let per_patch_node =
             self.lattice.len() as f64 / (self.n_cells * self.shape.len()).max(1) as f64;
-        let chunks = 64.0 * self.chunks.len().saturating_sub(1) as f64;
+        let chunks = 64.0 * self.active.len().saturating_sub(1) as f64;
         let (walls, adhesion) = (
             f64::from(u8::from(self.walls)),
             f64::from(u8::from(self.adhesion)),
@@ -1404,7 +1504,7 @@ impl GpuBackend {
 
     /// The number of chunks the per-cell arrays are split into.
     pub fn n_chunks(&self) -> usize {
-        self.chunks.len()
+        self.active.len()
     }
 
     /// Copies `bytes` of `buffer` to the host.
@@ -1494,7 +1594,7 @@ impl GpuBackend {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&p.velocity_sums);
-            for g in &self.groups.predict {
+            for g in &self.groups.predict[..self.active.len()] {
                 pass.set_bind_group(0, g, &[]);
                 pass.dispatch_workgroups(nx, ny, 1);
             }
@@ -1526,6 +1626,52 @@ impl GpuBackend {
             }),
         );
         Ok(Some(o))
+    }
+
+    /// What the last evaluation of the queued steps computed ([`Backend::evaluation`]): the
+    /// per-cell quantities (48 bytes a cell) and, when `pressure`, `P` per lattice node (16
+    /// bytes a node, of which the first 4 are kept). `None` when a queued step failed.
+    ///
+    /// # Errors
+    /// [`GpuError::Lost`].
+    pub fn device_evaluation(
+        &mut self,
+        pressure: bool,
+    ) -> Result<Option<mechanics::backend::DeviceEvaluation>, GpuError> {
+        self.flush();
+        if self.failed()? {
+            return Ok(None);
+        }
+        let q = self.cell_quantities_now()?;
+        let cells = q
+            .chunks_exact(CELL_STRIDE)
+            .map(|c| {
+                let c = |k: usize| f64::from(c[k]);
+                let mut st = mechanics::CellState::default();
+                st.area = c(0);
+                st.shape = mechanics::TracelessTensor::from([c(1), c(2)]);
+                st.force = mechanics::Vector2::new(c(5), c(6));
+                st.velocity = mechanics::Vector2::new(c(7), c(8));
+                st.phi_min = c(3);
+                st.phi_max = c(4);
+                st
+            })
+            .collect();
+        let pressure = if pressure {
+            let mut lat = self.read(&self.lat, self.lat_split as u64 * 16)?;
+            let rest = self.lattice.len() - self.lat_split;
+            if rest > 0 {
+                lat.extend(self.read(&self.lat_hi, rest as u64 * 16)?);
+            }
+            let lat: &[[f32; 4]] = bytemuck::cast_slice(&lat);
+            Some(lat.iter().map(|v| f64::from(v[0])).collect())
+        } else {
+            None
+        };
+        Ok(Some(mechanics::backend::DeviceEvaluation {
+            cells,
+            pressure,
+        }))
     }
 
     /// The per-cell quantities as they are on the device now (after a flush).
@@ -1623,8 +1769,13 @@ impl<T: Real> Backend<T> for GpuBackend {
         };
         if self.polarity {
             let mut theta = polarity_angles(tissue);
-            for (row, &id) in pol.chunks_exact(POL_STRIDE).zip(tissue.cell_ids()) {
+            let ids = tissue.cell_ids().to_vec();
+            for (row, &id) in pol.chunks_exact(POL_STRIDE).zip(&ids) {
                 theta[id] = f64::from(row[0]);
+                let mut last = mechanics::CellState::default();
+                last.area = f64::from(row[4]);
+                last.force = mechanics::Vector2::new(f64::from(row[5]), f64::from(row[6]));
+                tissue.terms_mut().set_last_evaluation(id, last);
             }
             tissue
                 .terms_mut()
@@ -1681,6 +1832,16 @@ impl<T: Real> Backend<T> for GpuBackend {
     fn upload(&mut self, tissue: &Tissue<T>) -> Result<(), StepError> {
         self.flush();
         self.upload_state(tissue)
+            .map_err(|e| Self::error(e.to_string()))
+    }
+
+    fn evaluation(
+        &mut self,
+        tissue: &Tissue<T>,
+        pressure: bool,
+    ) -> Result<Option<mechanics::backend::DeviceEvaluation>, StepError> {
+        let _ = tissue;
+        self.device_evaluation(pressure)
             .map_err(|e| Self::error(e.to_string()))
     }
 

@@ -115,6 +115,10 @@ override WALLS: u32 = 0u;
 override ADHESION: u32 = 0u;
 @group(0) @binding(20) var<storage, read_write> adh_s1: array<f32>;
 @group(0) @binding(21) var<storage, read_write> adh_lap: array<f32>;
+// Whether cells grow before they divide (the division clock's growth phase): per slot, the
+// time its target area starts to grow, less the growth's origin (`Params::growth_now`).
+override GROWTH: u32 = 0u;
+@group(0) @binding(24) var<storage, read> growth: array<f32>;
 // Per workgroup of the lattice: Σ |v|² of the tissue velocity over its nodes (`velocity_reduce`).
 @group(0) @binding(22) var<storage, read_write> v2_part: array<f32>;
 
@@ -141,6 +145,15 @@ var<private> kc: Kind;
 
 fn use_cell(c: u32) {
     kc = kinds[bitcast<u32>(cell[c + 11u])];
+    // A growing cell (the division clock's growth phase, mechanics::division): its target
+    // area scaled by 1 + clamp((t − t_g0)/T_g, 0, 1) at the time t of the step's start, as the
+    // host's `target_scale`.
+    if (GROWTH == 1u) {
+        let now = prm.growth_now + f32(atomicLoad(&status.steps)) * prm.dt;
+        let g = 1.0 + clamp((now - growth[c / CELL_STRIDE]) / prm.growth_time, 0.0, 1.0);
+        kc.area /= g;
+        kc.inv_target_area /= g;
+    }
 }
 
 // ---- the equations ----

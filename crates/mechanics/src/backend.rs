@@ -53,6 +53,23 @@ pub trait Backend<T: Real>: Send {
     /// [`StepError::Backend`] when the device cannot hold it.
     fn upload(&mut self, tissue: &Tissue<T>) -> Result<(), StepError>;
 
+    /// What the last evaluation on the device computed, for the division clock's decisions
+    /// between steps ([`Tissue::proliferate`], which reads it from the workspace on the host):
+    /// every cell's quantities by slot and, when `pressure`, the tissue pressure `P` per
+    /// lattice node (a pressure gate's). `None` when the backend cannot, or when a queued step
+    /// failed (the driver then syncs, which reports it).
+    ///
+    /// # Errors
+    /// [`StepError::Backend`] when the device fails.
+    fn evaluation(
+        &mut self,
+        tissue: &Tissue<T>,
+        pressure: bool,
+    ) -> Result<Option<DeviceEvaluation>, StepError> {
+        let _ = (tissue, pressure);
+        Ok(None)
+    }
+
     /// The observables of the device's current state ([`Tissue::observe`]), reduced there so
     /// that only the numbers come back, not the fields; `tissue` gives the clock and the
     /// parameters. `None` when the backend cannot, or when a queued step failed: the driver
@@ -64,6 +81,15 @@ pub trait Backend<T: Real>: Send {
         let _ = tissue;
         Ok(None)
     }
+}
+
+/// What a device's last evaluation computed ([`Backend::evaluation`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DeviceEvaluation {
+    /// Every cell's quantities, by slot.
+    pub cells: Vec<crate::CellState>,
+    /// The tissue pressure `P` per lattice node (index `x * ly + y`), when it was asked for.
+    pub pressure: Option<Vec<f64>>,
 }
 
 impl<T: Real> Tissue<T> {

@@ -839,6 +839,61 @@ impl<T: Real> Simulation<T> {
         Ok(())
     }
 
+    /// The division clock after a step on a backend: [`Tissue::proliferate`] on the host,
+    /// from the device's last evaluation, as the host's step leaves it in the workspace. The
+    /// cells' quantities come back after a step only while something could happen (a division
+    /// or a death due by age, or an extrusion rule, which reads the areas), the pressure only
+    /// for a pressure gate with a division due, the state only when an event is pending, and
+    /// it goes back to the device after the events.
+    fn proliferate_on_device(&mut self, before: f64) -> Result<(), SimulationError> {
+        let Some(clock) = self.tissue.proliferation() else {
+            return Ok(());
+        };
+        if !self.tissue.active() {
+            return Ok(());
+        }
+        let timed = clock.timed_event_due(&self.tissue);
+        if !timed && clock.extrusion.is_none() {
+            self.tissue.refresh_target_scale();
+            return Ok(());
+        }
+        let pressure = timed && clock.pressure_gate.is_some();
+        let Some(backend) = self.backend.as_mut() else {
+            return Ok(());
+        };
+        let Some(ev) = backend.evaluation(&self.tissue, pressure)? else {
+            // A queued step failed (the sync says which), or the backend cannot.
+            backend.sync(&mut self.tissue)?;
+            return Err(StepError::Backend {
+                backend: backend.name().to_string(),
+                message: "the backend does not bring back its evaluation, which the division clock reads; set [integrator] backend = \"cpu\"".into(),
+            }
+            .into());
+        };
+        self.workspace.fit(self.tissue.cells());
+        self.workspace.take_device_evaluation(&ev);
+        if !self.tissue.proliferation_pending(&self.workspace, before) {
+            self.tissue.refresh_target_scale();
+            return Ok(());
+        }
+        backend.sync(&mut self.tissue)?;
+        let events = self.tissue.proliferate(&mut self.workspace);
+        // The device takes the events first, also when the run stops here, so that the last
+        // sync finds the cells the host has.
+        if !events.divisions.is_empty() || !events.removals.is_empty() {
+            backend.upload(&self.tissue)?;
+        }
+        if let Some((cell, why)) = events.spared {
+            return Err(SimulationError::Extinct {
+                iteration: self.tissue.iteration(),
+                time: self.tissue.time(),
+                cell,
+                why: why.name(),
+            });
+        }
+        Ok(())
+    }
+
     fn run_loop(&mut self, start: Instant, stop: &mut bool) -> Result<(), SimulationError> {
         self.apply_activity();
         if !self.initialized {
@@ -857,9 +912,11 @@ impl<T: Real> Simulation<T> {
             let it = self.tissue.iteration();
             if let Some(backend) = &mut self.backend {
                 backend.step(&self.tissue, &self.step_params)?;
+                let before = self.tissue.time;
                 self.tissue.iteration += 1;
                 self.tissue.time += self.step_params.dt;
                 self.apply_activity();
+                self.proliferate_on_device(before)?;
                 self.after_device_step(start, stop)?;
                 continue;
             }

@@ -110,7 +110,8 @@ impl<T: Real> Tissue<T> {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SplitAxis {
     /// Across the long axis of the cell's deformation tensor `S_i` (the daughters lie along
-    /// it: Hertwig's rule).
+    /// it: Hertwig's rule); a cell round to round-off (`|S_i|` below 1e-5 of the magnitudes
+    /// summed into it) has none, and splits along a random direction as with `Random`.
     #[default]
     Long,
     /// A direction drawn uniformly from the noise of the cell and the step.
@@ -333,12 +334,16 @@ impl Proliferation {
     /// Fills `out` (by identity) with the target-area scale of every cell of `tissue` at its
     /// time; empty without a growth phase. Grows `out` only when identities are added.
     fn fill_target_scale<T: Real>(&self, tissue: &Tissue<T>, out: &mut Vec<f64>) {
+        self.fill_target_scale_at(tissue, tissue.time(), out);
+    }
+
+    /// [`Proliferation::fill_target_scale`] at the time `now`.
+    fn fill_target_scale_at<T: Real>(&self, tissue: &Tissue<T>, now: f64, out: &mut Vec<f64>) {
         if self.growth_time <= 0.0 {
             out.clear();
             return;
         }
         out.resize(tissue.next_id(), 1.0);
-        let now = tissue.time();
         for &id in tissue.cell_ids() {
             out[id] = self
                 .record_of(id)
@@ -496,18 +501,19 @@ impl Proliferation {
             if tissue.n_cells() >= self.max_cells {
                 break;
             }
-            let direction = match self.axis {
+            // The step computes S_i only when something needs it (activity, or a term): the
+            // mother's own, from her field. A round cell (to round-off) has no long axis.
+            let long = match self.axis {
                 SplitAxis::Long => {
-                    // The step computes S_i only when something needs it (activity, or a
-                    // term): the mother's own, from her field.
-                    let (_, axis) = shape_tensor(tissue, slot).axis();
-                    if axis.norm() > 0.0 {
-                        [axis.x, axis.y]
-                    } else {
-                        [1.0, 0.0]
-                    }
+                    let (s, scale) = shape_tensor(tissue, slot);
+                    let (magnitude, axis) = s.axis();
+                    (magnitude > ROUND * scale).then(|| [axis.x, axis.y])
                 }
-                SplitAxis::Random => {
+                SplitAxis::Random => None,
+            };
+            let direction = match long {
+                Some(axis) => axis,
+                None => {
                     let theta = 2.0
                         * std::f64::consts::PI
                         * NoiseKey {
@@ -552,6 +558,25 @@ impl Proliferation {
             r.death = Some((time, why));
             r.place = place;
         }
+    }
+
+    /// Whether a division or a death is due in `tissue` now, by the cells' ages alone (the
+    /// pressure gate and the cap may still hold a division back): what a device's driver asks
+    /// before it brings the state back for [`Tissue::proliferate`].
+    pub(crate) fn timed_event_due<T: Real>(&self, tissue: &Tissue<T>) -> bool {
+        let now = tissue.time();
+        tissue.cell_ids().iter().any(|&id| {
+            self.record_of(id).is_some_and(|r| {
+                now - r.birth >= r.cycle + self.growth_time
+                    || (self.death_rate > 0.0 && now - r.birth >= self.death_age(r))
+            })
+        })
+    }
+
+    /// The time at which the cell `id` starts to grow (its birth plus its cycle; its target
+    /// area then ramps over [`Proliferation::growth_time`]), if the clock knows it.
+    pub fn growth_start(&self, id: usize) -> Option<f64> {
+        self.record_of(id).map(|r| r.birth + r.cycle)
     }
 
     /// The cells of `tissue` whose age has passed their lifespan at the death rate, in the
@@ -619,6 +644,40 @@ impl<T: Real> Tissue<T> {
         self.ext.proliferation.as_deref()
     }
 
+    /// Brings the growth phase's target areas to the tissue's time, as [`Tissue::proliferate`]
+    /// leaves them: for a device's driver after a step without events, so that what the host
+    /// evaluates (a frame, an observation) sees them.
+    pub(crate) fn refresh_target_scale(&mut self) {
+        if let Some(clock) = self.ext.proliferation.take() {
+            self.set_target_scale(&clock);
+            self.ext.proliferation = Some(clock);
+        }
+    }
+
+    /// Whether [`Tissue::proliferate`] could do anything after this step, judged without the
+    /// state where it can be: a division or death due by age, or cells extruded by the areas
+    /// of the evaluation in `ws`. For a device's driver, which brings the state back only
+    /// then. The growth phase's target areas are brought to `before`, the time the step
+    /// started from, as the host's last [`Tissue::proliferate`] would have left them (the
+    /// extrusion rule reads them, and the device's step used them).
+    pub(crate) fn proliferation_pending(&mut self, ws: &Workspace<T>, before: f64) -> bool {
+        if !self.active {
+            return false;
+        }
+        let Some(clock) = self.ext.proliferation.take() else {
+            return false;
+        };
+        let mut scale = std::mem::take(&mut self.ext.target_scale);
+        clock.fill_target_scale_at(self, before, &mut scale);
+        self.ext.target_scale = scale;
+        let pending = clock.timed_event_due(self)
+            || clock
+                .extrusion
+                .is_some_and(|f| !extruded(self, ws, f).is_empty());
+        self.ext.proliferation = Some(clock);
+        pending
+    }
+
     /// Applies the clock after a step: the divisions that are due, then deaths at the death
     /// rate, then the extrusion rule, each in the order of identities, and fits `ws` to the
     /// new number of cells. Nothing happens while the tissue is inactive (the relaxation of
@@ -665,16 +724,28 @@ impl<T: Real> Tissue<T> {
 
 /// The deformation tensor `S_i` of the cell in slot `slot`, from its field
 /// (`equations::shape_tensor_density` summed over the patch, as the step's first pass does).
-fn shape_tensor<T: Real>(tissue: &Tissue<T>, slot: usize) -> crate::TracelessTensor {
+/// With the scale of its round-off: the sum of the magnitudes `¼ |∇φ|²` of the densities
+/// summed (each density's components are at most that), of which `S_i` of a round cell is a
+/// cancellation.
+fn shape_tensor<T: Real>(tissue: &Tissue<T>, slot: usize) -> (crate::TracelessTensor, f64) {
     let cells = tissue.cells();
     let mut acc = [0.0; 2];
+    let mut scale = 0.0;
     phasefield::for_each_stencil(cells.cell_phi(slot), cells.shape(), |_, s| {
-        let [xx, xy] = crate::equations::shape_tensor_density([s.diff_x(), s.diff_y()]);
+        let (dx, dy) = (s.diff_x(), s.diff_y());
+        let [xx, xy] = crate::equations::shape_tensor_density([dx, dy]);
         acc[0] += 0.25 * xx;
         acc[1] += 0.25 * xy;
+        scale += 0.125 * (dx * dx + dy * dy);
     });
-    crate::TracelessTensor::from(acc)
+    (crate::TracelessTensor::from(acc), scale)
 }
+
+/// How elongated a cell must be for its long axis to be its split axis: `|S_i|` above this
+/// fraction of the magnitudes summed into it (f32 storage leaves `|S_i|` of a round cell at
+/// about 1e-7 of them, so that its "long axis" would be round-off, another on every backend
+/// and precision; below, the axis is drawn at random).
+const ROUND: f64 = 1e-5;
 
 /// The pressure of the cell in slot `slot`, `p_i = Σ_x φ_i P / Σ_x φ_i`, the tissue pressure
 /// `P` of the last evaluation in `ws` weighted by the cell's field.

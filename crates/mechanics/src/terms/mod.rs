@@ -547,6 +547,21 @@ impl Terms {
         }
     }
 
+    /// What the terms see of the cell `id` before an evaluation (`CellContext::state`: what
+    /// the last evaluation of a step computed for it), or `None` for an identity the terms do
+    /// not hold. For a backend that steps elsewhere and keeps it itself.
+    pub fn last_evaluation(&self, id: usize) -> Option<&CellState> {
+        self.last.get(id)
+    }
+
+    /// Sets what the terms see of the cell `id` before an evaluation (see
+    /// [`Terms::last_evaluation`]); nothing for an identity they do not hold.
+    pub fn set_last_evaluation(&mut self, id: usize, state: CellState) {
+        if let Some(s) = self.last.get_mut(id) {
+            *s = state;
+        }
+    }
+
     /// Keeps what the evaluation `view` holds for each cell, by identity ([`Terms::last`]).
     fn remember(&mut self, view: &CellsView<'_>) {
         if self.entries.is_empty() {
