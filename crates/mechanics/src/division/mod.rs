@@ -565,9 +565,12 @@ impl Proliferation {
     /// before it brings the state back for [`Tissue::proliferate`].
     pub(crate) fn timed_event_due<T: Real>(&self, tissue: &Tissue<T>) -> bool {
         let now = tissue.time();
+        // At the cap no division happens (the removals of the same step come after the
+        // divisions), so a cell that waits for room is no event.
+        let room = tissue.n_cells() < self.max_cells;
         tissue.cell_ids().iter().any(|&id| {
             self.record_of(id).is_some_and(|r| {
-                now - r.birth >= r.cycle + self.growth_time
+                (room && now - r.birth >= r.cycle + self.growth_time)
                     || (self.death_rate > 0.0 && now - r.birth >= self.death_age(r))
             })
         })
