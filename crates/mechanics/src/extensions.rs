@@ -128,6 +128,10 @@ pub struct Extensions {
     pub(crate) target_scale: Vec<f64>,
 }
 
+/// The name of the array of what the terms see of each cell ([`Terms::last_evaluation`]):
+/// not of the form `term.variable`, so that no term's state can take it.
+pub const TERM_INPUTS: &str = "term_inputs";
+
 /// How the `lineage` array codes why a cell's life ended (0: it lives).
 const ENDING_CODES: [(Ending, f64); 3] = [
     (Ending::Division, 1.0),
@@ -239,6 +243,28 @@ impl Extensions {
                             values,
                         });
                     }
+                    // What the terms see of each cell before an evaluation (the last step
+                    // evaluation's area and interface force), so that a resumed run's first
+                    // step sees what the uninterrupted run's did. Checkpoints only; one
+                    // written before it existed resumes with zeros, as a new run starts.
+                    if !self.terms.is_empty() {
+                        let values = (0..self.terms.identities())
+                            .flat_map(|id| {
+                                let s = self.terms.last_evaluation(id).copied().unwrap_or_default();
+                                [s.area, s.force.x, s.force.y]
+                            })
+                            .collect();
+                        out.push(StateArray {
+                            name: TERM_INPUTS.into(),
+                            part,
+                            columns: 3,
+                            integer: false,
+                            per_identity: false,
+                            required: false,
+                            meaning: "what the physics terms see of each cell identity before an evaluation: the last step evaluation's area, and its interface force x, y".into(),
+                            values,
+                        });
+                    }
                 }
                 Part::Adhesion | Part::Walls => {}
                 Part::Populations => {
@@ -347,6 +373,25 @@ impl Extensions {
                 return Err(bad(&array.name, "holds non-finite values".into()));
             }
             match array.part {
+                Part::Terms if array.name == TERM_INPUTS => {
+                    if values.len() != 3 * n_ids {
+                        return Err(bad(
+                            &array.name,
+                            format!(
+                                "holds {} values for {n_ids} cells of 3 columns: the file is not of this scene's run",
+                                values.len()
+                            ),
+                        ));
+                    }
+                    for (id, row) in values.chunks_exact(3).enumerate() {
+                        let s = crate::CellState {
+                            area: row[0],
+                            force: nalgebra::Vector2::new(row[1], row[2]),
+                            ..Default::default()
+                        };
+                        self.terms.set_last_evaluation(id, s);
+                    }
+                }
                 Part::Terms => {
                     let variable = array.name.replacen('.', "/", 1);
                     self.terms
@@ -389,8 +434,17 @@ impl Extensions {
                 Part::Terms => {
                     let names =
                         |t: &Terms| t.iter().map(|t| t.name().to_string()).collect::<Vec<_>>();
+                    let seen = |t: &Terms| {
+                        (0..t.identities())
+                            .map(|id| {
+                                t.last_evaluation(id)
+                                    .map(|s| [s.area, s.force.x, s.force.y])
+                            })
+                            .collect::<Vec<_>>()
+                    };
                     names(&self.terms) != names(&other.terms)
                         || self.terms.variables() != other.terms.variables()
+                        || seen(&self.terms) != seen(&other.terms)
                 }
                 Part::Adhesion => false,
                 Part::Populations => {

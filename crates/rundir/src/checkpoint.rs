@@ -395,6 +395,40 @@ mod tests {
     /// part, so a part a checkpoint forgot would fail this: the same checkpoint read for the
     /// scene without that part differs in exactly it. A part added to [`Part::ALL`] that the
     /// scene here does not configure fails the first assertion.
+    /// A run resumed from a checkpoint is the uninterrupted one to the bit also when a term
+    /// reads what the last step evaluation computed for a cell (contact inhibition and a
+    /// density propulsion): the checkpoint keeps it (`term_inputs`). Without that array the
+    /// resumed run's first step saw zeros, and the angles differed from there on.
+    #[test]
+    fn a_resumed_run_sees_what_its_terms_saw() {
+        let text = "[domain]\nlx = 64\nly = 64\n[cells]\ncount = 6\nradius = 6.0\n[model]\nzeta = 0.002\n[polarity]\nalpha = 0.0005\npropulsion = \"density\"\ncontact_inhibition = 2.0\nrotational_diffusion = 0.01\n[run]\nrelax_time = 0.0\n";
+        let scene = scene::Scene::parse(text, &[]).unwrap();
+        let sp = scene.step_params();
+        let start = scene.simulation::<f64>().unwrap().tissue().clone();
+        let steps = |t: &mut Tissue<f64>, ws: &mut mechanics::Workspace<f64>, n: usize| {
+            for _ in 0..n {
+                t.step(ws, &sp).unwrap();
+            }
+        };
+        let mut whole = start.clone();
+        let mut ws = mechanics::Workspace::new(whole.cells());
+        steps(&mut whole, &mut ws, 20);
+        let mut first = start.clone();
+        let mut ws = mechanics::Workspace::new(first.cells());
+        steps(&mut first, &mut ws, 10);
+        let dir = tempfile::tempdir().unwrap();
+        let path = write_checkpoint(dir.path(), &first, None, &scene.to_toml()).unwrap();
+        let mut resumed: Tissue<f64> = read_checkpoint(&path, &scene).unwrap();
+        let mut ws = mechanics::Workspace::new(resumed.cells());
+        steps(&mut resumed, &mut ws, 10);
+        assert_eq!(
+            resumed.terms().state("polarity"),
+            whole.terms().state("polarity"),
+            "the angles"
+        );
+        assert!(resumed.cells().phi() == whole.cells().phi(), "the fields");
+    }
+
     #[test]
     fn every_part_is_written_restored_and_compared() {
         let full = scene(None);

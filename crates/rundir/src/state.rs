@@ -70,7 +70,7 @@ pub fn saved_terms<T: Real>(
 /// [`crate::frame::write_frame`] and [`crate::checkpoint::write_checkpoint`] that every run
 /// writes. The rest are the extensions' and are carried by [`saved_terms`] when the scene has
 /// the part that keeps them.
-const CORE_ARRAYS: [&str; 21] = [
+const CORE_ARRAYS: [&str; 22] = [
     "format",
     "step",
     "time",
@@ -92,6 +92,9 @@ const CORE_ARRAYS: [&str; 21] = [
     "scene",
     "controller",
     "lineage",
+    // What the terms saw of each cell in the last step (a checkpoint's, for a resume): a new
+    // run starts it at zero.
+    mechanics::extensions::TERM_INPUTS,
 ];
 
 /// The extensions' arrays of the saved state `scene` starts from (`init = "frame"`) that the

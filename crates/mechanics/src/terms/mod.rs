@@ -547,6 +547,11 @@ impl Terms {
         }
     }
 
+    /// The identities whose state is allocated (`0..identities()`).
+    pub fn identities(&self) -> usize {
+        self.n
+    }
+
     /// What the terms see of the cell `id` before an evaluation (`CellContext::state`: what
     /// the last evaluation of a step computed for it), or `None` for an identity the terms do
     /// not hold. For a backend that steps elsewhere and keeps it itself.
