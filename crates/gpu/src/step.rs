@@ -50,11 +50,7 @@ pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String
 /// refusal, for a tissue ([`GpuBackend::check`]) and for a scene before anything is written
 /// (the CLI's).
 pub fn unsupported(ext: &mechanics::Extensions, params: &mechanics::ModelParams) -> Vec<String> {
-    let mut out: Vec<String> = mechanics::Part::ALL
-        .into_iter()
-        .filter(|&p| ext.has(p, params) && !SUPPORTED.contains(&p))
-        .map(mechanics::Part::describe)
-        .collect();
+    let mut out = mechanics::backend::unsupported(ext, params, SUPPORTED);
     let terms = ext.terms();
     let polarity = terms.polarity();
     for (t, term) in terms.iter().enumerate() {
@@ -341,7 +337,7 @@ pub struct GpuMemory {
 impl GpuMemory {
     /// The device memory of `n_cells` cells on patches of `shape` on `lattice`, stepped with
     /// `npc` corrector passes, with the extensions `parts` (walls and adhesion hold 8 bytes a
-    /// lattice node each, polarity 32 bytes a cell).
+    /// lattice node each, polarity 32 bytes a cell, division 4).
     pub fn estimate(
         lattice: Lattice,
         shape: &PatchShape,
@@ -357,12 +353,15 @@ impl GpuMemory {
                 _ => 0,
             })
             .sum();
-        // The polarity's row of each cell.
-        let per_cell_parts = if parts.contains(&mechanics::Part::Terms) {
-            POL_STRIDE as u64 * 4
-        } else {
-            0
-        };
+        // The polarity's row of each cell, and with division each cell's growth start.
+        let per_cell_parts: u64 = parts
+            .iter()
+            .map(|p| match p {
+                mechanics::Part::Terms => POL_STRIDE as u64 * 4,
+                mechanics::Part::Division => 4,
+                _ => 0,
+            })
+            .sum();
         let phi_array = n * shape.len() as u64 * 4;
         let phi_arrays = if npc >= 2 { 4 } else { 3 };
         let (nb, cap) = bins(lattice, shape, n_cells);
@@ -1387,18 +1386,19 @@ impl GpuBackend {
         pass.dispatch_workgroups(self.groups_bins, 1, 1);
         // k1 = R(φ) with the check, and the predictor.
         let passes = if evaluate_only { 0 } else { self.npc };
-        for (cell, group, force) in std::iter::once((&p.cell_check, &g.predict, &p.predict)).chain(
-            (0..passes).map(|pass| {
-                let last = pass + 1 == self.npc;
-                let group = if last {
-                    &g.last[pass % 2]
-                } else {
-                    &g.middle[pass % 2]
-                };
-                let force = if last { &p.correct_last } else { &p.correct };
-                (&p.cell, group, force)
-            }),
-        ) {
+        // Each evaluation's cell pass, bind groups and force pass, and which of the polarity's
+        // updates follows it (0: the predictor, 1: a corrector).
+        let first = (&p.cell_check, &g.predict, &p.predict, 0);
+        for (cell, group, force, update) in std::iter::once(first).chain((0..passes).map(|pass| {
+            let last = pass + 1 == self.npc;
+            let group = if last {
+                &g.last[pass % 2]
+            } else {
+                &g.middle[pass % 2]
+            };
+            let force = if last { &p.correct_last } else { &p.correct };
+            (&p.cell, group, force, 1)
+        })) {
             // Each pass over every chunk before the next pass: the lattice sums need every
             // cell's area and shape, the forces every node's sums (chunk by chunk, in order).
             let group = &group[..na];
@@ -1425,8 +1425,7 @@ impl GpuBackend {
             // The polarity's predictor after the first evaluation, its corrector after the
             // others; not in an evaluation alone.
             if let (Some(polarity), false) = (&p.polarity, evaluate_only) {
-                let first = std::ptr::eq(force, &p.predict);
-                pass.set_pipeline(&polarity[usize::from(!first)]);
+                pass.set_pipeline(&polarity[update]);
                 pass.set_bind_group(0, &group[0], &[]);
                 pass.dispatch_workgroups((self.n_cells as u32).div_ceil(WG), 1, 1);
             }
@@ -1614,16 +1613,8 @@ impl GpuBackend {
             .sum();
         let o = mechanics::Observables::from_cells(
             v2 / self.lattice.len() as f64,
-            q.chunks_exact(CELL_STRIDE).map(|c| {
-                let c = |k: usize| f64::from(c[k]);
-                mechanics::CellObservables {
-                    area: c(0),
-                    shape: [c(1), c(2)],
-                    velocity: [c(7), c(8)],
-                    phi_min: c(3),
-                    phi_max: c(4),
-                }
-            }),
+            q.chunks_exact(CELL_STRIDE)
+                .map(|row| mechanics::CellObservables::from(&cell_state_of(row))),
         );
         Ok(Some(o))
     }
@@ -1643,20 +1634,7 @@ impl GpuBackend {
             return Ok(None);
         }
         let q = self.cell_quantities_now()?;
-        let cells = q
-            .chunks_exact(CELL_STRIDE)
-            .map(|c| {
-                let c = |k: usize| f64::from(c[k]);
-                let mut st = mechanics::CellState::default();
-                st.area = c(0);
-                st.shape = mechanics::TracelessTensor::from([c(1), c(2)]);
-                st.force = mechanics::Vector2::new(c(5), c(6));
-                st.velocity = mechanics::Vector2::new(c(7), c(8));
-                st.phi_min = c(3);
-                st.phi_max = c(4);
-                st
-            })
-            .collect();
+        let cells = q.chunks_exact(CELL_STRIDE).map(cell_state_of).collect();
         let pressure = if pressure {
             let mut lat = self.read(&self.lat, self.lat_split as u64 * 16)?;
             let rest = self.lattice.len() - self.lat_split;
@@ -1849,6 +1827,20 @@ impl<T: Real> Backend<T> for GpuBackend {
         self.observables(tissue)
             .map_err(|e| Self::error(e.to_string()))
     }
+}
+
+/// A cell's row of the cell buffer (area, `S_xx`, `S_xy`, `φ_min`, `φ_max`, `F`, `v`, the
+/// centre, the population) as the host's per-cell quantities (the terms' force is not kept).
+fn cell_state_of(row: &[f32]) -> mechanics::CellState {
+    let c = |k: usize| f64::from(row[k]);
+    let mut st = mechanics::CellState::default();
+    st.area = c(0);
+    st.shape = mechanics::TracelessTensor::from([c(1), c(2)]);
+    st.force = mechanics::Vector2::new(c(5), c(6));
+    st.velocity = mechanics::Vector2::new(c(7), c(8));
+    st.phi_min = c(3);
+    st.phi_max = c(4);
+    st
 }
 
 /// The polarity's angle of every identity, as the host holds it.

@@ -402,17 +402,24 @@ struct Stencil {
     yp: f32,
 }
 
-fn stencil(base: u32, a: u32, b: u32) -> Stencil {
+// The patch indices of the stencil at node (a, b) of a patch, periodic within the patch: the
+// centre, then −x, +x, −y, +y.
+fn stencil_nodes(a: u32, b: u32) -> array<u32, 5> {
     let am = select(a - 1u, NX - 1u, a == 0u);
     let ap = select(a + 1u, 0u, a + 1u == NX);
     let bm = select(b - 1u, NY - 1u, b == 0u);
     let bp = select(b + 1u, 0u, b + 1u == NY);
+    return array<u32, 5>(a * NY + b, am * NY + b, ap * NY + b, a * NY + bm, a * NY + bp);
+}
+
+fn stencil(base: u32, a: u32, b: u32) -> Stencil {
+    let k = stencil_nodes(a, b);
     var s: Stencil;
-    s.c = x_phi[base + a * NY + b];
-    s.xm = x_phi[base + am * NY + b];
-    s.xp = x_phi[base + ap * NY + b];
-    s.ym = x_phi[base + a * NY + bm];
-    s.yp = x_phi[base + a * NY + bp];
+    s.c = x_phi[base + k[0]];
+    s.xm = x_phi[base + k[1]];
+    s.xp = x_phi[base + k[2]];
+    s.ym = x_phi[base + k[3]];
+    s.yp = x_phi[base + k[4]];
     return s;
 }
 
@@ -438,16 +445,13 @@ fn cell_stencil(base: u32, a: u32, b: u32) -> Stencil {
     if (LOCAL_PATCH == 0u) {
         return stencil(base, a, b);
     }
-    let am = select(a - 1u, NX - 1u, a == 0u);
-    let ap = select(a + 1u, 0u, a + 1u == NX);
-    let bm = select(b - 1u, NY - 1u, b == 0u);
-    let bp = select(b + 1u, 0u, b + 1u == NY);
+    let k = stencil_nodes(a, b);
     var s: Stencil;
-    s.c = wg_patch[a * NY + b];
-    s.xm = wg_patch[am * NY + b];
-    s.xp = wg_patch[ap * NY + b];
-    s.ym = wg_patch[a * NY + bm];
-    s.yp = wg_patch[a * NY + bp];
+    s.c = wg_patch[k[0]];
+    s.xm = wg_patch[k[1]];
+    s.xp = wg_patch[k[2]];
+    s.ym = wg_patch[k[3]];
+    s.yp = wg_patch[k[4]];
     return s;
 }
 

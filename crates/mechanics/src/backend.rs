@@ -9,8 +9,9 @@
 
 use phasefield::Real;
 
-use crate::extensions::Part;
+use crate::extensions::{Extensions, Part};
 use crate::observables::Observables;
+use crate::params::ModelParams;
 use crate::params::StepParams;
 use crate::tissue::Tissue;
 use crate::StepError;
@@ -127,12 +128,13 @@ impl<T: Real> Tissue<T> {
     }
 }
 
-/// The parts of `tissue` that a backend supporting only `supported` cannot run, each named
-/// with its scene table (empty: it runs them all). The one refusal list: a backend declares
-/// what it supports, and every check derives from [`crate::Tissue::parts`].
-pub fn unsupported<T: Real>(tissue: &Tissue<T>, supported: &[Part]) -> Vec<String> {
-    tissue
-        .parts()
+/// The parts of the extensions `ext` (with the model's `params`) that a backend supporting only
+/// `supported` cannot run, each named with its scene table (empty: it runs them all). The one
+/// refusal list: a backend declares what it supports, and every check derives from
+/// [`Extensions::parts`], for a tissue ([`crate::Tissue::extensions`]) as for a scene's
+/// configured extensions.
+pub fn unsupported(ext: &Extensions, params: &ModelParams, supported: &[Part]) -> Vec<String> {
+    ext.parts(params)
         .into_iter()
         .filter(|p| !supported.contains(p))
         .map(Part::describe)

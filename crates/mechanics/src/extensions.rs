@@ -194,6 +194,15 @@ impl Extensions {
         self.proliferation.as_deref()
     }
 
+    /// The parts there are, in [`Part::ALL`]'s order (with the model's `params`: adhesion is
+    /// one of them).
+    pub fn parts(&self, params: &ModelParams) -> Vec<Part> {
+        Part::ALL
+            .into_iter()
+            .filter(|&p| self.has(p, params))
+            .collect()
+    }
+
     /// Whether `part` is there (adhesion: `params.omega ≠ 0`).
     pub fn has(&self, part: Part, params: &ModelParams) -> bool {
         match part {

@@ -3,7 +3,7 @@
 use phasefield::Real;
 
 use crate::tissue::Tissue;
-use crate::workspace::Workspace;
+use crate::workspace::{CellState, Workspace};
 
 /// Scalar summary of one state, computed on output steps only.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -43,16 +43,7 @@ impl<T: Real> Tissue<T> {
         let cs: &[_] = cell_state;
         let n_nodes = self.lattice().len() as f64;
         let v2: f64 = velocity_field.values().iter().map(|v| v * v).sum::<f64>() / n_nodes;
-        Observables::from_cells(
-            v2,
-            cs.iter().map(|c| CellObservables {
-                area: c.area,
-                shape: c.shape.components(),
-                velocity: [c.velocity.x, c.velocity.y],
-                phi_min: c.phi_min,
-                phi_max: c.phi_max,
-            }),
-        )
+        Observables::from_cells(v2, cs.iter().map(CellObservables::from))
     }
 }
 
@@ -69,6 +60,18 @@ pub struct CellObservables {
     pub phi_min: f64,
     /// The largest φ on its patch.
     pub phi_max: f64,
+}
+
+impl From<&CellState> for CellObservables {
+    fn from(c: &CellState) -> Self {
+        CellObservables {
+            area: c.area,
+            shape: c.shape.components(),
+            velocity: [c.velocity.x, c.velocity.y],
+            phi_min: c.phi_min,
+            phi_max: c.phi_max,
+        }
+    }
 }
 
 impl Observables {

@@ -872,7 +872,10 @@ impl<T: Real> Simulation<T> {
         };
         self.workspace.fit(self.tissue.cells());
         self.workspace.take_device_evaluation(&ev);
-        if !self.tissue.proliferation_pending(&self.workspace, before) {
+        if !self
+            .tissue
+            .proliferation_pending(&self.workspace, before, timed)
+        {
             self.tissue.refresh_target_scale();
             return Ok(());
         }

@@ -171,10 +171,7 @@ impl<T: Real> Tissue<T> {
     /// The parts beyond the paper's model this tissue has, in [`Part::ALL`]'s order (for a
     /// backend's refusal: [`crate::backend::Backend`]).
     pub fn parts(&self) -> Vec<Part> {
-        Part::ALL
-            .into_iter()
-            .filter(|&p| self.ext.has(p, &self.params))
-            .collect()
+        self.ext.parts(&self.params)
     }
 
     /// This tissue with the physics terms `terms` (`crate::terms`), their per-cell state

@@ -348,12 +348,8 @@ impl Scene {
     /// The parts beyond the paper's model the scene has, in [`mechanics::Part::ALL`]'s
     /// order (what a backend must support to run it).
     pub fn parts(&self) -> Vec<mechanics::Part> {
-        let ext = self.configured_extensions();
-        let params = self.model_params(self.zeta());
-        mechanics::Part::ALL
-            .into_iter()
-            .filter(|&p| ext.has(p, &params))
-            .collect()
+        self.configured_extensions()
+            .parts(&self.model_params(self.zeta()))
     }
 
     /// Every extension of the paper's model the scene configures, for `tissue` (its

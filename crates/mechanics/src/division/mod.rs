@@ -658,12 +658,18 @@ impl<T: Real> Tissue<T> {
     }
 
     /// Whether [`Tissue::proliferate`] could do anything after this step, judged without the
-    /// state where it can be: a division or death due by age, or cells extruded by the areas
+    /// state where it can be: a division or death due by age (`timed`, the clock's
+    /// `timed_event_due`, which the caller has asked already), or cells extruded by the areas
     /// of the evaluation in `ws`. For a device's driver, which brings the state back only
     /// then. The growth phase's target areas are brought to `before`, the time the step
     /// started from, as the host's last [`Tissue::proliferate`] would have left them (the
     /// extrusion rule reads them, and the device's step used them).
-    pub(crate) fn proliferation_pending(&mut self, ws: &Workspace<T>, before: f64) -> bool {
+    pub(crate) fn proliferation_pending(
+        &mut self,
+        ws: &Workspace<T>,
+        before: f64,
+        timed: bool,
+    ) -> bool {
         if !self.active {
             return false;
         }
@@ -673,7 +679,7 @@ impl<T: Real> Tissue<T> {
         let mut scale = std::mem::take(&mut self.ext.target_scale);
         clock.fill_target_scale_at(self, before, &mut scale);
         self.ext.target_scale = scale;
-        let pending = clock.timed_event_due(self)
+        let pending = timed
             || clock
                 .extrusion
                 .is_some_and(|f| !extruded(self, ws, f).is_empty());
