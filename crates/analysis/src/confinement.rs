@@ -1,5 +1,5 @@
 //! Observables of confined tissues: how much of a region the cells cover (a wound's gap),
-//! and the flow profile across a channel.
+//! the flow profile across a channel, and the rotation of cells about a disc's centre.
 
 /// The share of the nodes of `region` (a mask, index `x * ly + y`) where the cells' total
 /// `s1 = Σ_i φ_i` is below ½: the open part of a wound. NaN for an empty region.
@@ -41,9 +41,71 @@ pub fn mean_over_x(field: &[f64], lx: usize, ly: usize) -> Vec<f64> {
     out
 }
 
+/// The angular order parameter of cells about `centre`:
+/// `Ω = ⟨(r_i × v_i) / (|r_i| |v_i|)⟩` over the cells, `r_i` the cell's position from the
+/// centre and `v_i` its velocity. `Ω = ±1` when every cell moves along its circle
+/// (counterclockwise positive), 0 on average for undirected motion (its spread is then about
+/// `1/√(2N)`, the sine of a uniform angle having variance ½). Cells at the centre or at rest
+/// are left out; NaN when none is left.
+///
+/// # Panics
+/// If `centres` and `velocities` differ in length.
+pub fn angular_order(centres: &[[f64; 2]], velocities: &[[f64; 2]], centre: [f64; 2]) -> f64 {
+    assert_eq!(centres.len(), velocities.len(), "a velocity for every cell");
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (c, v) in centres.iter().zip(velocities) {
+        let r = [c[0] - centre[0], c[1] - centre[1]];
+        let norm = r[0].hypot(r[1]) * v[0].hypot(v[1]);
+        if norm > 0.0 {
+            sum += (r[0] * v[1] - r[1] * v[0]) / norm;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        f64::NAN
+    } else {
+        sum / n as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_angular_order_is_one_for_a_rigid_rotation_and_zero_for_a_radial_flow() {
+        let centre = [10.0, 20.0];
+        let angles: Vec<f64> = (0..7).map(|k| 0.9 * k as f64).collect();
+        let at: Vec<[f64; 2]> = angles
+            .iter()
+            .enumerate()
+            .map(|(k, a)| {
+                let r = 1.0 + k as f64;
+                [centre[0] + r * a.cos(), centre[1] + r * a.sin()]
+            })
+            .collect();
+        // A rigid rotation ω ẑ × r, counterclockwise: Ω = +1; clockwise: −1.
+        let spin = |w: f64| -> Vec<[f64; 2]> {
+            at.iter()
+                .map(|p| [-w * (p[1] - centre[1]), w * (p[0] - centre[0])])
+                .collect()
+        };
+        assert!((angular_order(&at, &spin(0.3), centre) - 1.0).abs() < 1e-15);
+        assert!((angular_order(&at, &spin(-2.0), centre) + 1.0).abs() < 1e-15);
+        // Radial motion has no angular part.
+        let radial: Vec<[f64; 2]> = at
+            .iter()
+            .map(|p| [p[0] - centre[0], p[1] - centre[1]])
+            .collect();
+        assert!(angular_order(&at, &radial, centre).abs() < 1e-15);
+        // A cell at rest or at the centre is left out.
+        let mut v = spin(1.0);
+        v.push([0.0, 0.0]);
+        let mut c = at.clone();
+        c.push([0.0, 0.0]);
+        assert!((angular_order(&c, &v, centre) - 1.0).abs() < 1e-15);
+        assert!(angular_order(&[centre], &[[1.0, 0.0]], centre).is_nan());
+    }
 
     #[test]
     fn the_uncovered_fraction_counts_the_region_only() {

@@ -183,6 +183,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let res = super::sweep(
             p,
             SweepJob {
+                scene: super::PAPER_SCENE,
                 name: format!("channel-w{w}-{}", p.scale.name()),
                 sets,
                 varies: vec![format!("model.zeta={}", ZETAS.join(","))],

@@ -23,6 +23,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let res = super::sweep(
         p,
         SweepJob {
+            scene: super::PAPER_SCENE,
             name: format!("contractile-{}", p.scale.name()),
             sets,
             varies: vec![

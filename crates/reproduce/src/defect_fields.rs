@@ -105,6 +105,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let res = super::sweep(
         p,
         SweepJob {
+            scene: super::PAPER_SCENE,
             name: format!("defect-fields-{}", p.scale.name()),
             sets,
             varies: vec!["model.pressure=paper,interaction".into()],

@@ -51,6 +51,7 @@ pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResul
     let zeta = super::sweep(
         p,
         SweepJob {
+            scene: super::PAPER_SCENE,
             name: format!("turbulence-zeta-{}", p.scale.name()),
             sets: sets.clone(),
             varies: vec![
@@ -66,6 +67,7 @@ pub(super) fn turbulence(p: &ReproduceParams) -> Result<(SweepResult, SweepResul
     let gamma = super::sweep(
         p,
         SweepJob {
+            scene: super::PAPER_SCENE,
             name: format!("turbulence-gamma-{}", p.scale.name()),
             sets: gsets,
             varies: vec![

@@ -15,8 +15,10 @@ mod channel;
 mod contractile;
 mod defect_fields;
 mod defects;
+mod flocking;
 mod lengths;
 mod rules;
+mod rotation;
 mod run_length;
 mod scaling;
 mod stability;
@@ -34,6 +36,8 @@ use study::{
     analyze_points, run_points, write_summary, Seeds, SweepError, SweepParams, SweepSpec, Vary,
 };
 
+pub use flocking::POLAR_SCENE;
+pub use rotation::DISC_SCENE;
 pub use table::Table;
 
 /// The paper's scene (docs/model.md §8): 60 cells of radius 8 in a periodic 100² box (15 cells per
@@ -141,11 +145,15 @@ pub enum Figure {
     RunLength,
     /// The critical width of flow in a channel against the activity (issue 28).
     Channel,
+    /// Collective rotation of polar cells in a disc (issue 41).
+    Rotation,
+    /// The flocking transition of polar cells against their noise (issue 41).
+    Flocking,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 9] = [
+    pub const ALL: [Figure; 11] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -155,6 +163,8 @@ impl Figure {
         Self::Stability,
         Self::RunLength,
         Self::Channel,
+        Self::Rotation,
+        Self::Flocking,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -169,6 +179,8 @@ impl Figure {
             Self::Stability => "stability",
             Self::RunLength => "run-length",
             Self::Channel => "channel",
+            Self::Rotation => "rotation",
+            Self::Flocking => "flocking",
         }
     }
 
@@ -188,6 +200,8 @@ impl Figure {
                 "The threshold of the random packing against the run length (issue 26)"
             }
             Self::Channel => "The critical width of flow in a channel (issue 28)",
+            Self::Rotation => "Collective rotation of polar cells in a disc (issue 41)",
+            Self::Flocking => "The flocking transition of polar cells against noise (issue 41)",
         }
     }
 }
@@ -332,7 +346,9 @@ impl ReproduceParams {
 pub(crate) struct SweepJob {
     /// Its directory name under `OUT/sweeps/`.
     pub name: String,
-    /// Overrides of [`PAPER_SCENE`].
+    /// The scene ([`PAPER_SCENE`] for the paper's figures).
+    pub scene: &'static str,
+    /// Overrides of the scene.
     pub sets: Vec<String>,
     /// Axes, `key=V1,V2`.
     pub varies: Vec<String>,
@@ -353,7 +369,7 @@ pub(crate) struct SweepResult {
 pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, SweepError> {
     let dir = p.out.join("sweeps").join(&job.name);
     let spec = SweepSpec {
-        scene_text: PAPER_SCENE.to_string(),
+        scene_text: job.scene.to_string(),
         sets: job.sets,
         varies: job
             .varies
@@ -405,6 +421,8 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Stability => stability::make(p, &dir)?,
         Figure::RunLength => run_length::make(p, &dir)?,
         Figure::Channel => channel::make(p, &dir)?,
+        Figure::Rotation => rotation::make(p, &dir)?,
+        Figure::Flocking => flocking::make(p, &dir)?,
     };
     let wall_s = start.elapsed().as_secs_f64();
     write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;
@@ -425,7 +443,7 @@ fn write_verdict(
     wall_s: f64,
 ) -> Result<(), SweepError> {
     let mut s = format!(
-        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (docs/model.md §9) | measured (± as the settings above state) | verdict | reason |\n|---|---|---|---|\n",
+        "# {}\n\nScale `{}`; made by `monolayer reproduce {} --scale {}` in {:.0} s of wall time (a resumed call counts only what it redid).\n\n## Settings\n\n{}\n\n## Verdicts\n\n| claim (docs/model.md §9, or the figure's section of docs/reproduction.md) | measured (± as the settings above state) | verdict | reason |\n|---|---|---|---|\n",
         figure.title(),
         scale.name(),
         figure.name(),

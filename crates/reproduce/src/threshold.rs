@@ -192,6 +192,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let res = super::sweep(
             p,
             SweepJob {
+                scene: super::PAPER_SCENE,
                 name: format!("threshold-L{lx}-{}", p.scale.name()),
                 sets,
                 varies: vec![
@@ -215,6 +216,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let res = super::sweep(
             p,
             SweepJob {
+                scene: super::PAPER_SCENE,
                 name: "threshold-L100-paper-integrator".into(),
                 sets,
                 varies: vec![

@@ -13,6 +13,10 @@ use crate::{Result, RunDirError};
 pub const SERIES_HEADER: &str =
     "step,time,zeta,v_rms,s_rms,area_mean,area_min,area_max,cell_speed_rms,phi_min,phi_max,cells";
 
+/// The header of `analysis/observables.csv`, one row per analysed frame (written by
+/// `monolayer analyze`; its columns are described in docs/outputs.md).
+pub const OBSERVABLES_HEADER: &str = "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap,rotation";
+
 /// Writes `series.csv` row by row, each row in one write, so that a run that stops keeps
 /// them; a row that fails (a full disk) is cut off again, so the file always ends with a
 /// whole row.

@@ -101,7 +101,7 @@ pub fn write_run_json(dir: &Path, scene: &scene::Scene) -> Result<()> {
         .collect(),
         columns: [
             ("series.csv", table(SERIES_HEADER)),
-            ("analysis/observables.csv", table("frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap")),
+            ("analysis/observables.csv", table(crate::OBSERVABLES_HEADER)),
             ("analysis/defects.csv", table("frame,time,x,y,charge,angle,track")),
             ("analysis/defect_events.csv", table("frame,time,kind,x,y")),
             ("analysis/correlations.csv", table("r,c_velocity,c_vorticity,c_q")),

@@ -686,10 +686,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         source,
     })?;
     let mut obs = String::new();
-    row!(
-        obs,
-        "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap"
-    );
+    row!(obs, "{}", rundir::OBSERVABLES_HEADER);
     let mut defects_csv = String::new();
     // Axes and angle conventions are in the README: a comment line here would be taken for
     // the header by pandas and numpy.
@@ -733,12 +730,27 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             w.field(false)
                 .map(|f| (0..lattice.len()).map(|k| f.is_solid(k)).collect())
         });
+    let disc_centre = scene
+        .file()
+        .walls
+        .as_ref()
+        .filter(|w| w.kind == scene::WallKind::Disc)
+        .map(|_| {
+            [
+                (lattice.lx as f64 - 1.0) / 2.0,
+                (lattice.ly as f64 - 1.0) / 2.0,
+            ]
+        });
     for path in &selected {
         let frame = load_frame(path, &scene, &shape, lattice)?;
         if let Some(lineage) = &lineage {
             check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
         }
         let (demix, polar) = mixing_and_order(&frame, &shape);
+        // In a disc (or an ellipse), the cells' rotation about its centre.
+        let rotation = disc_centre.map_or(f64::NAN, |c| {
+            analysis::confinement::angular_order(&frame.centres, &frame.velocities, c)
+        });
         // s1 = Σφ_i on the lattice: the tissue mask of the defects, a wound's gap and the
         // cover of the random points of `cell_events.csv`.
         let (phi_sum, _) = crate::view::phi_sum_and_owner(&frame, shape.nx, shape.ny);
@@ -826,7 +838,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         };
         row!(
             obs,
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -838,7 +850,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             rms(&[&svx, &svy]),
             demix,
             polar,
-            gap
+            gap,
+            rotation
         );
         prev_time = Some(time);
         info.frames += 1;

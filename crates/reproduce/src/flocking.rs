@@ -1,0 +1,375 @@
+//! `reproduce flocking`: the flocking transition of polar cells against their rotational
+//! noise (issue 41, item 5). Self-propelled particles that align with their own velocity
+//! order into a flock below a critical noise (Vicsek et al., Phys. Rev. Lett. 1995); so do
+//! deformable polar cells aligning to their velocity (Löber, Ziebert & Aranson, Sci. Rep.
+//! 2015; Zhang et al., arXiv:2005.13087, 2020).
+//!
+//! One sweep over the rotational diffusion `D_r` of `scenes/polar.toml`'s tissue. The statistic
+//! of a run is the time mean of the polar order `|⟨p_i⟩|` (`polar_order` of
+//! `analysis/observables.csv`) over the second half of the active phase; of a point, its mean
+//! and standard error over seeds. The critical noise `D_c` is where the seed mean crosses ½
+//! (linear in `ln D_r`), its error the jackknife over seeds.
+
+use std::path::Path;
+
+use render::{Plot, Series};
+use study::analyze::AnalyzeOptions;
+use study::SweepError;
+
+use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+
+/// `scenes/polar.toml`'s tissue: 80 polar cells in a periodic 120² box, aligning with their
+/// own velocity; the figure sets `D_r` and the run length.
+pub const POLAR_SCENE: &str = "\
+[domain]
+lx = 120
+ly = 120
+
+[cells]
+count = 80
+radius = 8.0
+
+[model]
+zeta = 0.0
+
+[polarity]
+alpha = 0.04
+rotational_diffusion = 4.5e-4
+align = \"velocity\"
+align_rate = 1.0
+
+[integrator]
+dt = 0.5
+
+[run]
+relax_time = 100.0
+time = 3000.0
+seed = 1
+output_every = 20.0
+series_every = 20.0
+";
+
+/// The cell count of [`POLAR_SCENE`].
+const CELLS: f64 = 80.0;
+
+/// The order parameter at the transition.
+pub(crate) const HALF: f64 = 0.5;
+
+fn settings(scale: Scale) -> (Vec<&'static str>, f64) {
+    match scale {
+        Scale::Quick => (
+            vec![
+                "0.0005", "0.001", "0.002", "0.004", "0.008", "0.016", "0.032", "0.064",
+            ],
+            3000.0,
+        ),
+        Scale::Paper => (
+            vec![
+                "0.0005", "0.001", "0.0014", "0.002", "0.0028", "0.004", "0.0057", "0.008",
+                "0.016", "0.032", "0.064",
+            ],
+            6000.0,
+        ),
+    }
+}
+
+/// The noise where the order `order[k]` (at the increasing noises `d[k]`) first falls below
+/// [`HALF`], linear in `ln d`; `None` when the first point is not above it or no point is
+/// below it.
+pub(crate) fn crossing(d: &[f64], order: &[f64]) -> Option<f64> {
+    if !(order.first()? > &HALF) {
+        return None;
+    }
+    let k = order.iter().position(|&o| o < HALF)?;
+    let (a, b) = (order[k - 1], order[k]);
+    let t = (a - HALF) / (a - b);
+    Some((d[k - 1].ln() + t * (d[k].ln() - d[k - 1].ln())).exp())
+}
+
+/// The critical noise from per-seed orders `order[seed][k]`, and its jackknife error (NaN
+/// with fewer than three seeds or where a jackknife sample has no crossing).
+pub(crate) fn critical_noise(d: &[f64], order: &[Vec<f64>]) -> (Option<f64>, f64) {
+    let mean_of = |seeds: &[usize]| -> Vec<f64> {
+        (0..d.len())
+            .map(|k| seeds.iter().map(|&s| order[s][k]).sum::<f64>() / seeds.len() as f64)
+            .collect()
+    };
+    let all: Vec<usize> = (0..order.len()).collect();
+    let dc = crossing(d, &mean_of(&all));
+    let n = order.len();
+    let Some(dc) = dc else {
+        return (None, f64::NAN);
+    };
+    if n < 3 {
+        return (Some(dc), f64::NAN);
+    }
+    let leave: Option<Vec<f64>> = (0..n)
+        .map(|out| {
+            let keep: Vec<usize> = all.iter().copied().filter(|&s| s != out).collect();
+            crossing(d, &mean_of(&keep)).map(f64::ln)
+        })
+        .collect();
+    let Some(leave) = leave else {
+        return (Some(dc), f64::NAN);
+    };
+    let m = leave.iter().sum::<f64>() / n as f64;
+    let var = (n as f64 - 1.0) / n as f64 * leave.iter().map(|v| (v - m) * (v - m)).sum::<f64>();
+    // The error of ln D_c, carried to D_c.
+    (Some(dc), dc * var.sqrt())
+}
+
+/// The verdict on "the cells flock below a critical noise and lose order above it", from the
+/// mean and standard error of the order at each noise and the critical noise: holds when the
+/// lowest noise is ordered (mean less two standard errors above ½), the highest disordered
+/// (mean plus two standard errors below ½) and `D_c` has an error; does not hold when the
+/// lowest noise is already disordered (no flock at any noise scanned); inconclusive
+/// otherwise.
+pub(crate) fn verdict(stats: &[(f64, f64)], dc: Option<f64>, dc_err: f64) -> (Verdict, String) {
+    let (Some(lo), Some(hi)) = (stats.first(), stats.last()) else {
+        return (Verdict::Inconclusive, "no noise was run".into());
+    };
+    let ordered = |s: &(f64, f64)| s.1.is_finite() && s.0 - 2.0 * s.1 > HALF;
+    let disordered = |s: &(f64, f64)| s.1.is_finite() && s.0 + 2.0 * s.1 < HALF;
+    if disordered(lo) {
+        return (
+            Verdict::DoesNotHold,
+            format!(
+                "even the lowest noise is disordered: order {} ± {}",
+                g(lo.0),
+                g(lo.1)
+            ),
+        );
+    }
+    match dc {
+        Some(dc) if ordered(lo) && disordered(hi) && dc_err.is_finite() => (
+            Verdict::Holds,
+            format!(
+                "ordered at the lowest noise ({} ± {}), disordered at the highest ({} ± {}); D_c = {} ± {}",
+                g(lo.0),
+                g(lo.1),
+                g(hi.0),
+                g(hi.1),
+                g(dc),
+                g(dc_err)
+            ),
+        ),
+        _ => (
+            Verdict::Inconclusive,
+            format!(
+                "order {} ± {} at the lowest noise and {} ± {} at the highest: the scan does not bracket a transition within two standard errors (or a jackknife sample has no crossing)",
+                g(lo.0),
+                g(lo.1),
+                g(hi.0),
+                g(hi.1)
+            ),
+        ),
+    }
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let (noises, t) = settings(p.scale);
+    let relax = 100.0;
+    let from = relax + t / 2.0;
+    let mut sets = vec![format!("run.time={t}")];
+    if p.scale == Scale::Paper {
+        sets.push("integrator.dt=0.2".into());
+    }
+    let res = super::sweep(
+        p,
+        SweepJob {
+            name: format!("flocking-{}", p.scale.name()),
+            scene: POLAR_SCENE,
+            sets,
+            varies: vec![format!(
+                "polarity.rotational_diffusion={}",
+                noises.join(",")
+            )],
+            analyze: Some(AnalyzeOptions::default()),
+            seeds: None,
+        },
+    )?;
+    let recs = res.records(None)?;
+    p.reporter.stage("flocking: tables and plots");
+    let mut seeds: Vec<u64> = recs.iter().map(|r| r.seed).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    let d: Vec<f64> = noises
+        .iter()
+        .map(|v| v.parse().expect("a number"))
+        .collect();
+    // order[seed][noise], and each run's series for the plot in time.
+    let mut order = vec![vec![f64::NAN; noises.len()]; seeds.len()];
+    let mut runs_csv = String::from("rotational_diffusion,seed,polar_order_mean\n");
+    let mut in_time: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
+    for r in &recs {
+        let k = noises
+            .iter()
+            .position(|v| *v == r.values[0])
+            .expect("a noise of the sweep");
+        let s = seeds.binary_search(&r.seed).expect("a seed of the sweep");
+        let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
+        let (times, pol) = (tab.f64s("time")?, tab.f64s("polar_order")?);
+        let w: Vec<f64> = times
+            .iter()
+            .zip(&pol)
+            .filter(|(t, o)| **t >= from && o.is_finite())
+            .map(|(_, o)| *o)
+            .collect();
+        order[s][k] = if w.is_empty() {
+            f64::NAN
+        } else {
+            w.iter().sum::<f64>() / w.len() as f64
+        };
+        runs_csv += &format!("{},{},{:e}\n", r.values[0], r.seed, order[s][k]);
+        if s == 0 {
+            in_time.push((format!("D_r = {}", r.values[0]), times, pol));
+        }
+    }
+    let stats: Vec<(f64, f64)> = (0..d.len())
+        .map(|k| mean_se(&order.iter().map(|o| o[k]).collect::<Vec<_>>()))
+        .collect();
+    let (dc, dc_err) = critical_noise(&d, &order);
+    let null = (std::f64::consts::PI / (4.0 * CELLS)).sqrt();
+    let mut points_csv = String::from("rotational_diffusion,polar_order_mean,polar_order_se\n");
+    for (v, s) in noises.iter().zip(&stats) {
+        points_csv += &format!("{v},{:e},{:e}\n", s.0, s.1);
+    }
+    write_text(&dir.join("flocking_runs.csv"), &runs_csv)?;
+    write_text(&dir.join("flocking.csv"), &points_csv)?;
+    let mut plot = Plot::new(
+        "Flocking against rotational noise",
+        "rotational diffusion D_r (1/TU)",
+        "polar order |⟨p⟩|, second half, mean ± s.e. over seeds",
+    );
+    plot.log_x = true;
+    plot.zero_y = true;
+    plot.legend = render::LegendAt::UpperRight;
+    plot.hlines = vec![
+        (HALF, "½: the transition".into()),
+        (null, "random orientations √(π/4N)".into()),
+    ];
+    plot.series.push(
+        Series::new("80 cells, align to velocity, J = 1, α = 0.04").with_points(
+            &d,
+            &stats.iter().map(|s| s.0).collect::<Vec<_>>(),
+            &stats.iter().map(|s| s.1).collect::<Vec<_>>(),
+        ),
+    );
+    drawn(plot.save_png(&dir.join("flocking.png")))?;
+    let mut tplot = Plot::new(
+        format!("Polar order in time, seed {}", seeds.first().copied().unwrap_or(1)),
+        "time (TU)",
+        "|⟨p⟩|",
+    );
+    tplot.zero_y = true;
+    tplot.legend = render::LegendAt::UpperRight;
+    for (label, times, pol) in &in_time {
+        tplot.series.push(
+            Series::new(label.clone())
+                .with_points(times, pol, &vec![0.0; times.len()])
+                .line_only(),
+        );
+    }
+    drawn(tplot.save_png(&dir.join("flocking_in_time.png")))?;
+    let (v, why) = verdict(&stats, dc, dc_err);
+    // The alignment rate of a cell at its free speed, J α/ξ (ξ = 2).
+    let align_rate = 1.0 * 0.04 / 2.0;
+    let claims = vec![Claim::new(
+        "flocking (issue 41): polar cells aligning with their velocity flock below a critical rotational noise and lose their order above it (Vicsek et al. 1995; Löber et al. 2015)",
+        match dc {
+            Some(dc) => format!(
+                "D_c = {} ± {} (jackknife over seeds), D_c/(J α/ξ) = {}; order {} at D_r = {} and {} at {} (random orientations: {})",
+                g(dc),
+                g(dc_err),
+                g(dc / align_rate),
+                super::pm(stats[0]),
+                noises[0],
+                super::pm(*stats.last().expect("noises")),
+                noises.last().expect("noises"),
+                g(null)
+            ),
+            None => format!(
+                "no crossing of ½; order {} at D_r = {} and {} at {}",
+                super::pm(stats[0]),
+                noises[0],
+                super::pm(*stats.last().expect("noises")),
+                noises.last().expect("noises")
+            ),
+        },
+        v,
+        why,
+    )];
+    let settings = format!(
+        "- `scenes/polar.toml`'s tissue: 80 polar cells (R = 8) in a periodic 120² box, ζ = 0, α = 0.04, alignment to the velocity at J = 1 (a free cell's alignment rate J α/ξ = {}), D_r ∈ {{{}}}; seeds {}.\n\
+         - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
+         - Statistic: the polar order |⟨p_i⟩| of each frame (`polar_order` of `analysis/observables.csv`), its time mean over the second half of the active phase per run, mean ± standard error over seeds. D_c: where the seed mean first falls below ½, linear in ln D_r; error: jackknife over seeds. Random orientations give √(π/4N) = {}.\n\
+         - Rule: holds when the lowest noise is ordered and the highest disordered by two standard errors each way from ½ and D_c has an error; does not hold when the lowest noise is already disordered; inconclusive otherwise.\n\
+         - Data: `flocking_runs.csv`, `flocking.csv`; plots `flocking.png`, `flocking_in_time.png`.",
+        g(align_rate),
+        noises.join(", "),
+        p.scale.seeds(),
+        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        g(null),
+    );
+    Ok((claims, settings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A synthetic order `1/(1 + (D/D_c)²)` per seed, with a seed's scatter of `D_c`.
+    fn synthetic(dc: f64, scatter: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
+        let d: Vec<f64> = (0..8).map(|k| 5e-4 * 2f64.powi(k)).collect();
+        let order = (0..4)
+            .map(|s| {
+                let c = dc * (1.0 + scatter * (s as f64 - 1.5));
+                d.iter().map(|x| 1.0 / (1.0 + (x / c).powi(2))).collect()
+            })
+            .collect();
+        (d, order)
+    }
+
+    fn stats(order: &[Vec<f64>]) -> Vec<(f64, f64)> {
+        (0..order[0].len())
+            .map(|k| mean_se(&order.iter().map(|o| o[k]).collect::<Vec<_>>()))
+            .collect()
+    }
+
+    #[test]
+    fn the_crossing_is_interpolated_in_ln_d() {
+        let d = [1.0, 4.0];
+        // From 0.75 to 0.25: half-way in ln d, at 2.
+        assert!((crossing(&d, &[0.75, 0.25]).unwrap() - 2.0).abs() < 1e-12);
+        assert_eq!(crossing(&d, &[0.4, 0.2]), None);
+        assert_eq!(crossing(&d, &[0.9, 0.8]), None);
+    }
+
+    #[test]
+    fn each_outcome_is_reached() {
+        // A transition at D_c = 4e-3 inside the scan: holds, D_c found within its error.
+        let (d, order) = synthetic(4e-3, 0.05);
+        let (dc, err) = critical_noise(&d, &order);
+        let (v, why) = verdict(&stats(&order), dc, err);
+        assert_eq!(v, Verdict::Holds, "{why}");
+        let dc = dc.unwrap();
+        assert!((dc / 4e-3 - 1.0).abs() < 0.1, "{dc}");
+        assert!(err > 0.0 && err < 0.5 * dc, "{err}");
+        // The transition below the scan: even the lowest noise is disordered.
+        let (d, order) = synthetic(5e-5, 0.05);
+        let (dc, err) = critical_noise(&d, &order);
+        assert_eq!(verdict(&stats(&order), dc, err).0, Verdict::DoesNotHold);
+        // The transition above the scan: all ordered, nothing bracketed.
+        let (d, order) = synthetic(1.0, 0.05);
+        let (dc, err) = critical_noise(&d, &order);
+        assert_eq!(dc, None);
+        assert_eq!(verdict(&stats(&order), dc, err).0, Verdict::Inconclusive);
+        // Seeds that scatter widely at the lowest noise: not decided.
+        let mut order = synthetic(4e-3, 0.05).1;
+        for (s, o) in order.iter_mut().enumerate() {
+            o[0] = if s % 2 == 0 { 0.95 } else { 0.1 };
+        }
+        let (dc, err) = critical_noise(&d, &order);
+        assert_eq!(verdict(&stats(&order), dc, err).0, Verdict::Inconclusive);
+    }
+}

@@ -1,0 +1,498 @@
+//! `reproduce rotation`: collective rotation of polar cells confined to a disc (issue 41,
+//! item 1; T1.4 of the extensions). Epithelial cells on small circular micropatterns rotate
+//! persistently (Doxzen et al., Integr. Biol. 2013; Segerer et al., Phys. Rev. Lett. 2015),
+//! and models with polarity aligned to the velocity or to the contact forces reproduce it.
+//!
+//! Each disc radius and density is a sweep of its own (the domain and the cell count follow
+//! the radius), over the alignment rule (`velocity`, `force`), its rate `J` and the
+//! propulsion `α`. The statistic of a frame is the angular order parameter
+//! `Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩` about the disc's centre (`rotation` of
+//! `analysis/observables.csv`); of a run, its time mean `Ω̄` over the second half of the active
+//! phase and the persistence of its sign (the share of those frames whose `Ω` has the sign of
+//! `Ω̄`); of a point, the mean and standard error over seeds of `|Ω̄|` and the mean
+//! persistence. [`classify`] says whether a point rotates.
+
+use std::path::Path;
+
+use render::{Plot, Series};
+use study::analyze::AnalyzeOptions;
+use study::SweepError;
+
+use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+
+/// The disc scene: polar cells of radius 8 in a disc, the interaction pressure (docs/model.md
+/// §11.4), no activity; the figure sets the disc's radius, the domain and the cell count.
+pub const DISC_SCENE: &str = "\
+[domain]
+lx = 100
+ly = 100
+
+[cells]
+count = 30
+radius = 8.0
+
+[model]
+pressure = \"interaction\"
+zeta = 0.0
+
+[polarity]
+alpha = 0.04
+rotational_diffusion = 4.5e-4
+align = \"velocity\"
+align_rate = 1.0
+
+[walls]
+kind = \"disc\"
+thickness = 1.0
+kappa = 1.0
+
+[integrator]
+dt = 0.5
+
+[run]
+relax_time = 100.0
+time = 3000.0
+seed = 1
+output_every = 20.0
+series_every = 20.0
+";
+
+/// The cell radius of [`DISC_SCENE`].
+const RADIUS: f64 = 8.0;
+
+/// Mean `|Ω̄|` (less two standard errors) from which a point rotates.
+pub(crate) const ROTATES: f64 = 0.5;
+
+/// Mean persistence of the sign from which a point rotates.
+pub(crate) const PERSISTENT: f64 = 0.9;
+
+/// Mean `|Ω̄|` (plus two standard errors) below which a point does not rotate.
+pub(crate) const STILL: f64 = 0.25;
+
+/// The alignment rules and rates, the propulsions.
+const RULES: [&str; 2] = ["velocity", "force"];
+const RATES: [&str; 2] = ["0.1", "1"];
+const ALPHAS: [&str; 2] = ["0.02", "0.04"];
+
+/// The disc radii in cell radii, the area fractions `N R²/R_d²`, the active time.
+fn settings(scale: Scale) -> (Vec<f64>, Vec<f64>, f64) {
+    match scale {
+        Scale::Quick => (vec![2.0, 3.0, 4.0, 6.0], vec![0.7, 0.85], 3000.0),
+        Scale::Paper => (vec![2.0, 3.0, 4.0, 5.0, 6.0, 8.0], vec![0.7, 0.85], 6000.0),
+    }
+}
+
+/// What a point does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum State {
+    /// Persistent collective rotation.
+    Rotates,
+    /// No collective rotation.
+    Still,
+    /// The seeds do not decide.
+    NotEstablished,
+}
+
+impl State {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Rotates => "rotates",
+            Self::Still => "still",
+            Self::NotEstablished => "not established",
+        }
+    }
+}
+
+/// A run's statistic from its frames' times and `Ω`: the mean `Ω̄` over the frames at or after
+/// `from`, and the share of them whose `Ω` has the sign of `Ω̄`. NaN without such frames.
+pub(crate) fn run_statistic(times: &[f64], omega: &[f64], from: f64) -> (f64, f64) {
+    let w: Vec<f64> = times
+        .iter()
+        .zip(omega)
+        .filter(|(t, o)| **t >= from && o.is_finite())
+        .map(|(_, o)| *o)
+        .collect();
+    if w.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let mean = w.iter().sum::<f64>() / w.len() as f64;
+    let same = w.iter().filter(|o| o.signum() == mean.signum()).count();
+    (mean, same as f64 / w.len() as f64)
+}
+
+/// A point's state from its seeds' `Ω̄` and persistences: [`State::Rotates`] when the mean of
+/// `|Ω̄|` less two standard errors is at least [`ROTATES`] and the mean persistence at least
+/// [`PERSISTENT`]; [`State::Still`] when the mean of `|Ω̄|` plus two standard errors is below
+/// [`STILL`]; not established otherwise (and with fewer than two seeds).
+pub(crate) fn classify(omega: &[f64], persistence: &[f64]) -> (State, (f64, f64), f64) {
+    let abs: Vec<f64> = omega.iter().map(|o| o.abs()).collect();
+    let (m, se) = mean_se(&abs);
+    let p = mean_se(persistence).0;
+    let state = if !se.is_finite() {
+        State::NotEstablished
+    } else if m - 2.0 * se >= ROTATES && p >= PERSISTENT {
+        State::Rotates
+    } else if m + 2.0 * se < STILL {
+        State::Still
+    } else {
+        State::NotEstablished
+    };
+    (state, (m, se), p)
+}
+
+/// The claim that confined polar cells rotate: holds when some point rotates, does not hold
+/// when every point is still, inconclusive otherwise.
+pub(crate) fn verdict_rotates(states: &[State]) -> (Verdict, String) {
+    let n = |s: State| states.iter().filter(|&&x| x == s).count();
+    let (r, st, ne) = (
+        n(State::Rotates),
+        n(State::Still),
+        n(State::NotEstablished),
+    );
+    let counts = format!("{r} points rotate, {st} are still, {ne} not established");
+    if r > 0 {
+        (Verdict::Holds, counts)
+    } else if !states.is_empty() && st == states.len() {
+        (Verdict::DoesNotHold, counts)
+    } else {
+        (Verdict::Inconclusive, counts)
+    }
+}
+
+/// The claim that coherent rotation is lost as the disc grows, from each combination of the
+/// other parameters' states at the smallest and the largest radius: holds when one
+/// combination rotates in the smallest disc and is still in the largest; does not hold when
+/// every combination that rotates in the smallest disc (at least one) also rotates in the
+/// largest; inconclusive otherwise.
+pub(crate) fn verdict_size(pairs: &[(State, State)]) -> (Verdict, String) {
+    let small: Vec<&(State, State)> = pairs.iter().filter(|p| p.0 == State::Rotates).collect();
+    let lost = small.iter().filter(|p| p.1 == State::Still).count();
+    let kept = small.iter().filter(|p| p.1 == State::Rotates).count();
+    let counts = format!(
+        "of {} combinations rotating in the smallest disc, {lost} are still and {kept} rotate in the largest",
+        small.len()
+    );
+    if lost > 0 {
+        (Verdict::Holds, counts)
+    } else if !small.is_empty() && kept == small.len() {
+        (Verdict::DoesNotHold, counts)
+    } else {
+        (Verdict::Inconclusive, counts)
+    }
+}
+
+/// One point of the scan and what its seeds did.
+struct PointResult {
+    radius: f64,
+    density: f64,
+    cells: usize,
+    rule: String,
+    rate: String,
+    alpha: String,
+    /// `(seed, Ω̄, persistence)`.
+    runs: Vec<(u64, f64, f64)>,
+    state: State,
+    abs: (f64, f64),
+    persistence: f64,
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let (radii, densities, t) = settings(p.scale);
+    let relax = 100.0;
+    let from = relax + t / 2.0;
+    let mut points: Vec<PointResult> = Vec::new();
+    let mut series_of_scene: Vec<(u64, Vec<f64>, Vec<f64>)> = Vec::new();
+    for &rk in &radii {
+        for &dens in &densities {
+            let rd = rk * RADIUS;
+            let side = (2.0 * rd).round() as usize + 4;
+            let cells = ((dens * rk * rk).round() as usize).max(1);
+            let mut sets = vec![
+                format!("domain.lx={side}"),
+                format!("domain.ly={side}"),
+                format!("walls.radius={rd}"),
+                format!("cells.count={cells}"),
+                format!("run.time={t}"),
+            ];
+            if p.scale == Scale::Paper {
+                sets.push("integrator.dt=0.2".into());
+            }
+            let res = super::sweep(
+                p,
+                SweepJob {
+                    name: format!("rotation-r{rk}-d{dens}-{}", p.scale.name()),
+                    scene: DISC_SCENE,
+                    sets,
+                    varies: vec![
+                        format!(
+                            "polarity.align={}",
+                            RULES.map(|r| format!("\"{r}\"")).join(",")
+                        ),
+                        format!("polarity.align_rate={}", RATES.join(",")),
+                        format!("polarity.alpha={}", ALPHAS.join(",")),
+                    ],
+                    analyze: Some(AnalyzeOptions::default()),
+                    seeds: None,
+                },
+            )?;
+            let recs = res.records(None)?;
+            for rule in RULES {
+                for rate in RATES {
+                    for alpha in ALPHAS {
+                        let mut runs = Vec::new();
+                        for r in recs.iter().filter(|r| {
+                            r.values[0].trim_matches('"') == rule
+                                && r.values[1] == rate
+                                && r.values[2] == alpha
+                        }) {
+                            let tab =
+                                super::Table::read(&r.run.join("analysis/observables.csv"))?;
+                            let (times, omega) = (tab.f64s("time")?, tab.f64s("rotation")?);
+                            let (o, per) = run_statistic(&times, &omega, from);
+                            runs.push((r.seed, o, per));
+                            if (rule, rate, alpha) == SCENE_POINT
+                                && rk == *radii.last().expect("radii")
+                                && dens == *densities.last().expect("densities")
+                            {
+                                series_of_scene.push((r.seed, times, omega));
+                            }
+                        }
+                        let (state, abs, persistence) = classify(
+                            &runs.iter().map(|r| r.1).collect::<Vec<_>>(),
+                            &runs.iter().map(|r| r.2).collect::<Vec<_>>(),
+                        );
+                        points.push(PointResult {
+                            radius: rk,
+                            density: dens,
+                            cells,
+                            rule: rule.into(),
+                            rate: rate.into(),
+                            alpha: alpha.into(),
+                            runs,
+                            state,
+                            abs,
+                            persistence,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    p.reporter.stage("rotation: tables and plots");
+    let mut runs_csv = String::from(
+        "radius_over_r,area_fraction,cells,align,align_rate,alpha,seed,omega_mean,persistence\n",
+    );
+    let mut points_csv = String::from(
+        "radius_over_r,area_fraction,cells,align,align_rate,alpha,abs_omega_mean,abs_omega_se,persistence,state\n",
+    );
+    for pt in &points {
+        for (seed, o, per) in &pt.runs {
+            runs_csv += &format!(
+                "{},{},{},{},{},{},{seed},{o:e},{per:e}\n",
+                pt.radius, pt.density, pt.cells, pt.rule, pt.rate, pt.alpha
+            );
+        }
+        points_csv += &format!(
+            "{},{},{},{},{},{},{:e},{:e},{:e},{}\n",
+            pt.radius,
+            pt.density,
+            pt.cells,
+            pt.rule,
+            pt.rate,
+            pt.alpha,
+            pt.abs.0,
+            pt.abs.1,
+            pt.persistence,
+            pt.state.name()
+        );
+    }
+    write_text(&dir.join("rotation_runs.csv"), &runs_csv)?;
+    write_text(&dir.join("rotation_points.csv"), &points_csv)?;
+    for rule in RULES {
+        let mut plot = Plot::new(
+            format!("Rotation in a disc, align = \"{rule}\""),
+            "disc radius / cell radius",
+            "|Ω̄| over the second half, mean ± s.e. over seeds",
+        );
+        plot.zero_y = true;
+        plot.hlines = vec![
+            (ROTATES, "rotates (less 2 s.e.)".into()),
+            (STILL, "still (plus 2 s.e.)".into()),
+        ];
+        for rate in RATES {
+            for alpha in ALPHAS {
+                for &dens in &densities {
+                    let sel: Vec<&PointResult> = points
+                        .iter()
+                        .filter(|q| {
+                            q.rule == rule && q.rate == rate && q.alpha == alpha && q.density == dens
+                        })
+                        .collect();
+                    let x: Vec<f64> = sel.iter().map(|q| q.radius).collect();
+                    let y: Vec<f64> = sel.iter().map(|q| q.abs.0).collect();
+                    let e: Vec<f64> = sel.iter().map(|q| q.abs.1).collect();
+                    plot.series.push(
+                        Series::new(format!("J = {rate}, α = {alpha}, area fraction {dens}"))
+                            .with_points(&x, &y, &e),
+                    );
+                }
+            }
+        }
+        drawn(plot.save_png(&dir.join(format!("rotation_{rule}.png"))))?;
+    }
+    let mut tplot = Plot::new(
+        format!(
+            "Ω(t) in the largest disc, align = \"{}\", J = {}, α = {}",
+            SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
+        ),
+        "time (TU)",
+        "Ω = ⟨(r × v)/(|r||v|)⟩",
+    );
+    for (seed, times, omega) in &series_of_scene {
+        tplot.series.push(
+            Series::new(format!("seed {seed}"))
+                .with_points(times, omega, &vec![0.0; times.len()])
+                .line_only(),
+        );
+    }
+    if !series_of_scene.is_empty() {
+        drawn(tplot.save_png(&dir.join("rotation_in_time.png")))?;
+    }
+
+    let states: Vec<State> = points.iter().map(|q| q.state).collect();
+    let best = points
+        .iter()
+        .filter(|q| q.state == State::Rotates)
+        .max_by(|a, b| a.abs.0.total_cmp(&b.abs.0));
+    let (v1, why1) = verdict_rotates(&states);
+    let (rmin, rmax) = (radii[0], *radii.last().expect("radii"));
+    let mut pairs = Vec::new();
+    let mut pair_text = Vec::new();
+    for rule in RULES {
+        for rate in RATES {
+            for alpha in ALPHAS {
+                for &dens in &densities {
+                    let at = |rk: f64| {
+                        points.iter().find(|q| {
+                            q.radius == rk
+                                && q.rule == rule
+                                && q.rate == rate
+                                && q.alpha == alpha
+                                && q.density == dens
+                        })
+                    };
+                    if let (Some(a), Some(b)) = (at(rmin), at(rmax)) {
+                        pairs.push((a.state, b.state));
+                        if a.state == State::Rotates {
+                            pair_text.push(format!(
+                                "{rule}, J = {rate}, α = {alpha}, {dens}: {} → {}",
+                                g(a.abs.0),
+                                b.state.name()
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let (v2, why2) = verdict_size(&pairs);
+    let claims = vec![
+        Claim::new(
+            "rotation (issue 41, T1.4 of the extensions): polar cells confined to a disc rotate collectively and persistently for some parameters (Doxzen et al. 2013; Segerer et al. 2015)",
+            match best {
+                Some(b) => format!(
+                    "strongest: |Ω̄| = {} ± {}, persistence {} at R_d = {}R, area fraction {}, align = \"{}\", J = {}, α = {}",
+                    g(b.abs.0), g(b.abs.1), g(b.persistence), b.radius, b.density, b.rule, b.rate, b.alpha
+                ),
+                None => "no point rotates".into(),
+            },
+            v1,
+            why1,
+        ),
+        Claim::new(
+            format!("rotation: coherent rotation is lost as the disc grows (from R_d = {rmin}R to {rmax}R)"),
+            if pair_text.is_empty() { "no combination rotates in the smallest disc".into() } else { pair_text.join("; ") },
+            v2,
+            why2,
+        ),
+    ];
+    let settings = format!(
+        "- Polar cells (R = 8, docs/model.md §11.1) in a disc of radius R_d ∈ {{{}}}·R (`[walls] kind = \"disc\"`, domain 2R_d + 4 square), at area fractions N R²/R_d² ∈ {{{}}}; alignment to the velocity or to the interface force, J ∈ {{{}}}, α ∈ {{{}}}, D_r = 4.5·10⁻⁴, ζ = 0, the interaction pressure; seeds {}.\n\
+         - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
+         - Statistic: Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩ about the disc's centre at each frame (`rotation` of `analysis/observables.csv`); a run's Ω̄ is its mean over the second half of the active phase, its persistence the share of those frames with the sign of Ω̄. A point rotates when the mean over seeds of |Ω̄| less two standard errors is at least {ROTATES} and the mean persistence at least {PERSISTENT}; it is still when the mean of |Ω̄| plus two standard errors is below {STILL}; otherwise not established. (Undirected motion of N cells gives Ω of spread about 1/√(2N) per frame, less in the time mean.)\n\
+         - Claim 1 holds when a point rotates, does not hold when every point is still. Claim 2 holds when a combination rotating in the smallest disc is still in the largest, does not hold when every such combination also rotates in the largest.\n\
+         - Data: `rotation_runs.csv` (every run), `rotation_points.csv` (every point and its state); plots `rotation_velocity.png`, `rotation_force.png` (|Ω̄| against R_d), `rotation_in_time.png` (Ω(t) of each seed at R_d = {}R, area fraction {}, align = \"{}\", J = {}, α = {}: `scenes/disc.toml`'s settings).",
+        radii.iter().map(|r| g(*r)).collect::<Vec<_>>().join(", "),
+        densities.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", "),
+        RATES.join(", "),
+        ALPHAS.join(", "),
+        p.scale.seeds(),
+        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        g(rmax),
+        g(*densities.last().expect("densities")),
+        SCENE_POINT.0,
+        SCENE_POINT.1,
+        SCENE_POINT.2,
+    );
+    Ok((claims, settings))
+}
+
+/// The alignment rule, rate and propulsion of `scenes/disc.toml`, drawn in time.
+const SCENE_POINT: (&str, &str, &str) = ("force", "0.1", "0.04");
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_is_its_time_mean_and_the_persistence_of_its_sign() {
+        let times = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0];
+        let omega = [0.9, 0.9, -0.2, 0.6, 0.8, f64::NAN];
+        // From t = 20: −0.2, 0.6, 0.8 (the NaN left out): mean 0.4, two of three positive.
+        let (m, p) = run_statistic(&times, &omega, 20.0);
+        assert!((m - 0.4).abs() < 1e-12);
+        assert!((p - 2.0 / 3.0).abs() < 1e-12);
+        assert!(run_statistic(&times, &omega, 60.0).0.is_nan());
+    }
+
+    #[test]
+    fn each_state_and_each_verdict_is_reached() {
+        // Three seeds rotating either way, persistently: rotates (the sign does not count).
+        let (s, ..) = classify(&[0.9, -0.85, 0.8], &[1.0, 1.0, 0.95]);
+        assert_eq!(s, State::Rotates);
+        // As strong but its sign flips: not persistent, not established.
+        let (s, ..) = classify(&[0.9, -0.85, 0.8], &[0.6, 0.7, 0.8]);
+        assert_eq!(s, State::NotEstablished);
+        // Small means: still.
+        let (s, ..) = classify(&[0.05, -0.02, 0.08], &[0.6, 0.5, 0.7]);
+        assert_eq!(s, State::Still);
+        // One seed rotates, two do not: the seeds do not decide.
+        let (s, ..) = classify(&[0.9, 0.05, 0.1], &[1.0, 0.6, 0.6]);
+        assert_eq!(s, State::NotEstablished);
+        // One seed: no error, not established.
+        assert_eq!(classify(&[0.95], &[1.0]).0, State::NotEstablished);
+
+        use State::*;
+        assert_eq!(verdict_rotates(&[Still, Rotates]).0, Verdict::Holds);
+        assert_eq!(verdict_rotates(&[Still, Still]).0, Verdict::DoesNotHold);
+        assert_eq!(
+            verdict_rotates(&[Still, NotEstablished]).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(verdict_rotates(&[]).0, Verdict::Inconclusive);
+
+        assert_eq!(
+            verdict_size(&[(Rotates, Rotates), (Rotates, Still)]).0,
+            Verdict::Holds
+        );
+        assert_eq!(
+            verdict_size(&[(Rotates, Rotates), (Still, Still)]).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(
+            verdict_size(&[(Rotates, NotEstablished), (Rotates, Rotates)]).0,
+            Verdict::Inconclusive
+        );
+        assert_eq!(verdict_size(&[(Still, Still)]).0, Verdict::Inconclusive);
+    }
+}
