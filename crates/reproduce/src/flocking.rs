@@ -278,9 +278,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         "flocking (issue 41): polar cells aligning with their velocity flock below a critical rotational noise and lose their order above it (Vicsek et al. 1995; Löber et al. 2015)",
         match dc {
             Some(dc) => format!(
-                "D_c = {} ± {} (jackknife over seeds), D_c/(J α/ξ) = {}; order {} at D_r = {} and {} at {} (random orientations: {})",
+                "D_c = {} ± {} (jackknife over seeds), between the scanned D_r = {} and {}; D_c/(J α/ξ) = {}; order {} at D_r = {} and {} at {} (random orientations: {})",
                 g(dc),
                 g(dc_err),
+                g(d.iter().copied().filter(|&x| x < dc).fold(f64::NAN, f64::max)),
+                g(d.iter().copied().filter(|&x| x > dc).fold(f64::NAN, f64::min)),
                 g(dc / align_rate),
                 super::pm(stats[0]),
                 noises[0],
@@ -302,7 +304,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let settings = format!(
         "- `scenes/polar.toml`'s tissue: 80 polar cells (R = 8) in a periodic 120² box, ζ = 0, α = 0.04, alignment to the velocity at J = 1 (a free cell's alignment rate J α/ξ = {}), D_r ∈ {{{}}}; seeds {}.\n\
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
-         - Statistic: the polar order |⟨p_i⟩| of each frame (`polar_order` of `analysis/observables.csv`), its time mean over the second half of the active phase per run, mean ± standard error over seeds. D_c: where the seed mean first falls below ½, linear in ln D_r; error: jackknife over seeds. Random orientations give √(π/4N) = {}.\n\
+         - Statistic: the polar order |⟨p_i⟩| of each frame (`polar_order` of `analysis/observables.csv`), its time mean over the second half of the active phase per run, mean ± standard error over seeds. D_c: where the seed mean first falls below ½, linear in ln D_r; error: jackknife over seeds (the interpolation's own error is not in it: the scanned noises that bracket D_c are given beside it). Random orientations give √(π/4N) = {}.\n\
          - Rule: holds when the lowest noise is ordered and the highest disordered by two standard errors each way from ½ and D_c has an error; does not hold when the lowest noise is already disordered; inconclusive otherwise.\n\
          - Data: `flocking_runs.csv`, `flocking.csv`; plots `flocking.png`, `flocking_in_time.png`.",
         g(align_rate),

@@ -77,8 +77,8 @@ const ALPHAS: [&str; 2] = ["0.02", "0.04"];
 /// The disc radii in cell radii, the area fractions `N R²/R_d²`, the active time.
 fn settings(scale: Scale) -> (Vec<f64>, Vec<f64>, f64) {
     match scale {
-        Scale::Quick => (vec![2.0, 3.0, 4.0, 6.0], vec![0.7, 0.85], 3000.0),
-        Scale::Paper => (vec![2.0, 3.0, 4.0, 5.0, 6.0, 8.0], vec![0.7, 0.85], 6000.0),
+        Scale::Quick => (vec![2.0, 3.0, 4.0, 6.0], vec![0.6, 0.85], 3000.0),
+        Scale::Paper => (vec![2.0, 3.0, 4.0, 5.0, 6.0, 8.0], vec![0.6, 0.85], 6000.0),
     }
 }
 
@@ -251,8 +251,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                             let (o, per) = run_statistic(&times, &omega, from);
                             runs.push((r.seed, o, per));
                             if (rule, rate, alpha) == SCENE_POINT
-                                && rk == *radii.last().expect("radii")
-                                && dens == *densities.last().expect("densities")
+                                && rk == SCENE_RADIUS
+                                && dens == SCENE_DENSITY
                             {
                                 series_of_scene.push((r.seed, times, omega));
                             }
@@ -342,7 +342,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     }
     let mut tplot = Plot::new(
         format!(
-            "Ω(t) in the largest disc, align = \"{}\", J = {}, α = {}",
+            "Ω(t) at R_d = {SCENE_RADIUS}R, area fraction {SCENE_DENSITY}, align = \"{}\", J = {}, α = {}",
             SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
         ),
         "time (TU)",
@@ -421,15 +421,13 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩ about the disc's centre at each frame (`rotation` of `analysis/observables.csv`); a run's Ω̄ is its mean over the second half of the active phase, its persistence the share of those frames with the sign of Ω̄. A point rotates when the mean over seeds of |Ω̄| less two standard errors is at least {ROTATES} and the mean persistence at least {PERSISTENT}; it is still when the mean of |Ω̄| plus two standard errors is below {STILL}; otherwise not established. (Undirected motion of N cells gives Ω of spread about 1/√(2N) per frame, less in the time mean.)\n\
          - Claim 1 holds when a point rotates, does not hold when every point is still. Claim 2 holds when a combination rotating in the smallest disc is still in the largest, does not hold when every such combination also rotates in the largest.\n\
-         - Data: `rotation_runs.csv` (every run), `rotation_points.csv` (every point and its state); plots `rotation_velocity.png`, `rotation_force.png` (|Ω̄| against R_d), `rotation_in_time.png` (Ω(t) of each seed at R_d = {}R, area fraction {}, align = \"{}\", J = {}, α = {}: `scenes/disc.toml`'s settings).",
+         - Data: `rotation_runs.csv` (every run), `rotation_points.csv` (every point and its state); plots `rotation_velocity.png`, `rotation_force.png` (|Ω̄| against R_d), `rotation_in_time.png` (Ω(t) of each seed at R_d = {SCENE_RADIUS}R, area fraction {SCENE_DENSITY}, align = \"{}\", J = {}, α = {}: `scenes/disc.toml`'s settings).",
         radii.iter().map(|r| g(*r)).collect::<Vec<_>>().join(", "),
         densities.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", "),
         RATES.join(", "),
         ALPHAS.join(", "),
         p.scale.seeds(),
         if p.scale == Scale::Paper { "0.2" } else { "0.5" },
-        g(rmax),
-        g(*densities.last().expect("densities")),
         SCENE_POINT.0,
         SCENE_POINT.1,
         SCENE_POINT.2,
@@ -438,7 +436,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
 }
 
 /// The alignment rule, rate and propulsion of `scenes/disc.toml`, drawn in time.
-const SCENE_POINT: (&str, &str, &str) = ("force", "0.1", "0.04");
+const SCENE_POINT: (&str, &str, &str) = ("velocity", "1", "0.04");
+
+/// The disc radius (in cell radii) and area fraction of `scenes/disc.toml`.
+const SCENE_RADIUS: f64 = 4.0;
+const SCENE_DENSITY: f64 = 0.85;
 
 #[cfg(test)]
 mod tests {

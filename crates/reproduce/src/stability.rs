@@ -167,6 +167,42 @@ fn failed(config: &Config, e: StabilityError) -> SweepError {
     }
 }
 
+/// A configuration's result as kept on disk: its threshold, or why σ did not cross zero.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Outcome {
+    threshold: Option<Threshold>,
+    no_crossing: Option<String>,
+}
+
+/// A result kept on disk with the settings that made it.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Kept<T> {
+    /// The settings, as `{:?}` writes them: a result made with others is made again.
+    fingerprint: String,
+    value: T,
+}
+
+/// The value kept in `path` ([`keep`]) when it was made with `fingerprint`.
+fn kept<T: serde::de::DeserializeOwned>(path: &Path, fingerprint: &str) -> Option<T> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let kept = toml::from_str::<Kept<T>>(&text).ok()?;
+    (kept.fingerprint == fingerprint).then_some(kept.value)
+}
+
+/// Keeps `value`, made with `fingerprint`, in `path` (written whole, under a temporary name
+/// first).
+fn keep<T: serde::Serialize>(path: &Path, fingerprint: &str, value: T) -> Result<T, SweepError> {
+    let kept = Kept {
+        fingerprint: fingerprint.to_string(),
+        value,
+    };
+    let text = toml::to_string(&kept).map_err(|e| SweepError::Reproduce {
+        why: format!("stability: cannot keep {}: {e}", path.display()),
+    })?;
+    write_text(path, &text)?;
+    Ok(kept.value)
+}
+
 /// One measured threshold.
 struct Row {
     config: Config,
@@ -205,6 +241,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .map(|c| (*c, Method::Growth(plan.growth_opts), TOL_GROWTH)),
         )
         .collect();
+    let done = dir.join("configurations");
+    std::fs::create_dir_all(&done).map_err(|e| SweepError::write("stability", &done, e))?;
     for (k, (config, method, tol)) in jobs.iter().enumerate() {
         p.reporter.stage(&format!(
             "stability {}/{}: ζ_cr by {} for {}",
@@ -219,15 +257,40 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             );
         }
         let rest = &rests[&key(config)];
-        let result = match threshold(
-            &rest.tissue,
-            &config.params(),
-            method,
-            &threshold_opts(*tol),
-        ) {
-            Ok(t) => Ok(t),
-            Err(e @ StabilityError::NoCrossing { .. }) => Err(e.to_string()),
-            Err(e) => return Err(failed(config, e)),
+        let opts = threshold_opts(*tol);
+        // Each configuration's result is kept as it finishes, so that a stopped figure goes
+        // on from the next one.
+        let file = done.join(format!(
+            "{}-g{}-{}x{}-{}.toml",
+            method.name(),
+            config.gamma,
+            config.hex.lx,
+            config.hex.ly,
+            pressure_name(config.pressure)
+        ));
+        let fingerprint = format!("{config:?} {method:?} {opts:?} {relax:?}");
+        let outcome: Outcome = match kept(&file, &fingerprint) {
+            Some(o) => o,
+            None => {
+                let o = match threshold(&rest.tissue, &config.params(), method, &opts) {
+                    Ok(t) => Outcome {
+                        threshold: Some(t),
+                        no_crossing: None,
+                    },
+                    Err(e @ StabilityError::NoCrossing { .. }) => Outcome {
+                        threshold: None,
+                        no_crossing: Some(e.to_string()),
+                    },
+                    Err(e) => return Err(failed(config, e)),
+                };
+                keep(&file, &fingerprint, o)?
+            }
+        };
+        let result = match outcome {
+            Outcome {
+                threshold: Some(t), ..
+            } => Ok(t),
+            Outcome { no_crossing, .. } => Err(no_crossing.unwrap_or_default()),
         };
         rows.push(Row {
             config: *config,
@@ -341,6 +404,7 @@ fn write_tables(
 }
 
 /// One line of the convergence table: what changed, σ at the reference ζ, its error.
+#[derive(serde::Serialize, serde::Deserialize)]
 struct Conv {
     what: String,
     sigma: f64,
@@ -416,7 +480,14 @@ fn convergence(
             },
         ),
     ];
-    for (what, dt, margin, steps, opts) in cases {
+    let done = dir.join("configurations");
+    for (k, (what, dt, margin, steps, opts)) in cases.into_iter().enumerate() {
+        let fingerprint = format!("{config:?} ζ {zeta:e} dt {dt} margin {margin} steps {steps} {opts:?}");
+        let file = done.join(format!("convergence-{k}.toml"));
+        if let Some(conv) = kept(&file, &fingerprint) {
+            out.push(conv);
+            continue;
+        }
         if let std::collections::btree_map::Entry::Vacant(slot) = rest_at.entry(margin) {
             let relax = Relaxation {
                 margin,
@@ -436,11 +507,12 @@ fn convergence(
         )
         .map_err(|e| failed(&config, e))?;
         let s = stability::arnoldi(&mut map, &opts, None).map_err(|e| failed(&config, e))?;
-        out.push(Conv {
+        let conv = Conv {
             what,
             sigma: s.sigma(),
             err: s.ritz[0].residual,
-        });
+        };
+        out.push(keep(&file, &fingerprint, conv)?);
     }
     let mut csv = String::from("case,zeta,sigma,sigma_err,zeta_shift\n");
     let reference = out[0].sigma;

@@ -29,7 +29,7 @@ impl Default for ArnoldiOptions {
 }
 
 /// One Ritz pair's eigenvalue, as a rate.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Ritz {
     /// `μ` of the map, real part.
     pub mu_re: f64,
@@ -44,7 +44,7 @@ pub struct Ritz {
 }
 
 /// The leading part of the spectrum.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Spectrum {
     /// The Ritz values, largest σ first.
     pub ritz: Vec<Ritz>,

@@ -124,7 +124,7 @@ pub struct ThresholdOptions {
 }
 
 /// One evaluation of σ(ζ).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Evaluation {
     /// The activity.
     pub zeta: f64,
@@ -135,8 +135,9 @@ pub struct Evaluation {
     pub sigma_err: f64,
 }
 
-/// The threshold of one configuration by one method.
-#[derive(Debug, Clone, PartialEq)]
+/// The threshold of one configuration by one method (serialisable, so that a study can keep
+/// each one as it finishes).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Threshold {
     /// ζ_cr.
     pub zeta_cr: f64,
