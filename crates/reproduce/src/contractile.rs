@@ -7,11 +7,68 @@ use render::{Plot, Series};
 
 use super::column_stats;
 use super::{
-    drawn, g, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict,
+    drawn, g, mean_se, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob,
+    Verdict,
 };
 use study::SweepError;
 
 const ZETAS: [&str; 3] = ["-0.0018", "0", "0.005"];
+
+/// The extensile run's v_rms over the passive one's (less two standard errors) above which
+/// the runs are long enough to show flow.
+const CONTRAST: f64 = 3.0;
+
+/// The verdict on "contractile activity stays stable" from the contractile runs' late growth
+/// rate `d ln v_rms/dt` (mean, standard error over seeds) and the extensile runs' v_rms ratio
+/// to ζ = 0 (mean, standard error): holds when the rate is negative by more than two standard
+/// errors and the extensile contrast exceeds [`CONTRAST`] by two; does not hold when the rate
+/// is positive by more than two standard errors; inconclusive otherwise (a rate within two
+/// standard errors of zero, or runs too short to show the extensile flow).
+pub(crate) fn rule(rate: (f64, f64), extensile: (f64, f64)) -> (Verdict, String) {
+    let (r, e) = rate;
+    if !e.is_finite() {
+        return (
+            Verdict::Inconclusive,
+            "fewer than two seeds: the growth rate has no error".into(),
+        );
+    }
+    let contrast = extensile.0 - 2.0 * extensile.1.max(0.0) > CONTRAST;
+    if r - 2.0 * e > 0.0 {
+        (
+            Verdict::DoesNotHold,
+            format!(
+                "the contractile flow grows: its late growth rate is {} standard errors above zero",
+                g(r / e)
+            ),
+        )
+    } else if r + 2.0 * e < 0.0 && contrast {
+        (
+            Verdict::Holds,
+            format!(
+                "the contractile flow decays (late growth rate {} standard errors below zero: below the threshold by the protocol of the threshold figure), while the extensile run flows {}× faster than ζ = 0",
+                g(-r / e),
+                g(extensile.0)
+            ),
+        )
+    } else if !contrast {
+        (
+            Verdict::Inconclusive,
+            format!(
+                "the extensile contrast does not flow clearly ({}× ζ = 0, less two standard errors not above {CONTRAST}): the runs may be too short",
+                g(extensile.0)
+            ),
+        )
+    } else {
+        (
+            Verdict::Inconclusive,
+            format!(
+                "the late growth rate is within two standard errors of zero ({} ± {} /TU)",
+                g(r),
+                g(e)
+            ),
+        )
+    }
+}
 
 pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
     let t = match p.scale {
@@ -111,41 +168,30 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let v_ratio = mean_std(&paired("-0.0018", v_rms_ratio));
         let e_ratio = mean_std(&paired("0.005", v_rms_ratio));
         let e_rate = mean_std(&paired("0.005", rate_excess));
-        // Stable: its flow decays, ⟨r⟩ < 0, the threshold protocol's "below ζ_cr".
-        let rate = mean_std(
+        // Stable: its flow decays, ⟨r⟩ < 0 beyond its error, the threshold protocol's "below
+        // ζ_cr".
+        let rate = mean_se(
             &of("-0.0018")
                 .iter()
                 .map(|r| r.summary.growth_rate)
                 .collect::<Vec<_>>(),
         );
-        let stable = rate.0 < 0.0;
-        let contrast = e_ratio.0 > 3.0;
+        let e_ratio_se = mean_se(&paired("0.005", v_rms_ratio));
+        let (verdict, reason) = rule(rate, e_ratio_se);
         claims.push(Claim::new(
-        format!("9.3 ({pressure} pressure): contractile activity (ζ = −0.0018) stays stable"),
-        format!(
-            "over the second half of the active phase: late growth rate d ln v_rms/dt = {} /TU; against ζ = 0 from the same seeds: v_rms ratio {}, excess growth rate {} /TU, S_rms excess {}; extensile ζ = 0.005 for contrast: v_rms ratio {}, excess growth rate {} /TU",
-            pm(rate),
-            pm(v_ratio),
-            pm(d_rate),
-            pm(d_s),
-            pm(e_ratio),
-            pm(e_rate)
-        ),
-        match (stable, contrast) {
-            (true, true) => Verdict::Holds,
-            (false, _) => Verdict::DoesNotHold,
-            (true, false) => Verdict::Inconclusive,
-        },
-        match (stable, contrast) {
-            (true, true) => format!(
-                "the contractile flow decays (negative late growth rate, below the threshold by the protocol of the threshold figure), like the passive one, while the extensile run flows {}× faster than ζ = 0; the contractile level stays {}× the passive one from the kick at the switch",
-                g(e_ratio.0),
-                g(v_ratio.0)
+            format!("9.3 ({pressure} pressure): contractile activity (ζ = −0.0018) stays stable"),
+            format!(
+                "over the second half of the active phase: late growth rate d ln v_rms/dt = {} /TU (mean ± s.e.); against ζ = 0 from the same seeds (mean ± std): v_rms ratio {}, excess growth rate {} /TU, S_rms excess {}; extensile ζ = 0.005 for contrast: v_rms ratio {}, excess growth rate {} /TU",
+                pm(rate),
+                pm(v_ratio),
+                pm(d_rate),
+                pm(d_s),
+                pm(e_ratio),
+                pm(e_rate)
             ),
-            (false, _) => "the contractile flow does not decay: its late growth rate is not negative".into(),
-            (true, false) => "the extensile contrast does not flow either: the runs may be too short".into(),
-        },
-    ));
+            verdict,
+            reason,
+        ));
     }
     write_text(&dir.join("contractile_series.csv"), &csv)?;
     let settings = format!(
@@ -157,4 +203,27 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.integrator_name()
     );
     Ok((claims, settings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_outcome_is_reached() {
+        // Decays beyond its error, with a clear extensile contrast: holds.
+        assert_eq!(rule((-2e-3, 4e-4), (12.0, 1.0)).0, Verdict::Holds);
+        // Grows beyond its error: does not hold (whatever the contrast).
+        assert_eq!(rule((1e-3, 2e-4), (12.0, 1.0)).0, Verdict::DoesNotHold);
+        assert_eq!(rule((1e-3, 2e-4), (1.0, 0.1)).0, Verdict::DoesNotHold);
+        // Negative but within two standard errors of zero: inconclusive.
+        assert_eq!(rule((-2e-4, 4e-4), (12.0, 1.0)).0, Verdict::Inconclusive);
+        // Decays, but the extensile runs do not flow clearly: inconclusive.
+        assert_eq!(rule((-2e-3, 4e-4), (3.5, 1.0)).0, Verdict::Inconclusive);
+        // One seed: no error.
+        assert_eq!(
+            rule((-2e-3, f64::NAN), (12.0, 1.0)).0,
+            Verdict::Inconclusive
+        );
+    }
 }

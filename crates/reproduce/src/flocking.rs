@@ -77,7 +77,8 @@ fn settings(scale: Scale) -> (Vec<&'static str>, f64) {
 /// [`HALF`], linear in `ln d`; `None` when the first point is not above it or no point is
 /// below it.
 pub(crate) fn crossing(d: &[f64], order: &[f64]) -> Option<f64> {
-    if !(order.first()? > &HALF) {
+    let first = *order.first()?;
+    if first.is_nan() || first <= HALF {
         return None;
     }
     let k = order.iter().position(|&o| o < HALF)?;
@@ -257,7 +258,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     );
     drawn(plot.save_png(&dir.join("flocking.png")))?;
     let mut tplot = Plot::new(
-        format!("Polar order in time, seed {}", seeds.first().copied().unwrap_or(1)),
+        format!(
+            "Polar order in time, seed {}",
+            seeds.first().copied().unwrap_or(1)
+        ),
         "time (TU)",
         "|⟨p⟩|",
     );

@@ -144,11 +144,7 @@ pub(crate) fn classify(omega: &[f64], persistence: &[f64]) -> (State, (f64, f64)
 /// when every point is still, inconclusive otherwise.
 pub(crate) fn verdict_rotates(states: &[State]) -> (Verdict, String) {
     let n = |s: State| states.iter().filter(|&&x| x == s).count();
-    let (r, st, ne) = (
-        n(State::Rotates),
-        n(State::Still),
-        n(State::NotEstablished),
-    );
+    let (r, st, ne) = (n(State::Rotates), n(State::Still), n(State::NotEstablished));
     let counts = format!("{r} points rotate, {st} are still, {ne} not established");
     if r > 0 {
         (Verdict::Holds, counts)
@@ -245,8 +241,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                                 && r.values[1] == rate
                                 && r.values[2] == alpha
                         }) {
-                            let tab =
-                                super::Table::read(&r.run.join("analysis/observables.csv"))?;
+                            let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
                             let (times, omega) = (tab.f64s("time")?, tab.f64s("rotation")?);
                             let (o, per) = run_statistic(&times, &omega, from);
                             runs.push((r.seed, o, per));
@@ -325,7 +320,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     let sel: Vec<&PointResult> = points
                         .iter()
                         .filter(|q| {
-                            q.rule == rule && q.rate == rate && q.alpha == alpha && q.density == dens
+                            q.rule == rule
+                                && q.rate == rate
+                                && q.alpha == alpha
+                                && q.density == dens
                         })
                         .collect();
                     let x: Vec<f64> = sel.iter().map(|q| q.radius).collect();

@@ -482,7 +482,8 @@ fn convergence(
     ];
     let done = dir.join("configurations");
     for (k, (what, dt, margin, steps, opts)) in cases.into_iter().enumerate() {
-        let fingerprint = format!("{config:?} ζ {zeta:e} dt {dt} margin {margin} steps {steps} {opts:?}");
+        let fingerprint =
+            format!("{config:?} ζ {zeta:e} dt {dt} margin {margin} steps {steps} {opts:?}");
         let file = done.join(format!("convergence-{k}.toml"));
         if let Some(conv) = kept(&file, &fingerprint) {
             out.push(conv);
@@ -1034,6 +1035,47 @@ fn settings(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A threshold kept on disk reads back to the bit, NaN included; one made with other
+    /// settings, or a damaged file, is not read back.
+    #[test]
+    fn a_kept_threshold_reads_back_only_with_its_settings() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("kept.toml");
+        let t = Threshold {
+            zeta_cr: 5.7e-4,
+            err: 1.0 / 3.0 * 1e-5,
+            slope: 0.123456789012345,
+            evaluations: vec![
+                stability::Evaluation {
+                    zeta: 0.0,
+                    sigma: -1.1e-3,
+                    sigma_err: f64::NAN,
+                },
+                stability::Evaluation {
+                    zeta: 8e-3,
+                    sigma: 2.5e-3,
+                    sigma_err: 1e-6,
+                },
+            ],
+            spectrum: None,
+        };
+        let o = Outcome {
+            threshold: Some(t.clone()),
+            no_crossing: None,
+        };
+        keep(&path, "settings A", o).unwrap();
+        let back: Outcome = kept(&path, "settings A").unwrap();
+        let b = back.threshold.unwrap();
+        assert_eq!(b.zeta_cr.to_bits(), t.zeta_cr.to_bits());
+        assert_eq!(b.err.to_bits(), t.err.to_bits());
+        assert_eq!(b.slope.to_bits(), t.slope.to_bits());
+        assert!(b.evaluations[0].sigma_err.is_nan());
+        assert_eq!(b.evaluations[1], t.evaluations[1]);
+        assert!(kept::<Outcome>(&path, "settings B").is_none());
+        std::fs::write(&path, "fingerprint = \"settings A\"\n[value\n").unwrap();
+        assert!(kept::<Outcome>(&path, "settings A").is_none());
+    }
 
     #[test]
     fn the_isolated_cell_rule_gives_each_outcome() {

@@ -102,9 +102,15 @@ pub fn write_run_json(dir: &Path, scene: &scene::Scene) -> Result<()> {
         columns: [
             ("series.csv", table(SERIES_HEADER)),
             ("analysis/observables.csv", table(crate::OBSERVABLES_HEADER)),
-            ("analysis/defects.csv", table("frame,time,x,y,charge,angle,track")),
+            (
+                "analysis/defects.csv",
+                table("frame,time,x,y,charge,angle,track"),
+            ),
             ("analysis/defect_events.csv", table("frame,time,kind,x,y")),
-            ("analysis/correlations.csv", table("r,c_velocity,c_vorticity,c_q")),
+            (
+                "analysis/correlations.csv",
+                table("r,c_velocity,c_vorticity,c_q"),
+            ),
             ("analysis/lengths.csv", table("field,length")),
         ]
         .into_iter()
