@@ -21,6 +21,7 @@ mod rotation;
 mod rules;
 mod run_length;
 mod scaling;
+mod sorting;
 mod stability;
 mod table;
 mod threshold;
@@ -38,6 +39,7 @@ use study::{
 
 pub use flocking::POLAR_SCENE;
 pub use rotation::DISC_SCENE;
+pub use sorting::SORTING_SCENE;
 pub use table::Table;
 
 /// The paper's scene (docs/model.md §8): 60 cells of radius 8 in a periodic 100² box (15 cells per
@@ -149,11 +151,13 @@ pub enum Figure {
     Rotation,
     /// The flocking transition of polar cells against their noise (issue 41).
     Flocking,
+    /// Whether a mixture of two populations sorts (issue 41).
+    Sorting,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 11] = [
+    pub const ALL: [Figure; 12] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -165,6 +169,7 @@ impl Figure {
         Self::Channel,
         Self::Rotation,
         Self::Flocking,
+        Self::Sorting,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -181,6 +186,7 @@ impl Figure {
             Self::Channel => "channel",
             Self::Rotation => "rotation",
             Self::Flocking => "flocking",
+            Self::Sorting => "sorting",
         }
     }
 
@@ -202,6 +208,7 @@ impl Figure {
             Self::Channel => "The critical width of flow in a channel (issue 28)",
             Self::Rotation => "Collective rotation of polar cells in a disc (issue 41)",
             Self::Flocking => "The flocking transition of polar cells against noise (issue 41)",
+            Self::Sorting => "Sorting of a mixture of two populations (issue 41)",
         }
     }
 }
@@ -423,6 +430,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Channel => channel::make(p, &dir)?,
         Figure::Rotation => rotation::make(p, &dir)?,
         Figure::Flocking => flocking::make(p, &dir)?,
+        Figure::Sorting => sorting::make(p, &dir)?,
     };
     let wall_s = start.elapsed().as_secs_f64();
     write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;

@@ -17,8 +17,9 @@ use study::threshold::{growth_threshold, RatePoint, Threshold};
 use study::SweepError;
 
 /// The activities: few, around the brackets of every T (ζ_cr is near 0.004 at T = 100 and has
-/// fallen below 0.001 by T = 800).
-const ZETAS: &str = "0.0005,0.001,0.0015,0.002,0.003,0.004,0.006";
+/// fallen below 0.001 by T = 800), reaching below the lowest per-seed threshold measured with
+/// the grid that started at 5·10⁻⁴ (a seed of the paper form fell below it at T = 3200).
+const ZETAS: &str = "0.0001,0.00025,0.0005,0.001,0.0015,0.002,0.003,0.004,0.006";
 
 /// The run lengths read from the same runs.
 const LENGTHS: [f64; 6] = [100.0, 200.0, 400.0, 800.0, 1600.0, 3200.0];
@@ -91,46 +92,158 @@ pub(crate) fn fit_power(t: &[f64], y: &[f64], e: &[f64]) -> Option<PowerFit> {
     })
 }
 
-/// A finite threshold of the random packing: holds (established) when `ζ_∞ − 2 err > 0`; does
-/// not hold (ruled out) when `ζ_∞ + 2 err ≤ 0`; inconclusive (undecided at this scale)
-/// otherwise, or without a fit.
-pub(crate) fn rule_finite(fit: Option<&PowerFit>) -> (Verdict, String) {
+/// A fit of `ζ_cr(T) = a T^(−b)`: the threshold falls to zero.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ZeroFit {
+    pub a: f64,
+    pub b: f64,
+    pub chi2: f64,
+    pub dof: usize,
+}
+
+/// Weighted least squares of `y = a x^(−b)` (no constant), b on the grid of [`fit_power`].
+/// `None` with fewer than three points.
+pub(crate) fn fit_zero(t: &[f64], y: &[f64], e: &[f64]) -> Option<ZeroFit> {
+    if t.len() < 3 {
+        return None;
+    }
+    (1..=300)
+        .map(|k| {
+            let b = k as f64 * 0.01;
+            let x: Vec<f64> = t.iter().map(|t| t.powf(-b)).collect();
+            // The weighted fit through the origin: a = Σ w x y / Σ w x².
+            let (sxy, sxx) = x
+                .iter()
+                .zip(y)
+                .zip(e)
+                .fold((0.0, 0.0), |(a, c), ((x, y), e)| {
+                    let w = 1.0 / (e * e);
+                    (a + w * x * y, c + w * x * x)
+                });
+            let a = sxy / sxx;
+            let chi2: f64 = x
+                .iter()
+                .zip(y)
+                .zip(e)
+                .map(|((x, y), e)| ((y - a * x) / e).powi(2))
+                .sum();
+            ZeroFit {
+                a,
+                b,
+                chi2,
+                dof: t.len() - 2,
+            }
+        })
+        .min_by(|p, q| p.chi2.total_cmp(&q.chi2))
+}
+
+/// The 99 % point of χ² with `dof` degrees of freedom (Wilson–Hilferty: within 1 % of the
+/// exact quantile from 3 degrees of freedom up, and 4 % at 1).
+pub(crate) fn chi2_99(dof: usize) -> f64 {
+    let n = dof.max(1) as f64;
+    let h = 2.0 / (9.0 * n);
+    n * (1.0 - h + 2.326_348 * h.sqrt()).powi(3)
+}
+
+/// A finite threshold of the random packing, from the free fit `ζ_∞ + a T^(−b)`, the fit with
+/// the limit zero `a T^(−b)`, and the smallest threshold measured `floor`:
+/// - inconclusive when the free fit fails its goodness of fit (χ² above its 99 % point) or
+///   there is no fit;
+/// - holds (a finite limit) when `ζ_∞ − 2 err > 0` and the zero-limit fit is worse by
+///   `Δχ² ≥ 4` (the limit 0 excluded at two standard errors);
+/// - does not hold (the limit is zero) when `ζ_∞ + 2 err ≤ 0`, or when the zero-limit fit
+///   passes its goodness of fit, the free fit improves on it by `Δχ² < 1`, and the free fit
+///   bounds the limit below half the smallest threshold measured (`ζ_∞ + 2 err < floor/2`);
+/// - inconclusive otherwise.
+pub(crate) fn rule_finite(
+    fit: Option<&PowerFit>,
+    zero: Option<&ZeroFit>,
+    floor: f64,
+) -> (Verdict, String) {
     let Some(f) = fit else {
         return (
             Verdict::Inconclusive,
-            "fewer than four run lengths with a bracketed ζ_cr: no fit".into(),
+            "fewer than four run lengths with a measured ζ_cr: no fit".into(),
         );
     };
-    let what = format!(
-        "ζ_cr(T) = ζ_∞ + a T^(−b): ζ_∞ = {} ± {}, b = {} (Δχ² ≤ 1: {}–{}), χ² = {} for {} dof",
+    let mut what = format!(
+        "ζ_cr(T) = ζ_∞ + a T^(−b): ζ_∞ = {} ± {}, b = {} (Δχ² ≤ 1: {}–{}), χ² = {} for {} dof (99 % point {})",
         g(f.zeta_inf),
         g(f.zeta_inf_err),
         g(f.b),
         g(f.b_range.0),
         g(f.b_range.1),
         g(f.chi2),
-        f.dof
+        f.dof,
+        g(chi2_99(f.dof))
     );
-    if f.zeta_inf - 2.0 * f.zeta_inf_err > 0.0 {
+    let delta = zero.map_or(f64::NAN, |z| z.chi2 - f.chi2);
+    if let Some(z) = zero {
+        what += &format!(
+            "; with ζ_∞ = 0: b = {}, χ² = {} for {} dof (99 % point {}), Δχ² = {}",
+            g(z.b),
+            g(z.chi2),
+            z.dof,
+            g(chi2_99(z.dof)),
+            g(delta)
+        );
+    }
+    if f.dof == 0 || f.chi2 > chi2_99(f.dof) {
+        return (
+            Verdict::Inconclusive,
+            format!("{what}: the free fit fails its goodness of fit (or has no degree of freedom left), so its ζ_∞ says nothing"),
+        );
+    }
+    let zero_fits = zero.is_some_and(|z| z.dof > 0 && z.chi2 <= chi2_99(z.dof));
+    if f.zeta_inf - 2.0 * f.zeta_inf_err > 0.0 && delta >= 4.0 {
         (
             Verdict::Holds,
-            format!("{what}: ζ_∞ > 0 by more than 2 errors"),
+            format!("{what}: ζ_∞ > 0 by more than 2 errors, and the limit 0 fits worse by Δχ² ≥ 4"),
         )
     } else if f.zeta_inf + 2.0 * f.zeta_inf_err <= 0.0 {
         (
             Verdict::DoesNotHold,
             format!("{what}: ζ_∞ ≤ 0 by more than 2 errors"),
         )
+    } else if zero_fits && delta < 1.0 && f.zeta_inf + 2.0 * f.zeta_inf_err < floor / 2.0 {
+        (
+            Verdict::DoesNotHold,
+            format!(
+                "{what}: the limit 0 fits as well (Δχ² < 1), and the free fit bounds ζ_∞ below half the smallest threshold measured ({})",
+                g(floor)
+            ),
+        )
     } else {
         (
             Verdict::Inconclusive,
-            format!("{what}: 0 lies within 2 errors of ζ_∞, so the data do not decide"),
+            format!("{what}: neither a positive limit nor the limit 0 is established"),
         )
     }
 }
 
+/// The mean threshold of the seeds at one run length, with the seeds whose crossing lies below
+/// the grid counted as censored, not dropped: each lies somewhere in `[0, lowest ζ]`. The
+/// mean with them at their interval's middle, and an error of the seeds' standard error and
+/// the half-width of the mean's range (censored seeds from 0 to the lowest ζ) in quadrature.
+/// `None` when a seed's crossing lies above the grid (the mean is then unbounded) or fewer
+/// than two seeds have a value.
+pub(crate) fn censored_mean(found: &[f64], below: &[f64]) -> Option<(f64, f64)> {
+    let n = found.len() + below.len();
+    if n < 2 {
+        return None;
+    }
+    let mid: Vec<f64> = found
+        .iter()
+        .copied()
+        .chain(below.iter().map(|hi| hi / 2.0))
+        .collect();
+    let (m, se) = mean_se(&mid);
+    let half = below.iter().sum::<f64>() / 2.0 / n as f64;
+    Some((m, se.hypot(half)))
+}
+
 /// The per-seed ζ_cr: where that seed's growth rate first turns positive.
-fn per_seed(rates: &[(f64, u64, f64)], seed: u64) -> Option<f64> {
+fn per_seed(rates: &[(f64, u64, f64)], seed: u64) -> Threshold {
     let points: Vec<RatePoint> = rates
         .iter()
         .filter(|r| r.1 == seed)
@@ -139,10 +252,7 @@ fn per_seed(rates: &[(f64, u64, f64)], seed: u64) -> Option<f64> {
             rates: vec![r.2],
         })
         .collect();
-    match growth_threshold(&points) {
-        Threshold::Bracketed { zeta_cr, .. } => Some(zeta_cr),
-        _ => None,
-    }
+    growth_threshold(&points)
 }
 
 pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
@@ -171,8 +281,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let s = seeds_of(p.scale);
         (s.first..=s.last).collect()
     };
-    let mut csv = String::from("pressure,run_time,seed,zeta_cr\n");
-    let mut means = String::from("pressure,run_time,zeta_cr,zeta_cr_se,seeds_bracketed,seeds\n");
+    let mut csv = String::from("pressure,run_time,seed,zeta_cr,censored\n");
+    let mut means = String::from(
+        "pressure,run_time,zeta_cr,zeta_cr_err,seeds_bracketed,seeds_below,seeds_above,seeds\n",
+    );
     let mut plot = Plot::new(
         "ζ_cr of the random packing against the run length (L = 100, γ = 0.01)",
         "run length T (TU)",
@@ -181,7 +293,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     plot.log_x = true;
     plot.zero_y = true;
     let mut claims = Vec::new();
-    let mut fits = String::from("pressure,zeta_inf,zeta_inf_err,a,b,b_lo,b_hi,chi2,dof\n");
+    let mut fits = String::from(
+        "pressure,zeta_inf,zeta_inf_err,a,b,b_lo,b_hi,chi2,dof,zero_a,zero_b,zero_chi2,zero_dof\n",
+    );
     for pressure in PRESSURES {
         let mut pts = Vec::new();
         for &t in &LENGTHS {
@@ -197,18 +311,38 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     )
                 })
                 .collect();
-            let mut z = Vec::new();
+            let (mut found, mut below, mut above) = (Vec::new(), Vec::new(), 0usize);
             for &s in &seeds {
-                let v = per_seed(&rates, s);
-                csv += &format!(
-                    "{pressure},{t},{s},{}\n",
-                    v.map_or(String::new(), |v| v.to_string())
-                );
-                z.extend(v);
+                let (value, censored) = match per_seed(&rates, s) {
+                    Threshold::Bracketed { zeta_cr, .. } => {
+                        found.push(zeta_cr);
+                        (zeta_cr.to_string(), "")
+                    }
+                    Threshold::Below { hi } => {
+                        below.push(hi);
+                        (String::new(), "below")
+                    }
+                    // Above the grid (`Threshold::Above`; the enum may grow).
+                    _ => {
+                        above += 1;
+                        (String::new(), "above")
+                    }
+                };
+                csv += &format!("{pressure},{t},{s},{value},{censored}\n");
             }
-            let (m, se) = mean_se(&z);
-            means += &format!("{pressure},{t},{m:e},{se:e},{},{}\n", z.len(), seeds.len());
-            if z.len() >= 2 {
+            let mean = if above > 0 {
+                None
+            } else {
+                censored_mean(&found, &below)
+            };
+            let (m, se) = mean.unwrap_or((f64::NAN, f64::NAN));
+            means += &format!(
+                "{pressure},{t},{m:e},{se:e},{},{},{above},{}\n",
+                found.len(),
+                below.len(),
+                seeds.len()
+            );
+            if mean.is_some() {
                 pts.push((t, m, se));
             }
         }
@@ -220,10 +354,29 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         plot.series
             .push(Series::new(format!("{pressure} form")).with_points(&t, &y, &e));
         let fit = fit_power(&t, &y, &e);
+        let zero = fit_zero(&t, &y, &e);
+        let floor = y.iter().copied().fold(f64::INFINITY, f64::min);
         if let Some(f) = &fit {
+            let z = zero.unwrap_or(ZeroFit {
+                a: f64::NAN,
+                b: f64::NAN,
+                chi2: f64::NAN,
+                dof: 0,
+            });
             fits += &format!(
-                "{pressure},{:e},{:e},{:e},{},{},{},{},{}\n",
-                f.zeta_inf, f.zeta_inf_err, f.a, f.b, f.b_range.0, f.b_range.1, f.chi2, f.dof
+                "{pressure},{:e},{:e},{:e},{},{},{},{},{},{:e},{},{},{}\n",
+                f.zeta_inf,
+                f.zeta_inf_err,
+                f.a,
+                f.b,
+                f.b_range.0,
+                f.b_range.1,
+                f.chi2,
+                f.dof,
+                z.a,
+                z.b,
+                z.chi2,
+                z.dof
             );
             let tt: Vec<f64> = (0..=40)
                 .map(|k| 100.0 * (t_max / 100.0).powf(k as f64 / 40.0))
@@ -235,7 +388,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     .line_only(),
             );
         }
-        let (v, why) = rule_finite(fit.as_ref());
+        let (v, why) = rule_finite(fit.as_ref(), zero.as_ref(), floor);
         claims.push(Claim::new(
             format!("9.1: the random packing has a finite threshold as T → ∞ ({pressure} form)"),
             pts.iter()
@@ -252,8 +405,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     drawn(plot.save_png(&dir.join("zeta_cr_vs_run_length.png")))?;
     let settings = format!(
         "- The paper's scene (L = 100, 60 cells, γ = 0.01, random packing relaxed 200 TU at ζ = 0), {}, both pressure forms, ζ ∈ {{{ZETAS}}}, seeds {}–{}, each run {t_max} TU of activity.\n\
-         - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] first turns positive (linear interpolation between the activities around the crossing); mean ± standard error over the seeds whose crossing lies inside the grid (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
-         - Fit: `ζ_cr(T) = ζ_∞ + a T^(−b)`, weighted by the standard errors, b on a grid over (0, 3]; the error of ζ_∞ is the widest reach of ζ_∞ ± its standard error over the b within Δχ² ≤ 1 (`fit.csv`). Verdict: established when ζ_∞ − 2 err > 0, ruled out when ζ_∞ + 2 err ≤ 0, undecided otherwise.\n\
+         - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] first turns positive (linear interpolation between the activities around the crossing); seeds whose crossing lies below the lowest ζ are censored, not dropped: each lies in [0, lowest ζ], and the mean puts them at the middle with the half-width of the mean's range added to its standard error in quadrature; a run length where a seed's crossing lies above the grid is left out (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
+         - Fit: `ζ_cr(T) = ζ_∞ + a T^(−b)`, weighted by the standard errors, b on a grid over (0, 3]; the error of ζ_∞ is the widest reach of ζ_∞ ± its standard error over the b within Δχ² ≤ 1 (`fit.csv`). Also fitted: the limit zero, `ζ_cr(T) = a T^(−b)`. Verdict: inconclusive when the free fit's χ² exceeds its 99 % point; holds when ζ_∞ − 2 err > 0 and the zero-limit fit is worse by Δχ² ≥ 4; does not hold (the limit is zero) when ζ_∞ + 2 err ≤ 0, or when the zero-limit fit passes its goodness of fit, improves on the free fit by less than Δχ² = 1 and the free fit bounds ζ_∞ below half the smallest threshold measured; inconclusive otherwise.\n\
          - Files: `zeta_cr_vs_run_length.png`, the CSVs above.",
         p.scale.integrator_name(),
         seeds.first().copied().unwrap_or(1),
@@ -277,19 +430,81 @@ mod tests {
         assert!(fit_power(&t[..3], &y[..3], &[1e-6; 3]).is_none());
     }
 
-    /// A limit well above zero is established; one that tends to zero with small errors is
-    /// ruled out only when a positive limit is excluded; large errors leave it undecided.
+    /// Synthetic seed means at the figure's run lengths with relative scatter `noise` that
+    /// alternates in sign (a fixed pattern, not a fit's exact points).
+    fn data(f: impl Fn(f64) -> f64, err: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let t = LENGTHS.to_vec();
+        let y: Vec<f64> = t
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| f(t) + err * [0.6, -0.9, 0.3, 0.8, -0.5, -0.2][k])
+            .collect();
+        (t, y, vec![err; LENGTHS.len()])
+    }
+
+    fn judge(t: &[f64], y: &[f64], e: &[f64]) -> Verdict {
+        let floor = y.iter().copied().fold(f64::INFINITY, f64::min);
+        rule_finite(
+            fit_power(t, y, e).as_ref(),
+            fit_zero(t, y, e).as_ref(),
+            floor,
+        )
+        .0
+    }
+
+    /// Each outcome from data made for it: a limit well above zero is established; a power law
+    /// to zero is recognised as the limit zero (which the old rule could not say); large errors
+    /// leave it undecided; a form that does not fit is not judged.
     #[test]
     fn the_finite_threshold_rule_gives_each_outcome() {
-        let t = LENGTHS;
-        let finite: Vec<f64> = t.iter().map(|t| 8e-4 + 0.02 * t.powf(-0.6)).collect();
-        let f = fit_power(&t, &finite, &[1e-6; 6]);
-        assert_eq!(rule_finite(f.as_ref()).0, Verdict::Holds);
-        let to_zero: Vec<f64> = t.iter().map(|t| -2e-4 + 0.02 * t.powf(-0.5)).collect();
-        let f = fit_power(&t, &to_zero, &[1e-6; 6]);
-        assert_eq!(rule_finite(f.as_ref()).0, Verdict::DoesNotHold);
-        let noisy = fit_power(&t, &finite, &[5e-4; 6]);
-        assert_eq!(rule_finite(noisy.as_ref()).0, Verdict::Inconclusive);
-        assert_eq!(rule_finite(None).0, Verdict::Inconclusive);
+        // ζ_∞ = 8e-4 with errors of 2e-5: holds.
+        let (t, y, e) = data(|t| 8e-4 + 0.02 * t.powf(-0.6), 2e-5);
+        assert_eq!(judge(&t, &y, &e), Verdict::Holds);
+        // To zero, a T^(−0.5) with errors of 2e-5: the limit is zero.
+        let (t, y, e) = data(|t| 0.04 * t.powf(-0.5), 2e-5);
+        let z = fit_zero(&t, &y, &e).unwrap();
+        assert!((z.b - 0.5).abs() < 0.05, "{z:?}");
+        assert_eq!(judge(&t, &y, &e), Verdict::DoesNotHold);
+        // A negative limit, well measured: does not hold either.
+        let (t, y, e) = data(|t| -2e-4 + 0.02 * t.powf(-0.5), 1e-6);
+        assert_eq!(judge(&t, &y, &e), Verdict::DoesNotHold);
+        // The finite limit with errors as large as it: undecided.
+        let (t, y, e) = data(|t| 8e-4 + 0.02 * t.powf(-0.6), 5e-4);
+        assert_eq!(judge(&t, &y, &e), Verdict::Inconclusive);
+        // A step the form cannot follow, with small errors: the fit fails, not judged.
+        let (t, y, e) = data(|t| if t < 500.0 { 3e-3 } else { 1e-3 }, 2e-5);
+        let f = fit_power(&t, &y, &e).unwrap();
+        assert!(f.chi2 > chi2_99(f.dof), "{f:?}");
+        assert_eq!(judge(&t, &y, &e), Verdict::Inconclusive);
+        assert_eq!(rule_finite(None, None, 1e-3).0, Verdict::Inconclusive);
+    }
+
+    /// The 99 % points of χ² against tables: 6.63 (1 dof), 11.34 (3), 15.09 (5), 23.21 (10).
+    #[test]
+    fn the_chi2_points_match_the_tables() {
+        for (dof, exact) in [(1, 6.635), (3, 11.345), (5, 15.086), (10, 23.209)] {
+            let rel = (chi2_99(dof) / exact - 1.0).abs();
+            assert!(
+                rel < if dof == 1 { 0.04 } else { 0.01 },
+                "{dof}: {}",
+                chi2_99(dof)
+            );
+        }
+    }
+
+    /// Censored seeds widen the mean's error instead of raising it: with one of three seeds
+    /// below a grid starting at 5e-4, the mean is that of (6e-4, 8e-4, 2.5e-4) and its error
+    /// grows by the range the censored seed leaves open.
+    #[test]
+    fn censored_seeds_are_counted_not_dropped() {
+        let (m, e) = censored_mean(&[6e-4, 8e-4], &[5e-4]).unwrap();
+        assert!((m - (6e-4 + 8e-4 + 2.5e-4) / 3.0).abs() < 1e-15);
+        let (_, se) = mean_se(&[6e-4, 8e-4, 2.5e-4]);
+        assert!((e - se.hypot(5e-4 / 2.0 / 3.0)).abs() < 1e-15);
+        // Dropping it would have given 7e-4: an upward bias the censored mean does not have.
+        assert!(m < 7e-4);
+        assert_eq!(censored_mean(&[6e-4], &[]), None);
+        let (m, _) = censored_mean(&[6e-4, 8e-4], &[]).unwrap();
+        assert!((m - 7e-4).abs() < 1e-15);
     }
 }
