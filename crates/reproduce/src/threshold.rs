@@ -612,19 +612,12 @@ fn verdicts(all: &[Group], half: &[Group], compare: &[Group]) -> Vec<Claim> {
             ));
         }
     }
+    let (v, why) = rule_pressure_form(lower, n);
     claims.push(Claim::new(
         "Pressure form (issue 11): does the interaction pressure give a lower ζ_cr than the paper form?",
         diffs.join("; "),
-        if n == 0 {
-            Verdict::Inconclusive
-        } else if lower == n {
-            Verdict::Holds
-        } else if lower == 0 {
-            Verdict::DoesNotHold
-        } else {
-            Verdict::Inconclusive
-        },
-        format!("lower in {lower} of {n} bracketed pairs"),
+        v,
+        why,
     ));
     if !compare.is_empty() {
         let mut text = Vec::new();
@@ -668,6 +661,22 @@ fn verdicts(all: &[Group], half: &[Group], compare: &[Group]) -> Vec<Claim> {
     claims
 }
 
+/// The pressure form's verdict from the count of bracketed pairs (box, γ) in which the
+/// interaction form's ζ_cr is the lower: holds when it is lower in every pair, does not hold
+/// when in none, inconclusive when in some, or without a pair.
+fn rule_pressure_form(lower: usize, n: usize) -> (Verdict, String) {
+    let v = if n == 0 {
+        Verdict::Inconclusive
+    } else if lower == n {
+        Verdict::Holds
+    } else if lower == 0 {
+        Verdict::DoesNotHold
+    } else {
+        Verdict::Inconclusive
+    };
+    (v, format!("lower in {lower} of {n} bracketed pairs"))
+}
+
 /// One verdict from several: does not hold if any does not, holds if all hold, else
 /// inconclusive.
 fn combine(v: &[(Verdict, String)]) -> Verdict {
@@ -686,13 +695,18 @@ mod tests {
     use study::summary::RunSummary;
 
     /// Synthetic runs whose late growth rate is `r = 1.5 (ζ − ζ_cr(γ))` plus a seed offset that
-    /// cancels in the mean, on both boxes and forms.
+    /// cancels in the mean, on both boxes and forms; v_rms rises by 2× over the ζ grid.
     fn recs(zeta_cr: impl Fn(f64, &str) -> f64) -> Vec<Rec> {
+        recs_with(zeta_cr, [-1e-4, 0.0, 1e-4], 100.0)
+    }
+
+    /// The same with the seeds' offsets of the growth rate and v_rms = 10⁻³ (1 + `flow` ζ).
+    fn recs_with(zeta_cr: impl Fn(f64, &str) -> f64, offsets: [f64; 3], flow: f64) -> Vec<Rec> {
         let mut out = Vec::new();
         for pressure in PRESSURES {
             for gamma in GAMMAS {
                 for z in ZETAS.split(',') {
-                    for (seed, off) in [(1, -1e-4), (2, 0.0), (3, 1e-4)] {
+                    for (seed, off) in [1, 2, 3].into_iter().zip(offsets) {
                         let zeta: f64 = z.parse().unwrap();
                         let rate = 1.5 * (zeta - zeta_cr(gamma, pressure)) + off;
                         out.push(Rec {
@@ -703,7 +717,7 @@ mod tests {
                                 window_start: 0.0,
                                 window_end: 1.0,
                                 rows: 2,
-                                v_rms: 1e-3 * (1.0 + 100.0 * zeta),
+                                v_rms: 1e-3 * (1.0 + flow * zeta),
                                 s_rms: 1.0 + 50.0 * zeta,
                                 area_mean: 200.0,
                                 growth_rate: rate,
@@ -767,5 +781,56 @@ mod tests {
             .collect();
         let claims = verdicts(&all, &all, &[]);
         assert_eq!(verdict_of(&claims, "9.2a ("), [Verdict::DoesNotHold; 4]);
+    }
+
+    /// 9.1 gives each outcome: flow that rises 3× with a threshold that has settled between
+    /// T/2 and T holds; the same flow with a threshold that moves by 40 % is inconclusive; a
+    /// flow that does not rise 3× does not hold (above).
+    #[test]
+    fn the_composite_9_1_gives_each_outcome() {
+        let cr = |gamma: f64, _: &str| 0.001 + 0.1 * gamma;
+        let groups_of = |r: &[Rec]| -> Vec<Group> {
+            BOXES
+                .iter()
+                .flat_map(|(lx, _)| groups(r, *lx, "test", true))
+                .collect()
+        };
+        // v_rms 10× over the grid; at T/2 the seeds' thresholds differ by ±7e-6 about those at
+        // T: settled within 10 % of ζ_cr.
+        let late = groups_of(&recs_with(cr, [-1e-4, 0.0, 1e-4], 1500.0));
+        let early = groups_of(&recs_with(cr, [-1.1e-4, 0.0, 1.1e-4], 1500.0));
+        let claims = verdicts(&late, &early, &[]);
+        assert_eq!(verdict_of(&claims, "9.1"), [Verdict::Holds; 2]);
+        // At T/2 the threshold was 40 % higher: not settled, so not established.
+        let moved = groups_of(&recs_with(
+            |g, p| 1.4 * cr(g, p),
+            [-1.1e-4, 0.0, 1.1e-4],
+            1500.0,
+        ));
+        let claims = verdicts(&late, &moved, &[]);
+        assert_eq!(verdict_of(&claims, "9.1"), [Verdict::Inconclusive; 2]);
+    }
+
+    /// The pressure form's count gives each outcome, and the synthetic runs reach "does not
+    /// hold" when the interaction form's threshold is the higher.
+    #[test]
+    fn the_pressure_form_count_gives_each_outcome() {
+        assert_eq!(rule_pressure_form(6, 6).0, Verdict::Holds);
+        assert_eq!(rule_pressure_form(0, 6).0, Verdict::DoesNotHold);
+        assert_eq!(rule_pressure_form(4, 6).0, Verdict::Inconclusive);
+        assert_eq!(rule_pressure_form(0, 0).0, Verdict::Inconclusive);
+        let higher = recs(|gamma, p| {
+            if p == "paper" {
+                0.001 + 0.1 * gamma
+            } else {
+                0.0015 + 0.1 * gamma
+            }
+        });
+        let all: Vec<Group> = BOXES
+            .iter()
+            .flat_map(|(lx, _)| groups(&higher, *lx, "test", true))
+            .collect();
+        let claims = verdicts(&all, &all, &[]);
+        assert_eq!(verdict_of(&claims, "Pressure form"), [Verdict::DoesNotHold]);
     }
 }
