@@ -12,7 +12,8 @@
 //! - [`defects`]: ±½ defects by winding, orientation by Vromans & Giomi;
 //! - [`tracking`]: links between frames, creation and annihilation in pairs;
 //! - [`crop`]: fields averaged in the frame of each defect;
-//! - [`proximity`]: how near events come to defects, against random points in the tissue.
+//! - [`proximity`]: how near events come to defects, against random points in the tissue;
+//! - [`motion`]: mean squared displacements of tracked cells, and the shape index of a cell.
 //!
 //! Axis convention: x first index, y second, right-handed; angles counterclockwise from +x.
 //!
@@ -44,6 +45,7 @@ pub mod crop;
 pub mod defects;
 pub mod fields;
 pub mod mixing;
+pub mod motion;
 pub mod proximity;
 pub mod smooth;
 pub mod tracking;

@@ -36,7 +36,7 @@ pub use frame::{
 };
 pub use lineage::{read_lineage, write_lineage, LINEAGE_HEADER};
 pub use run::{lock_dir, DirLock, Interrupt, Outcome, RunDir, RunError, LOCK};
-pub use series::{SeriesWriter, OBSERVABLES_HEADER, SERIES_HEADER};
+pub use series::{SeriesWriter, MSD_HEADER, OBSERVABLES_HEADER, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
 pub use state::{initial_state, initial_tissue, not_carried, read_state, StateError};
 pub use writers::{

@@ -15,7 +15,12 @@ pub const SERIES_HEADER: &str =
 
 /// The header of `analysis/observables.csv`, one row per analysed frame (written by
 /// `monolayer analyze`; its columns are described in docs/outputs.md).
-pub const OBSERVABLES_HEADER: &str = "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap,rotation";
+pub const OBSERVABLES_HEADER: &str = "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap,rotation,shape_index";
+
+/// The header of `analysis/msd.csv`: the mean squared displacement of the cells at each lag
+/// between analysed frames, with the tissue's mean displacement removed (`msd`) and kept
+/// (`msd_raw`), and the number of (cell, time origin) pairs averaged.
+pub const MSD_HEADER: &str = "lag,msd,msd_raw,samples";
 
 /// Writes `series.csv` row by row, each row in one write, so that a run that stops keeps
 /// them; a row that fails (a full disk) is cut off again, so the file always ends with a

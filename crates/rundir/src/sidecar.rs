@@ -41,6 +41,8 @@ fn unit(column: &str) -> &'static str {
         "v_rms" | "v_rms_smooth" | "cell_speed_rms" => "nodes/TU",
         "area_mean" | "area_min" | "area_max" => "nodes² (Σ φ²)",
         "x" | "y" | "r" | "length" => "nodes",
+        "lag" => "TU",
+        "msd" | "msd_raw" => "nodes²",
         "angle" => "radians",
         "defect_density" => "defects per node",
         "cells" | "divisions" | "extrusions" | "deaths" => "cells",

@@ -730,6 +730,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             w.field(false)
                 .map(|f| (0..lattice.len()).map(|k| f.is_solid(k)).collect())
         });
+    let mut positions: Vec<analysis::motion::Positions> = Vec::new();
     let disc_centre = scene
         .file()
         .walls
@@ -747,6 +748,24 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
         }
         let (demix, polar) = mixing_and_order(&frame, &shape);
+        // Each cell's shape index P/√A, averaged; and the centres for the MSD.
+        let cells_n = frame.centres.len();
+        let patch = shape.nx * shape.ny;
+        let shape_index = if cells_n == 0 {
+            f64::NAN
+        } else {
+            frame
+                .phi
+                .chunks_exact(patch)
+                .map(|p| analysis::motion::shape_index(p, shape.nx, shape.ny))
+                .sum::<f64>()
+                / cells_n as f64
+        };
+        positions.push(analysis::motion::Positions {
+            time: frame.tissue.time(),
+            ids: frame.ids.clone(),
+            centres: frame.centres.clone(),
+        });
         // In a disc (or an ellipse), the cells' rotation about its centre.
         let rotation = disc_centre.map_or(f64::NAN, |c| {
             analysis::confinement::angular_order(&frame.centres, &frame.velocities, c)
@@ -838,7 +857,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         };
         row!(
             obs,
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -851,7 +870,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             demix,
             polar,
             gap,
-            rotation
+            rotation,
+            shape_index
         );
         prev_time = Some(time);
         info.frames += 1;
@@ -859,6 +879,24 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         info.events += tracks.events.len();
     }
     write_file(&out.join("observables.csv"), obs.as_bytes())?;
+    let periodic = [lattice.lx as f64, lattice.ly as f64];
+    let (without, with) = (
+        analysis::motion::msd(&positions, periodic, true),
+        analysis::motion::msd(&positions, periodic, false),
+    );
+    let mut msd_csv = String::new();
+    row!(msd_csv, "{}", rundir::MSD_HEADER);
+    for (a, b) in without.iter().zip(&with) {
+        row!(
+            msd_csv,
+            "{:.6},{:e},{:e},{}",
+            a.lag,
+            a.msd,
+            b.msd,
+            a.samples
+        );
+    }
+    write_file(&out.join("msd.csv"), msd_csv.as_bytes())?;
     write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
     write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
     if let Some(lineage) = &lineage {
