@@ -16,6 +16,7 @@ mod contractile;
 mod defect_fields;
 mod defects;
 mod flocking;
+mod jamming;
 mod lengths;
 mod rotation;
 mod rules;
@@ -38,6 +39,7 @@ use study::{
 };
 
 pub use flocking::POLAR_SCENE;
+pub use jamming::JAMMING_SCENE;
 pub use rotation::DISC_SCENE;
 pub use sorting::SORTING_SCENE;
 pub use table::Table;
@@ -153,11 +155,13 @@ pub enum Figure {
     Flocking,
     /// Whether a mixture of two populations sorts (issue 41).
     Sorting,
+    /// The solid–liquid transition of self-propelled cells (issue 41).
+    Jamming,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 12] = [
+    pub const ALL: [Figure; 13] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -170,6 +174,7 @@ impl Figure {
         Self::Rotation,
         Self::Flocking,
         Self::Sorting,
+        Self::Jamming,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -187,6 +192,7 @@ impl Figure {
             Self::Rotation => "rotation",
             Self::Flocking => "flocking",
             Self::Sorting => "sorting",
+            Self::Jamming => "jamming",
         }
     }
 
@@ -209,6 +215,9 @@ impl Figure {
             Self::Rotation => "Collective rotation of polar cells in a disc (issue 41)",
             Self::Flocking => "The flocking transition of polar cells against noise (issue 41)",
             Self::Sorting => "Sorting of a mixture of two populations (issue 41)",
+            Self::Jamming => {
+                "The solid–liquid transition of a tissue of self-propelled cells (issue 41)"
+            }
         }
     }
 }
@@ -431,6 +440,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Rotation => rotation::make(p, &dir)?,
         Figure::Flocking => flocking::make(p, &dir)?,
         Figure::Sorting => sorting::make(p, &dir)?,
+        Figure::Jamming => jamming::make(p, &dir)?,
     };
     let wall_s = start.elapsed().as_secs_f64();
     write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;
