@@ -1,16 +1,20 @@
 //! `reproduce channel`: the flow transition of an active tissue in a channel (issue 28, T3.4
-//! of the extensions). Continuum active nematics confined to a channel flow spontaneously
-//! only above a critical width `W_c ∝ √(K/ζ)`; here `W_c` is measured against ζ and its
+//! of the extensions; redone in issue 41). Continuum active nematics confined to a channel are
+//! quiescent below a critical width `W_c ∝ √(K/ζ)` and flow spontaneously above it, with a net
+//! flow along the channel (Voituriez, Joanny & Prost, Europhys. Lett. 2005; in cell
+//! monolayers, Duclos et al., Nat. Phys. 2018); here `W_c` is measured against ζ and its
 //! exponent compared with −½.
 //!
 //! Each width is a sweep of its own (the cell count follows the width, at the paper's
-//! density), over ζ = 0 and three activities. The statistic of a run is its `v_rms` over the
-//! second half of its active phase, divided by that of the ζ = 0 run of the same width and
-//! seed (the passive baseline: coarsening and the walls' push, docs/model.md §11.4). `W_c` is
-//! the width where the active part of the mean ratio, `ratio − 1`, reaches half its value in
-//! the widest channel (an activity whose widest channel does not flow, ratio ≤ [`FLOWS`], has
-//! none). The exponent is the least-squares slope of `ln W_c` against `ln ζ`, its error from
-//! the jackknife over seeds.
+//! density), over ζ = 0 and four activities, from W = 24 (three cell radii: narrower channels
+//! clip an R = 8 cell's patch). The order parameter vanishes at rest: the net flow along the
+//! channel, `Φ = ⟨|v̄_x|⟩`, the time mean over the second half of the active phase of the
+//! magnitude of the lattice mean of `v_x` (`v_mean_x` of `analysis/observables.csv`). A run's
+//! statistic is Φ over that of the ζ = 0 run of the same width and seed (the passive
+//! coarsening's drift). `W_c` is the narrowest width at which the seed mean of that ratio
+//! reaches [`FLOWS`], interpolated linearly from the width below: a fixed level, so `W_c` does
+//! not depend on the widest width. The exponent is the least-squares slope of `ln W_c`
+//! against `ln ζ`, its error from the jackknife over seeds.
 
 use std::path::Path;
 
@@ -22,8 +26,7 @@ use study::SweepError;
 /// The activities; ζ = 0 is the baseline.
 const ZETAS: [&str; 5] = ["0", "0.001", "0.0025", "0.005", "0.01"];
 
-/// The ratio of `v_rms` to the passive baseline above which the widest channel flows: below
-/// it the activity is too weak for a width to be found at this run length.
+/// The ratio of the net flow to the passive one from which a channel flows.
 pub(crate) const FLOWS: f64 = 2.0;
 
 /// The continuum exponent of `W_c ∝ ζ^b`.
@@ -34,25 +37,34 @@ const AREA_PER_CELL: f64 = 10_000.0 / 60.0;
 
 fn widths(scale: Scale) -> Vec<usize> {
     match scale {
-        Scale::Quick => vec![16, 20, 24, 32, 40, 48, 64, 96],
-        Scale::Paper => vec![16, 20, 24, 28, 32, 40, 48, 64, 96, 128],
+        Scale::Quick => vec![24, 32, 40, 48, 64, 96],
+        Scale::Paper => vec![24, 28, 32, 40, 48, 64, 96, 128],
     }
 }
 
+/// Where the flow sets in, from the mean ratios at the increasing widths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Onset {
+    /// The narrowest width at which the ratio reaches [`FLOWS`], interpolated from the width
+    /// below.
+    At(f64),
+    /// Already at the narrowest width: no quiescent channel in the range.
+    Narrower,
+    /// At no width.
+    Wider,
+}
+
 /// The critical width from the mean ratios `ratio[k]` at the increasing widths `widths`: the
-/// width at which the active part of the flow, `(ratio − 1)/(ratio_widest − 1)`, reaches ½,
-/// interpolated linearly above the widest width where it is below ½. `None` when the widest
-/// channel does not flow (its ratio at most [`FLOWS`]) or when no width is below ½.
-pub(crate) fn critical_width(widths: &[f64], ratio: &[f64]) -> Option<f64> {
-    let widest = *ratio.last()?;
-    if widest.is_nan() || widest <= FLOWS {
-        return None;
+/// narrowest width with `ratio ≥ FLOWS`, linear between it and the width below.
+pub(crate) fn critical_width(widths: &[f64], ratio: &[f64]) -> Onset {
+    match ratio.iter().position(|&r| r >= FLOWS) {
+        None => Onset::Wider,
+        Some(0) => Onset::Narrower,
+        Some(k) => {
+            let t = (FLOWS - ratio[k - 1]) / (ratio[k] - ratio[k - 1]);
+            Onset::At(widths[k - 1] + t * (widths[k] - widths[k - 1]))
+        }
     }
-    let f: Vec<f64> = ratio.iter().map(|r| (r - 1.0) / (widest - 1.0)).collect();
-    let below = (0..f.len()).rev().find(|&k| f[k].is_nan() || f[k] < 0.5)?;
-    let k = below + 1;
-    let t = (0.5 - f[below]) / (f[k] - f[below]);
-    Some(widths[below] + t * (widths[k] - widths[below]))
 }
 
 /// The least-squares slope of `y` against `x`.
@@ -65,15 +77,15 @@ fn slope(x: &[f64], y: &[f64]) -> f64 {
 }
 
 /// The exponent `b` of `W_c ∝ ζ^b` from per-seed ratios `ratio[seed][zeta][width]`, and its
-/// jackknife error over seeds, with the critical widths of the seed means (`None` where not
-/// bracketed). NaN exponent when fewer than two activities bracket `W_c`.
+/// jackknife error over seeds, with the onsets of the seed means. NaN exponent when fewer than
+/// two activities have an onset inside the widths.
 pub(crate) fn exponent(
     widths: &[f64],
     zetas: &[f64],
     ratio: &[Vec<Vec<f64>>],
-) -> (f64, f64, Vec<Option<f64>>) {
-    let fit = |seeds: &[usize]| -> (f64, Vec<Option<f64>>) {
-        let wc: Vec<Option<f64>> = (0..zetas.len())
+) -> (f64, f64, Vec<Onset>) {
+    let fit = |seeds: &[usize]| -> (f64, Vec<Onset>) {
+        let wc: Vec<Onset> = (0..zetas.len())
             .map(|z| {
                 let mean: Vec<f64> = (0..widths.len())
                     .map(|w| {
@@ -86,7 +98,10 @@ pub(crate) fn exponent(
         let (x, y): (Vec<f64>, Vec<f64>) = zetas
             .iter()
             .zip(&wc)
-            .filter_map(|(z, w)| w.map(|w| (z.ln(), w.ln())))
+            .filter_map(|(z, w)| match w {
+                Onset::At(w) => Some((z.ln(), w.ln())),
+                _ => None,
+            })
             .unzip();
         (
             if x.len() >= 2 {
@@ -121,14 +136,23 @@ pub(crate) fn exponent(
     (b, var.sqrt(), wc)
 }
 
-/// The verdict on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se`: holds within 2 standard
-/// errors (and an error below 0.25), does not hold beyond 3, inconclusive between, or when
-/// the exponent or its error could not be measured.
-pub(crate) fn verdict(b: f64, se: f64) -> (Verdict, String) {
+/// The verdict on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se` and the onsets: holds within 2
+/// standard errors (and an error below 0.25), does not hold beyond 3, inconclusive between or
+/// when the exponent or its error could not be measured; "not testable" (inconclusive) when
+/// every flowing activity already flows at the narrowest width, so that no channel that
+/// resolves a cell is quiescent.
+pub(crate) fn verdict(b: f64, se: f64, onsets: &[Onset]) -> (Verdict, String) {
+    let flowing: Vec<&Onset> = onsets.iter().filter(|o| **o != Onset::Wider).collect();
+    if !flowing.is_empty() && flowing.iter().all(|o| **o == Onset::Narrower) {
+        return (
+            Verdict::Inconclusive,
+            "not testable in this model: every activity that flows already flows at the narrowest width that resolves a cell, so there is no quiescent channel to find the onset from".into(),
+        );
+    }
     if !(b.is_finite() && se.is_finite()) {
         return (
             Verdict::Inconclusive,
-            "W_c is bracketed by the widths at fewer than two activities (or in fewer than three seeds' jackknife samples): widen the range of widths".into(),
+            "the onset lies inside the widths at fewer than two activities (or in fewer than three seeds' jackknife samples)".into(),
         );
     }
     let off = (b - CONTINUUM).abs() / se.max(1e-12);
@@ -161,7 +185,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .iter()
         .map(|z| z.parse().expect("a number"))
         .collect();
-    let mut recs: Vec<(usize, Vec<Rec>)> = Vec::new();
+    // Each width's runs with their net flow Φ.
+    let mut recs: Vec<(usize, Vec<(Rec, f64)>)> = Vec::new();
     for &w in &ws {
         let ly = w + 2;
         let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
@@ -172,7 +197,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             "walls.kind=\"channel\"".to_string(),
             "model.pressure=\"interaction\"".to_string(),
             format!("run.time={t}"),
-            format!("run.output_every={t}"),
+            "run.output_every=10".to_string(),
         ];
         sets.extend(p.scale.integrator());
         let margin: usize = match p.scale {
@@ -187,25 +212,41 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 name: format!("channel-w{w}-{}", p.scale.name()),
                 sets,
                 varies: vec![format!("model.zeta={}", ZETAS.join(","))],
-                analyze: None,
+                analyze: Some(study::analyze::AnalyzeOptions::default()),
                 seeds: None,
             },
         )?;
-        recs.push((w, res.records(None)?));
+        let mut with_flow = Vec::new();
+        for r in res.records(None)? {
+            let o = super::Table::read(&r.run.join("analysis/observables.csv"))?;
+            let (times, vx) = (o.f64s("time")?, o.f64s("v_mean_x")?);
+            let late: Vec<f64> = times
+                .iter()
+                .zip(&vx)
+                .filter(|(time, v)| **time >= 200.0 + t / 2.0 && v.is_finite())
+                .map(|(_, v)| v.abs())
+                .collect();
+            let phi = late.iter().sum::<f64>() / late.len().max(1) as f64;
+            with_flow.push((r, phi));
+        }
+        recs.push((w, with_flow));
     }
     p.reporter.stage("channel: tables and plots");
     let seeds: Vec<u64> = {
-        let mut s: Vec<u64> = recs[0].1.iter().map(|r| r.seed).collect();
+        let mut s: Vec<u64> = recs[0].1.iter().map(|r| r.0.seed).collect();
         s.sort_unstable();
         s.dedup();
         s
     };
-    // ratio[seed][zeta][width]
-    let v_of = |w: usize, z: &str, seed: u64| -> f64 {
+    // ratio[seed][zeta][width] of the net flow Φ; v_rms beside it.
+    let run_of = |w: usize, z: &str, seed: u64| {
         recs.iter()
             .find(|(ww, _)| *ww == w)
-            .and_then(|(_, rs)| rs.iter().find(|r| r.values[0] == z && r.seed == seed))
-            .map_or(f64::NAN, |r| r.summary.v_rms)
+            .and_then(|(_, rs)| rs.iter().find(|r| r.0.values[0] == z && r.0.seed == seed))
+    };
+    let v_of = |w: usize, z: &str, seed: u64| -> f64 { run_of(w, z, seed).map_or(f64::NAN, |r| r.1) };
+    let vrms_of = |w: usize, z: &str, seed: u64| -> f64 {
+        run_of(w, z, seed).map_or(f64::NAN, |r| r.0.summary.v_rms)
     };
     let ratio: Vec<Vec<Vec<f64>>> = seeds
         .iter()
@@ -223,20 +264,26 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let wf: Vec<f64> = ws.iter().map(|&w| w as f64).collect();
     let (b, se, wc) = exponent(&wf, &zetas, &ratio);
 
-    let mut csv = String::from("width,zeta,v_rms,v_rms_se,ratio,ratio_se\n");
+    let mut csv =
+        String::from("width,zeta,net_flow,net_flow_se,ratio,ratio_se,v_rms,v_rms_se\n");
     let mut plot = Plot::new(
-        "Flow in a channel against its width",
+        "Net flow along a channel against its width",
         "channel width W (nodes)",
-        "v_rms / v_rms(ζ = 0), mean ± s.e. over seeds",
+        "Φ = ⟨|mean v_x|⟩ over that at ζ = 0, mean ± s.e. over seeds",
     );
     plot.log_y = true;
+    plot.hlines = vec![(FLOWS, "flows: 2× the passive net flow".into())];
     for (zi, z) in ZETAS[1..].iter().enumerate() {
         let mut ys = Vec::new();
         let mut es = Vec::new();
         for (wi, &w) in ws.iter().enumerate() {
             let r = mean_se(&ratio.iter().map(|s| s[zi][wi]).collect::<Vec<_>>());
             let v = mean_se(&seeds.iter().map(|&s| v_of(w, z, s)).collect::<Vec<_>>());
-            csv += &format!("{w},{z},{:e},{:e},{:e},{:e}\n", v.0, v.1, r.0, r.1);
+            let u = mean_se(&seeds.iter().map(|&s| vrms_of(w, z, s)).collect::<Vec<_>>());
+            csv += &format!(
+                "{w},{z},{:e},{:e},{:e},{:e},{:e},{:e}\n",
+                v.0, v.1, r.0, r.1, u.0, u.1
+            );
             ys.push(r.0);
             es.push(if r.1.is_finite() { r.1 } else { 0.0 });
         }
@@ -245,14 +292,18 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     }
     for (w, _) in &recs {
         let v = mean_se(&seeds.iter().map(|&s| v_of(*w, "0", s)).collect::<Vec<_>>());
-        csv += &format!("{w},0,{:e},{:e},1,0\n", v.0, v.1);
+        let u = mean_se(&seeds.iter().map(|&s| vrms_of(*w, "0", s)).collect::<Vec<_>>());
+        csv += &format!("{w},0,{:e},{:e},1,0,{:e},{:e}\n", v.0, v.1, u.0, u.1);
     }
     write_text(&dir.join("channel_flow.csv"), &csv)?;
     drawn(plot.save_png(&dir.join("channel_flow.png")))?;
     let (x, y): (Vec<f64>, Vec<f64>) = zetas
         .iter()
         .zip(&wc)
-        .filter_map(|(z, w)| w.map(|w| (*z, w)))
+        .filter_map(|(z, w)| match w {
+            Onset::At(w) => Some((*z, *w)),
+            _ => None,
+        })
         .unzip();
     let mut wplot = Plot::new("Critical width against activity", "ζ", "W_c (nodes)");
     (wplot.log_x, wplot.log_y) = (true, true);
@@ -271,11 +322,20 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         );
     }
     drawn(wplot.save_png(&dir.join("channel_critical_width.png")))?;
-    let (v, reason) = verdict(b, se);
+    let (v, reason) = verdict(b, se, &wc);
     let wc_text: Vec<String> = ZETAS[1..]
         .iter()
         .zip(&wc)
-        .map(|(z, w)| format!("ζ = {z}: {}", w.map_or("not bracketed".into(), g)))
+        .map(|(z, w)| {
+            format!(
+                "ζ = {z}: {}",
+                match w {
+                    Onset::At(w) => g(*w),
+                    Onset::Narrower => format!("flows at W = {}", ws[0]),
+                    Onset::Wider => "does not flow".into(),
+                }
+            )
+        })
         .collect();
     let claims = vec![Claim::new(
         "channel (extensions T3.4): the critical width of channel flow scales as W_c ∝ ζ^(−1/2)",
@@ -290,8 +350,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     )];
     let settings = format!(
         "- A channel along x: `[walls] kind = \"channel\"`, lx = {lx}, free width W ∈ {{{}}} (ly = W + 2), the paper's density (a cell per {:.1} nodes), the paper's parameters with the interaction pressure (docs/model.md §11.4: in the paper's form the walls' push dominates v_rms); ζ ∈ {{{}}}; seeds {}.\n\
-         - 200 TU of relaxation, then {t} TU; integrator {} (margin at most (ly − 1)/2); f32 storage.\n\
-         - Statistic: the ratio of v_rms over the second half of the active phase to that of ζ = 0 at the same width and seed; W_c is where the active part of the mean ratio, ratio − 1, reaches half its value in the widest channel (linear interpolation above the widest width below half; none when the widest channel's ratio is at most {FLOWS}). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: holds within 2 standard errors of −½ (error below 0.25), does not hold beyond 3, inconclusive between. Data in `channel_flow.csv`, plots `channel_flow.png`, `channel_critical_width.png`.",
+         - 200 TU of relaxation, then {t} TU; integrator {} (margin at most (ly − 1)/2); f32 storage; frames every 10 TU, analysed. The narrowest width is 24 nodes (3R): narrower channels clip an R = 8 cell's patch.\n\
+         - Order parameter, zero at rest: the net flow along the channel Φ = ⟨|v̄_x|⟩, the time mean over the second half of the active phase of the magnitude of the lattice mean of v_x (`v_mean_x` of `analysis/observables.csv`). Statistic: Φ over that of ζ = 0 at the same width and seed (the passive coarsening's drift). W_c: the narrowest width at which the seed mean of the ratio reaches {FLOWS}, linear from the width below (a fixed level: it does not depend on the widest width). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: not testable when every flowing activity already flows at the narrowest width; holds within 2 standard errors of −½ (error below 0.25), does not hold beyond 3, inconclusive between. Data in `channel_flow.csv` (with v_rms beside Φ), plots `channel_flow.png`, `channel_critical_width.png`.",
         ws.iter().map(|w| w.to_string()).collect::<Vec<_>>().join(", "),
         AREA_PER_CELL,
         ZETAS.join(", "),
@@ -306,9 +366,9 @@ mod tests {
     use super::*;
 
     /// Synthetic ratios `1 + 5 W⁴/(W⁴ + W_c⁴)` with `W_c = c ζ^b` and a seed's scatter: the
-    /// rule finds each outcome.
+    /// onset (ratio 2) is at `W_c/√2`, so its exponent is b.
     fn synthetic(b: f64, scatter: f64, c: f64) -> (Verdict, f64, f64) {
-        let widths: [f64; 10] = [16.0, 20.0, 24.0, 32.0, 40.0, 48.0, 64.0, 96.0, 128.0, 192.0];
+        let widths: [f64; 9] = [24.0, 28.0, 32.0, 40.0, 48.0, 64.0, 96.0, 128.0, 192.0];
         let zetas: [f64; 3] = [0.0025, 0.005, 0.01];
         let ratio: Vec<Vec<Vec<f64>>> = (0..4)
             .map(|s| {
@@ -327,40 +387,43 @@ mod tests {
                     .collect()
             })
             .collect();
-        let (e, se, _) = exponent(&widths, &zetas, &ratio);
-        (verdict(e, se).0, e, se)
+        let (e, se, onsets) = exponent(&widths, &zetas, &ratio);
+        (verdict(e, se, &onsets).0, e, se)
     }
 
     #[test]
     fn the_rule_reaches_each_verdict() {
-        // W_c = 30 at ζ = 0.005 with the continuum exponent: holds.
-        let c = 30.0 / 0.005f64.powf(-0.5);
+        // W_c = 80 at ζ = 0.005 with the continuum exponent: holds.
+        let c = 80.0 / 0.005f64.powf(-0.5);
         let (v, b, se) = synthetic(-0.5, 0.04, c);
         assert_eq!(v, Verdict::Holds, "{b} ± {se}");
         assert!((b + 0.5).abs() < 0.1, "{b}");
         // A steeper law, W_c ∝ ζ^(−1.2): does not hold.
-        let c = 30.0 / 0.005f64.powf(-1.2);
+        let c = 80.0 / 0.005f64.powf(-1.2);
         let (v, b, se) = synthetic(-1.2, 0.02, c);
         assert_eq!(v, Verdict::DoesNotHold, "{b} ± {se}");
-        // Every width flows at every activity: nothing bracketed, inconclusive.
+        // Every width flows at every activity: not testable, inconclusive.
         let (v, ..) = synthetic(-0.5, 0.02, 0.1);
         assert_eq!(v, Verdict::Inconclusive);
+        assert!(verdict(f64::NAN, f64::NAN, &[Onset::Narrower, Onset::Wider])
+            .1
+            .starts_with("not testable"));
         // A large scatter between seeds: inconclusive.
-        assert_eq!(verdict(-0.9, 0.19).0, Verdict::Inconclusive);
+        assert_eq!(
+            verdict(-0.9, 0.19, &[Onset::At(30.0), Onset::At(40.0)]).0,
+            Verdict::Inconclusive
+        );
     }
 
     #[test]
-    fn the_critical_width_interpolates_the_crossing() {
+    fn the_critical_width_is_the_first_reaching_the_level() {
         let w = [10.0, 20.0, 40.0];
-        // Active part 0, 2, 4 of the widest 4: half at 20.
-        assert!((critical_width(&w, &[1.0, 3.0, 5.0]).unwrap() - 20.0).abs() < 1e-12);
-        // 0.25 and 0.75 of it: half-way between 10 and 20.
-        assert!((critical_width(&w, &[2.0, 4.0, 5.0]).unwrap() - 15.0).abs() < 1e-12);
-        // Every width above half, or the widest not flowing: none.
-        assert_eq!(critical_width(&w, &[3.5, 4.0, 5.0]), None);
-        assert_eq!(critical_width(&w, &[1.0, 1.2, 1.5]), None);
-        // A dip above a wider width: the crossing above the widest width below half.
-        let expected = 20.0 + 20.0 / 3.0;
-        assert!((critical_width(&w, &[3.0, 2.0, 5.0]).unwrap() - expected).abs() < 1e-12);
+        // 1, 3, 5: the level 2 half-way from 10 to 20, whatever the widest width does.
+        assert_eq!(critical_width(&w, &[1.0, 3.0, 5.0]), Onset::At(15.0));
+        assert_eq!(critical_width(&w, &[1.0, 3.0, 50.0]), Onset::At(15.0));
+        assert_eq!(critical_width(&w, &[2.5, 4.0, 5.0]), Onset::Narrower);
+        assert_eq!(critical_width(&w, &[1.0, 1.2, 1.5]), Onset::Wider);
+        // A dip after the first crossing does not move it.
+        assert_eq!(critical_width(&w, &[1.5, 2.5, 1.0]), Onset::At(15.0));
     }
 }
