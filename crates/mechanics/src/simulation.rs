@@ -843,7 +843,8 @@ impl<T: Real> Simulation<T> {
     /// from the device's last evaluation, as the host's step leaves it in the workspace. The
     /// cells' quantities come back after a step only while something could happen (a division
     /// or a death due by age, or an extrusion rule, which reads the areas), the pressure only
-    /// for a pressure gate with a division due, the state only when an event is pending, and
+    /// for a pressure gate with a division due or for the stress-based extrusion rule, the
+    /// state only when an event is pending, and
     /// it goes back to the device after the events.
     fn proliferate_on_device(&mut self, before: f64) -> Result<(), SimulationError> {
         let Some(clock) = self.tissue.proliferation() else {
@@ -853,11 +854,12 @@ impl<T: Real> Simulation<T> {
             return Ok(());
         }
         let timed = clock.timed_event_due(&self.tissue);
-        if !timed && clock.extrusion.is_none() {
+        if !timed && !clock.extrudes() {
             self.tissue.refresh_target_scale();
             return Ok(());
         }
-        let pressure = timed && clock.pressure_gate.is_some();
+        let pressure =
+            (timed && clock.pressure_gate.is_some()) || clock.extrusion_pressure.is_some();
         let Some(backend) = self.backend.as_mut() else {
             return Ok(());
         };

@@ -10,11 +10,12 @@
 //! clip an R = 8 cell's patch). The order parameter vanishes at rest: the net flow along the
 //! channel, `Φ = ⟨|v̄_x|⟩`, the time mean over the second half of the active phase of the
 //! magnitude of the lattice mean of `v_x` (`v_mean_x` of `analysis/observables.csv`). A run's
-//! statistic is Φ over that of the ζ = 0 run of the same width and seed (the passive
-//! coarsening's drift). `W_c` is the narrowest width at which the seed mean of that ratio
-//! reaches [`FLOWS`], interpolated linearly from the width below: a fixed level, so `W_c` does
-//! not depend on the widest width. The exponent is the least-squares slope of `ln W_c`
-//! against `ln ζ`, its error from the jackknife over seeds.
+//! statistic is its coherence `C = Φ / v_rms`: 1 for a plug flow, about `1/√(πN)` for N cells
+//! moving in random directions. `W_c` is the narrowest width at which the seed mean of C
+//! reaches [`FLOWS`] (half the flow is net flow along the channel), interpolated linearly from
+//! the width below: a fixed level, so `W_c` does not depend on the widest width. The exponent
+//! is the least-squares slope of `ln W_c` against `ln ζ`, its error from the jackknife over
+//! seeds.
 
 use std::path::Path;
 
@@ -26,8 +27,9 @@ use study::SweepError;
 /// The activities; ζ = 0 is the baseline.
 const ZETAS: [&str; 5] = ["0", "0.001", "0.0025", "0.005", "0.01"];
 
-/// The ratio of the net flow to the passive one from which a channel flows.
-pub(crate) const FLOWS: f64 = 2.0;
+/// The coherence `Φ/v_rms` from which a channel flows along itself: half the flow is net
+/// flow.
+pub(crate) const FLOWS: f64 = 0.5;
 
 /// The continuum exponent of `W_c ∝ ζ^b`.
 pub(crate) const CONTINUUM: f64 = -0.5;
@@ -138,10 +140,16 @@ pub(crate) fn exponent(
 
 /// The verdict on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se` and the onsets: holds within 2
 /// standard errors (and an error below 0.25), does not hold beyond 3, inconclusive between or
-/// when the exponent or its error could not be measured; "not testable" (inconclusive) when
-/// every flowing activity already flows at the narrowest width, so that no channel that
-/// resolves a cell is quiescent.
+/// when the exponent or its error could not be measured; "not testable" (inconclusive) when no
+/// activity flows coherently at any width, or every one that does already flows at the
+/// narrowest width, so that no channel that resolves a cell is quiescent.
 pub(crate) fn verdict(b: f64, se: f64, onsets: &[Onset]) -> (Verdict, String) {
+    if !onsets.is_empty() && onsets.iter().all(|o| *o == Onset::Wider) {
+        return (
+            Verdict::Inconclusive,
+            format!("not testable in this model: no activity has a coherent net flow along the channel (Φ/v_rms ≥ {FLOWS}) at any width: the active flow in a channel is undirected, so there is no onset of spontaneous flow to scale"),
+        );
+    }
     let flowing: Vec<&Onset> = onsets.iter().filter(|o| **o != Onset::Wider).collect();
     if !flowing.is_empty() && flowing.iter().all(|o| **o == Onset::Narrower) {
         return (
@@ -244,7 +252,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             .find(|(ww, _)| *ww == w)
             .and_then(|(_, rs)| rs.iter().find(|r| r.0.values[0] == z && r.0.seed == seed))
     };
-    let v_of = |w: usize, z: &str, seed: u64| -> f64 { run_of(w, z, seed).map_or(f64::NAN, |r| r.1) };
+    let v_of =
+        |w: usize, z: &str, seed: u64| -> f64 { run_of(w, z, seed).map_or(f64::NAN, |r| r.1) };
     let vrms_of = |w: usize, z: &str, seed: u64| -> f64 {
         run_of(w, z, seed).map_or(f64::NAN, |r| r.0.summary.v_rms)
     };
@@ -255,7 +264,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .iter()
                 .map(|z| {
                     ws.iter()
-                        .map(|&w| v_of(w, z, s) / v_of(w, "0", s))
+                        .map(|&w| v_of(w, z, s) / vrms_of(w, z, s))
                         .collect()
                 })
                 .collect()
@@ -265,14 +274,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let (b, se, wc) = exponent(&wf, &zetas, &ratio);
 
     let mut csv =
-        String::from("width,zeta,net_flow,net_flow_se,ratio,ratio_se,v_rms,v_rms_se\n");
+        String::from("width,zeta,net_flow,net_flow_se,coherence,coherence_se,v_rms,v_rms_se\n");
     let mut plot = Plot::new(
-        "Net flow along a channel against its width",
+        "Coherence of the flow along a channel against its width",
         "channel width W (nodes)",
-        "Φ = ⟨|mean v_x|⟩ over that at ζ = 0, mean ± s.e. over seeds",
+        "C = Φ / v_rms, mean ± s.e. over seeds",
     );
     plot.log_y = true;
-    plot.hlines = vec![(FLOWS, "flows: 2× the passive net flow".into())];
+    plot.hlines = vec![(FLOWS, "coherent: half the flow is net flow".into())];
     for (zi, z) in ZETAS[1..].iter().enumerate() {
         let mut ys = Vec::new();
         let mut es = Vec::new();
@@ -290,10 +299,37 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         plot.series
             .push(Series::new(format!("ζ = {z}")).with_points(&wf, &ys, &es));
     }
+    // N cells moving in random directions: E|v̄_x| = v/√(πN).
+    let random: Vec<f64> = ws
+        .iter()
+        .map(|&w| {
+            let n = (lx * w) as f64 / AREA_PER_CELL;
+            1.0 / (std::f64::consts::PI * n).sqrt()
+        })
+        .collect();
+    plot.series.push(
+        Series::new("cells in random directions, 1/√(πN)")
+            .with_points(&wf, &random, &vec![0.0; wf.len()])
+            .line_only(),
+    );
     for (w, _) in &recs {
         let v = mean_se(&seeds.iter().map(|&s| v_of(*w, "0", s)).collect::<Vec<_>>());
-        let u = mean_se(&seeds.iter().map(|&s| vrms_of(*w, "0", s)).collect::<Vec<_>>());
-        csv += &format!("{w},0,{:e},{:e},1,0,{:e},{:e}\n", v.0, v.1, u.0, u.1);
+        let u = mean_se(
+            &seeds
+                .iter()
+                .map(|&s| vrms_of(*w, "0", s))
+                .collect::<Vec<_>>(),
+        );
+        let c = mean_se(
+            &seeds
+                .iter()
+                .map(|&s| v_of(*w, "0", s) / vrms_of(*w, "0", s))
+                .collect::<Vec<_>>(),
+        );
+        csv += &format!(
+            "{w},0,{:e},{:e},{:e},{:e},{:e},{:e}\n",
+            v.0, v.1, c.0, c.1, u.0, u.1
+        );
     }
     write_text(&dir.join("channel_flow.csv"), &csv)?;
     drawn(plot.save_png(&dir.join("channel_flow.png")))?;
@@ -307,6 +343,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .unzip();
     let mut wplot = Plot::new("Critical width against activity", "ζ", "W_c (nodes)");
     (wplot.log_x, wplot.log_y) = (true, true);
+    // Drawn only when an activity has an onset inside the widths.
     if !x.is_empty() {
         wplot.series.push(
             Series::new("W_c (seed means)")
@@ -320,8 +357,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .with_points(&x, &line, &vec![0.0; x.len()])
                 .line_only(),
         );
+        drawn(wplot.save_png(&dir.join("channel_critical_width.png")))?;
     }
-    drawn(wplot.save_png(&dir.join("channel_critical_width.png")))?;
     let (v, reason) = verdict(b, se, &wc);
     let wc_text: Vec<String> = ZETAS[1..]
         .iter()
@@ -351,7 +388,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let settings = format!(
         "- A channel along x: `[walls] kind = \"channel\"`, lx = {lx}, free width W ∈ {{{}}} (ly = W + 2), the paper's density (a cell per {:.1} nodes), the paper's parameters with the interaction pressure (docs/model.md §11.4: in the paper's form the walls' push dominates v_rms); ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {} (margin at most (ly − 1)/2); f32 storage; frames every 10 TU, analysed. The narrowest width is 24 nodes (3R): narrower channels clip an R = 8 cell's patch.\n\
-         - Order parameter, zero at rest: the net flow along the channel Φ = ⟨|v̄_x|⟩, the time mean over the second half of the active phase of the magnitude of the lattice mean of v_x (`v_mean_x` of `analysis/observables.csv`). Statistic: Φ over that of ζ = 0 at the same width and seed (the passive coarsening's drift). W_c: the narrowest width at which the seed mean of the ratio reaches {FLOWS}, linear from the width below (a fixed level: it does not depend on the widest width). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: not testable when every flowing activity already flows at the narrowest width; holds within 2 standard errors of −½ (error below 0.25), does not hold beyond 3, inconclusive between. Data in `channel_flow.csv` (with v_rms beside Φ), plots `channel_flow.png`, `channel_critical_width.png`.",
+         - Order parameter, zero at rest: the net flow along the channel Φ = ⟨|v̄_x|⟩, the time mean over the second half of the active phase of the magnitude of the lattice mean of v_x (`v_mean_x` of `analysis/observables.csv`). Statistic: the coherence C = Φ/v_rms of each run (1 for a plug flow, about 1/√(πN) for N cells in random directions). W_c: the narrowest width at which the seed mean of C reaches {FLOWS}, linear from the width below (a fixed level: it does not depend on the widest width). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: not testable when no activity flows coherently at any width, or every one that does already at the narrowest; holds within 2 standard errors of −½ (error below 0.25), does not hold beyond 3, inconclusive between. Data in `channel_flow.csv` (Φ, C and v_rms), plots `channel_flow.png` and, when an onset is found, `channel_critical_width.png`.",
         ws.iter().map(|w| w.to_string()).collect::<Vec<_>>().join(", "),
         AREA_PER_CELL,
         ZETAS.join(", "),
@@ -365,8 +402,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
 mod tests {
     use super::*;
 
-    /// Synthetic ratios `1 + 5 W⁴/(W⁴ + W_c⁴)` with `W_c = c ζ^b` and a seed's scatter: the
-    /// onset (ratio 2) is at `W_c/√2`, so its exponent is b.
+    /// Synthetic coherences `0.05 + 0.9 W⁴/(W⁴ + W_c⁴)` with `W_c = c ζ^b` and a seed's
+    /// scatter: the onset (C = ½) is at `W_c`.
     fn synthetic(b: f64, scatter: f64, c: f64) -> (Verdict, f64, f64) {
         let widths: [f64; 9] = [24.0, 28.0, 32.0, 40.0, 48.0, 64.0, 96.0, 128.0, 192.0];
         let zetas: [f64; 3] = [0.0025, 0.005, 0.01];
@@ -381,7 +418,7 @@ mod tests {
                         let wc = c * z.powf(b) * (1.0 + scatter * k / 2.0);
                         widths
                             .iter()
-                            .map(|&w| 1.0 + 5.0 * w.powi(4) / (w.powi(4) + wc.powi(4)))
+                            .map(|&w| 0.05 + 0.9 * w.powi(4) / (w.powi(4) + wc.powi(4)))
                             .collect()
                     })
                     .collect()
@@ -405,9 +442,17 @@ mod tests {
         // Every width flows at every activity: not testable, inconclusive.
         let (v, ..) = synthetic(-0.5, 0.02, 0.1);
         assert_eq!(v, Verdict::Inconclusive);
-        assert!(verdict(f64::NAN, f64::NAN, &[Onset::Narrower, Onset::Wider])
+        // No width flows at any activity: not testable either.
+        let (v, ..) = synthetic(-0.5, 0.02, 1e5);
+        assert_eq!(v, Verdict::Inconclusive);
+        assert!(verdict(f64::NAN, f64::NAN, &[Onset::Wider, Onset::Wider])
             .1
             .starts_with("not testable"));
+        assert!(
+            verdict(f64::NAN, f64::NAN, &[Onset::Narrower, Onset::Wider])
+                .1
+                .starts_with("not testable")
+        );
         // A large scatter between seeds: inconclusive.
         assert_eq!(
             verdict(-0.9, 0.19, &[Onset::At(30.0), Onset::At(40.0)]).0,
@@ -418,12 +463,12 @@ mod tests {
     #[test]
     fn the_critical_width_is_the_first_reaching_the_level() {
         let w = [10.0, 20.0, 40.0];
-        // 1, 3, 5: the level 2 half-way from 10 to 20, whatever the widest width does.
-        assert_eq!(critical_width(&w, &[1.0, 3.0, 5.0]), Onset::At(15.0));
-        assert_eq!(critical_width(&w, &[1.0, 3.0, 50.0]), Onset::At(15.0));
-        assert_eq!(critical_width(&w, &[2.5, 4.0, 5.0]), Onset::Narrower);
-        assert_eq!(critical_width(&w, &[1.0, 1.2, 1.5]), Onset::Wider);
+        // 0.25, 0.75, 0.9: the level ½ half-way from 10 to 20, whatever the widest does.
+        assert_eq!(critical_width(&w, &[0.25, 0.75, 0.9]), Onset::At(15.0));
+        assert_eq!(critical_width(&w, &[0.25, 0.75, 0.55]), Onset::At(15.0));
+        assert_eq!(critical_width(&w, &[0.6, 0.8, 0.9]), Onset::Narrower);
+        assert_eq!(critical_width(&w, &[0.1, 0.2, 0.3]), Onset::Wider);
         // A dip after the first crossing does not move it.
-        assert_eq!(critical_width(&w, &[1.5, 2.5, 1.0]), Onset::At(15.0));
+        assert_eq!(critical_width(&w, &[0.25, 0.75, 0.1]), Onset::At(15.0));
     }
 }

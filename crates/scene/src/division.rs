@@ -134,6 +134,17 @@ pub(crate) fn check(spec: &DivisionSpec, file: &SceneFile) -> Result<(), SceneEr
             ));
         }
     }
+    if let Some(p) = spec.extrusion_pressure {
+        if !p.is_finite() {
+            return Err(invalid(
+                s,
+                "extrusion_pressure",
+                p,
+                "the extrusion pressure must be a finite pressure",
+                "use a value above the cells' pressures p_i = Σφ_i P/Σφ_i at rest (0.005–0.013 in the paper's relaxed tissue), or leave it out",
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -172,6 +183,9 @@ pub(crate) fn configure(
     }
     if let Some(p) = spec.pressure_gate {
         clock = clock.with_pressure_gate(p);
+    }
+    if let Some(p) = spec.extrusion_pressure {
+        clock = clock.with_extrusion_pressure(p);
     }
     clock
 }
@@ -243,6 +257,10 @@ mod tests {
             (
                 &["division.pressure_gate=nan"],
                 &["[division] pressure_gate"],
+            ),
+            (
+                &["division.extrusion_pressure=inf"],
+                &["[division] extrusion_pressure"],
             ),
             (&["division.axis=\"short\""], &["axis", "long"]),
             (&["division.cycle=3"], &["cycle"]),

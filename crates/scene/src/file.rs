@@ -381,6 +381,10 @@ pub struct DivisionSpec {
     /// `p_i = Σφ_i P/Σφ_i` is above this; absent: never waits.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pressure_gate: Option<f64>,
+    /// Stress-based extrusion: a cell whose pressure `p_i = Σφ_i P/Σφ_i` rises above this is
+    /// removed; absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extrusion_pressure: Option<f64>,
 }
 
 /// `[[population]]`: a population of cells with parameters of their own (docs/model.md

@@ -186,6 +186,10 @@ pub struct Proliferation {
     /// The extrusion rule: a cell whose area falls below this fraction of its target area
     /// is removed ([`remove_extruded`]; none: no extrusion).
     pub extrusion: Option<f64>,
+    /// The stress-based extrusion rule: a cell whose pressure ([`cell_pressure`], the
+    /// isotropic stress at the cell, compressive positive) rises above this is removed
+    /// (none: no such rule).
+    pub extrusion_pressure: Option<f64>,
     /// The death rate `k_d` per time unit (0: none): each cell's lifespan is drawn at its
     /// birth, exponential of mean `1/k_d`, and it is removed when its age passes it.
     pub death_rate: f64,
@@ -285,6 +289,7 @@ impl Proliferation {
                 self.max_cells,
                 self.pressure_gate,
                 self.extrusion,
+                self.extrusion_pressure,
                 self.death_rate,
                 self.growth_time,
                 self.seed,
@@ -302,6 +307,7 @@ impl Proliferation {
             max_cells: usize::MAX,
             pressure_gate: None,
             extrusion: None,
+            extrusion_pressure: None,
             death_rate: 0.0,
             growth_time: 0.0,
             seed,
@@ -314,6 +320,18 @@ impl Proliferation {
     pub fn with_extrusion(mut self, fraction: f64) -> Self {
         self.extrusion = Some(fraction);
         self
+    }
+
+    /// The same clock with the stress-based extrusion rule: cells whose pressure
+    /// ([`cell_pressure`]) rises above `p_max` are removed.
+    pub fn with_extrusion_pressure(mut self, p_max: f64) -> Self {
+        self.extrusion_pressure = Some(p_max);
+        self
+    }
+
+    /// Whether the clock removes cells by a rule on the last evaluation (area or pressure).
+    pub fn extrudes(&self) -> bool {
+        self.extrusion.is_some() || self.extrusion_pressure.is_some()
     }
 
     /// The same clock with a growth phase of `t_g` before each division.
@@ -679,10 +697,7 @@ impl<T: Real> Tissue<T> {
         let mut scale = std::mem::take(&mut self.ext.target_scale);
         clock.fill_target_scale_at(self, before, &mut scale);
         self.ext.target_scale = scale;
-        let pending = timed
-            || clock
-                .extrusion
-                .is_some_and(|f| !extruded(self, ws, f).is_empty());
+        let pending = timed || !extruded(self, ws, &clock).is_empty();
         self.ext.proliferation = Some(clock);
         pending
     }
@@ -705,10 +720,7 @@ impl<T: Real> Tissue<T> {
         let Some(mut clock) = self.ext.proliferation.take() else {
             return CellEvents::default();
         };
-        let mut removals: Vec<(usize, Ending)> = clock
-            .extrusion
-            .map(|f| extruded(self, ws, f))
-            .unwrap_or_default()
+        let mut removals: Vec<(usize, Ending)> = extruded(self, ws, &clock)
             .into_iter()
             .map(|id| (id, Ending::Extrusion))
             .collect();
@@ -789,7 +801,7 @@ pub fn remove_extruded<T: Real>(
     fraction: f64,
     lineage: Option<&mut Proliferation>,
 ) -> Vec<usize> {
-    let small = extruded(tissue, ws, fraction)
+    let small = extruded_by_area(tissue, ws, fraction)
         .into_iter()
         .map(|id| (id, Ending::Extrusion))
         .collect();
@@ -836,7 +848,27 @@ fn remove_cells<T: Real>(
 
 /// The cells whose area in the evaluation `ws` is below `fraction` of their target area, in
 /// the order of their identities.
-fn extruded<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, fraction: f64) -> Vec<usize> {
+/// The cells (by identity, sorted) that `clock`'s extrusion rules remove after the last
+/// evaluation in `ws`: by area ([`Proliferation::extrusion`]) or by pressure
+/// ([`Proliferation::extrusion_pressure`]).
+fn extruded<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, clock: &Proliferation) -> Vec<usize> {
+    let mut out = clock
+        .extrusion
+        .map(|f| extruded_by_area(tissue, ws, f))
+        .unwrap_or_default();
+    if let Some(p_max) = clock.extrusion_pressure {
+        out.extend(
+            (0..tissue.n_cells())
+                .filter(|&slot| cell_pressure(tissue, ws, slot) > p_max)
+                .map(|slot| tissue.cell_ids()[slot]),
+        );
+        out.sort_unstable();
+        out.dedup();
+    }
+    out
+}
+
+fn extruded_by_area<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, fraction: f64) -> Vec<usize> {
     // Each cell's target radius by its population's override rules (`Populations::params`).
     let mut small: Vec<usize> = (0..tissue.n_cells())
         .map(|slot| (slot, tissue.cell_ids()[slot]))

@@ -480,3 +480,47 @@ fn a_removed_cells_identity_is_not_given_again() {
     assert_eq!(t.terms().state("polarity").unwrap()[2], theta_2);
     assert!(t.set_next_id(2).is_err(), "below a living identity");
 }
+
+/// The stress-based extrusion rule removes exactly the cells whose pressure `p_i` is above
+/// its threshold, in the order of their identities, as extrusions; with the threshold above
+/// every pressure it removes none. The relaxed confluent tissue of the pressure-gate test
+/// (30 cells on 71², pressures from 5.4e-3 to 1.3e-2), the threshold at its upper quartile.
+#[test]
+fn the_pressure_rule_extrudes_the_compressed_cells() {
+    let lattice = Lattice::new(71, 71);
+    let shape = PatchShape::new(lattice, 14).unwrap();
+    let centres = init::positions(lattice, 30, 4.0, &init::Layout::Random { seed: 3 }).unwrap();
+    let cells = init::discs(lattice, shape, &centres, 4.0, 2.5);
+    let mut t0 = Tissue::new(cells, ModelParams::paper(0.0));
+    let mut ws0 = Workspace::new(t0.cells());
+    for _ in 0..200 {
+        t0.step(&mut ws0, &StepParams::default()).unwrap();
+    }
+    t0.refresh(&mut ws0);
+    let by_id: Vec<(usize, f64)> = (0..t0.n_cells())
+        .map(|s| (t0.cell_ids()[s], cell_pressure(&t0, &ws0, s)))
+        .collect();
+    let mut p: Vec<f64> = by_id.iter().map(|x| x.1).collect();
+    p.sort_by(f64::total_cmp);
+    let quartile = p[3 * p.len() / 4];
+    let mut expected: Vec<usize> = by_id
+        .iter()
+        .filter(|x| x.1 > quartile)
+        .map(|x| x.0)
+        .collect();
+    expected.sort_unstable();
+    assert!(expected.len() >= 5, "{expected:?}");
+    for (threshold, want) in [(quartile, expected), (p[p.len() - 1] * 1.01, Vec::new())] {
+        let clock = Proliferation::new(1e9, 1.0, 4, &t0).with_extrusion_pressure(threshold);
+        assert!(clock.extrudes());
+        let mut t = t0.clone().with_proliferation(clock);
+        let mut ws = Workspace::new(t.cells());
+        t.refresh(&mut ws);
+        let events = t.proliferate(&mut ws);
+        let removed: Vec<(usize, Ending)> =
+            want.iter().map(|&id| (id, Ending::Extrusion)).collect();
+        assert_eq!(events.removals, removed);
+        assert!(events.divisions.is_empty());
+        assert_eq!(t.n_cells(), 30 - want.len());
+    }
+}
