@@ -15,6 +15,7 @@ mod channel;
 mod contractile;
 mod defect_fields;
 mod defects;
+mod extrusion;
 mod flocking;
 mod jamming;
 mod lengths;
@@ -38,6 +39,7 @@ use study::{
     analyze_points, run_points, write_summary, Seeds, SweepError, SweepParams, SweepSpec, Vary,
 };
 
+pub use extrusion::EXTRUSION_SCENE;
 pub use flocking::POLAR_SCENE;
 pub use jamming::JAMMING_SCENE;
 pub use rotation::DISC_SCENE;
@@ -157,11 +159,13 @@ pub enum Figure {
     Sorting,
     /// The solid–liquid transition of self-propelled cells (issue 41).
     Jamming,
+    /// Where extruded cells are found, against the defects (issue 41).
+    Extrusion,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 13] = [
+    pub const ALL: [Figure; 14] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -175,6 +179,7 @@ impl Figure {
         Self::Flocking,
         Self::Sorting,
         Self::Jamming,
+        Self::Extrusion,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -193,6 +198,7 @@ impl Figure {
             Self::Flocking => "flocking",
             Self::Sorting => "sorting",
             Self::Jamming => "jamming",
+            Self::Extrusion => "extrusion",
         }
     }
 
@@ -218,6 +224,7 @@ impl Figure {
             Self::Jamming => {
                 "The solid–liquid transition of a tissue of self-propelled cells (issue 41)"
             }
+            Self::Extrusion => "Extrusion against the ±1/2 defects (issue 41)",
         }
     }
 }
@@ -441,6 +448,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Flocking => flocking::make(p, &dir)?,
         Figure::Sorting => sorting::make(p, &dir)?,
         Figure::Jamming => jamming::make(p, &dir)?,
+        Figure::Extrusion => extrusion::make(p, &dir)?,
     };
     let wall_s = start.elapsed().as_secs_f64();
     write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;

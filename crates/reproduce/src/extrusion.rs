@@ -1,0 +1,202 @@
+//! `reproduce extrusion`: are extruded cells found at +½ defects (issue 41, item 4)? In MDCK
+//! monolayers, cell death and extrusion concentrate at +½ defects of the cells' orientation
+//! field, where the isotropic stress is compressive (Saw et al., Nature 2017).
+//!
+//! The paper's tissue in active turbulence (ζ = 0.01) renews itself: cells divide on a
+//! cell-cycle clock and are extruded by one of two rules, each a sweep of its own: the
+//! stress-based rule (`[division] extrusion_pressure`: a cell whose pressure, the isotropic
+//! stress at the cell, rises above a threshold) and the area rule (`[division] extrusion`: a
+//! cell squeezed below a fraction of its target area). `monolayer analyze` gives each
+//! extrusion's distance to the nearest +½ and −½ defect of the frame nearest in time, and the
+//! mean distance of a random point of that frame's tissue (`analysis/cell_events.csv`). The
+//! statistic of a run is the mean over its extrusions of `d₊ − d₊,random` (and of
+//! `d₋ − d₋,random`); of a rule, the mean and standard error over seeds.
+
+use std::path::Path;
+
+use study::analyze::AnalyzeOptions;
+use study::SweepError;
+
+use super::{g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+
+/// The paper's tissue at ζ = 0.01 (active turbulence) with a cell-cycle clock of 300 TU and a
+/// growth phase of 50 TU; the figure adds an extrusion rule.
+pub const EXTRUSION_SCENE: &str = "\
+[domain]
+lx = 100
+ly = 100
+
+[cells]
+count = 60
+radius = 8.0
+
+[model]
+zeta = 0.01
+
+[division]
+cycle_time = 300.0
+growth_time = 50.0
+
+[integrator]
+dt = 0.5
+
+[run]
+relax_time = 200.0
+time = 1000.0
+seed = 1
+output_every = 10.0
+series_every = 10.0
+";
+
+/// The distance (nodes) closer to a defect than random points by which an attraction is
+/// material: a quarter of a cell radius.
+pub(crate) const MATERIAL: f64 = 2.0;
+
+/// The two rules: name, their key, its value.
+const RULES: [(&str, &str); 2] = [
+    ("pressure", "division.extrusion_pressure=0.04"),
+    ("area", "division.extrusion=0.3"),
+];
+
+fn seeds(scale: Scale) -> study::Seeds {
+    match scale {
+        Scale::Quick => study::Seeds { first: 1, last: 8 },
+        Scale::Paper => study::Seeds { first: 1, last: 20 },
+    }
+}
+
+/// The verdict on "extrusions concentrate at the defects" from the per-seed means of
+/// `d − d_random`: holds when their mean plus two standard errors is below zero (closer than
+/// random points); does not hold when their mean less two standard errors is above
+/// −[`MATERIAL`] (an attraction of a quarter radius is excluded); inconclusive otherwise (and
+/// with fewer than two seeds).
+pub(crate) fn verdict(per_seed: &[f64]) -> (Verdict, String) {
+    let (m, se) = mean_se(per_seed);
+    let what = format!(
+        "d − d_random = {} ± {} nodes over {} seeds",
+        g(m),
+        g(se),
+        per_seed.iter().filter(|v| v.is_finite()).count()
+    );
+    if !se.is_finite() {
+        (Verdict::Inconclusive, format!("{what}: too few seeds"))
+    } else if m + 2.0 * se < 0.0 {
+        (
+            Verdict::Holds,
+            format!(
+                "{what}: closer than random points of the tissue by more than two standard errors"
+            ),
+        )
+    } else if m - 2.0 * se > -MATERIAL {
+        (
+            Verdict::DoesNotHold,
+            format!("{what}: an attraction of {MATERIAL} nodes (R/4) or more is excluded by two standard errors"),
+        )
+    } else {
+        (Verdict::Inconclusive, what)
+    }
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+    let t = match p.scale {
+        Scale::Quick => 1000.0,
+        Scale::Paper => 2000.0,
+    };
+    let mut claims = Vec::new();
+    let mut csv =
+        String::from("rule,seed,extrusions,divisions,d_plus_excess,d_minus_excess,cells_end\n");
+    for (rule, key) in RULES {
+        let mut sets = vec![key.to_string(), format!("run.time={t}")];
+        if p.scale == Scale::Paper {
+            sets.push("integrator.dt=0.2".into());
+        }
+        let res = super::sweep(
+            p,
+            SweepJob {
+                name: format!("extrusion-{rule}-{}", p.scale.name()),
+                scene: EXTRUSION_SCENE,
+                sets,
+                varies: vec![],
+                analyze: Some(AnalyzeOptions::default()),
+                seeds: Some(seeds(p.scale)),
+            },
+        )?;
+        let (mut plus, mut minus, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+        for r in res.records(None)? {
+            let ev = super::Table::read(&r.run.join("analysis/cell_events.csv"))?;
+            let kind = ev.strs("kind")?;
+            let cols = ["d_plus", "d_plus_random", "d_minus", "d_minus_random"]
+                .map(|c| ev.f64s(c))
+                .into_iter()
+                .collect::<Result<Vec<_>, _>>()?;
+            let excess = |a: usize, b: usize| -> f64 {
+                let v: Vec<f64> = (0..kind.len())
+                    .filter(|&k| kind[k] == "extrusion")
+                    .map(|k| cols[a][k] - cols[b][k])
+                    .filter(|v| v.is_finite())
+                    .collect();
+                v.iter().sum::<f64>() / v.len().max(1) as f64
+            };
+            let n_ext = kind.iter().filter(|k| *k == "extrusion").count();
+            let n_div = kind.iter().filter(|k| *k == "division").count();
+            let (dp, dm) = if n_ext == 0 {
+                (f64::NAN, f64::NAN)
+            } else {
+                (excess(0, 1), excess(2, 3))
+            };
+            let series = super::Table::read(&r.run.join("series.csv"))?;
+            let cells_end = series.f64s("cells")?.last().copied().unwrap_or(f64::NAN);
+            csv += &format!(
+                "{rule},{},{n_ext},{n_div},{dp:e},{dm:e},{cells_end}\n",
+                r.seed
+            );
+            plus.push(dp);
+            minus.push(dm);
+            counts.push(n_ext as f64);
+        }
+        let (vp, wp) = verdict(&plus);
+        let (vm, wm) = verdict(&minus);
+        let n = mean_se(&counts);
+        claims.push(Claim::new(
+            format!("extrusion (issue 41), {rule} rule: extruded cells are found at +½ defects (Saw et al. 2017)"),
+            format!("{} extrusions per run (mean over seeds); {wp}", g(n.0)),
+            vp,
+            wp.clone(),
+        ));
+        claims.push(Claim::new(
+            format!("extrusion, {rule} rule: extruded cells are found at −½ defects"),
+            format!("{} extrusions per run; {wm}", g(n.0)),
+            vm,
+            wm.clone(),
+        ));
+    }
+    write_text(&dir.join("extrusion.csv"), &csv)?;
+    let settings = format!(
+        "- The paper's tissue (60 cells, R = 8, periodic 100², γ = 0.01, paper form) at ζ = 0.01 (active turbulence), with `[division] cycle_time = 300`, `growth_time = 50` and an extrusion rule: the stress-based rule `extrusion_pressure = 0.04` (a cell whose pressure p_i = Σφ_i P/Σφ_i, the isotropic stress at the cell, rises above it; the relaxed tissue's pressures are 0.005–0.013) or the area rule `extrusion = 0.3` (a cell below 30 % of its target area); seeds {}.\n\
+         - 200 TU of relaxation, then {t} TU; dt = {}; frames every 10 TU, analysed; at these settings the cell count holds at about 53 (pressure rule) and 86 (area rule) instead of growing to the cap.\n\
+         - Statistic: for each extrusion, `d₊ − d₊,random` (and `d₋ − d₋,random`): its distance to the nearest +½ (−½) defect of the frame nearest in time, less the mean distance of a point of that frame's tissue (`analysis/cell_events.csv`); its mean over a run's extrusions, then mean ± standard error over seeds. Rule: holds when the mean plus two standard errors is below 0 (closer than random); does not hold when the mean less two standard errors is above −{MATERIAL} nodes (an attraction of a quarter radius is excluded); inconclusive otherwise.\n\
+         - Data: `extrusion.csv` (each run: extrusions, divisions, the two excesses, the final cell count).",
+        seeds(p.scale),
+        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+    );
+    Ok((claims, settings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_outcome_is_reached() {
+        // Closer than random by 4 ± 0.5 nodes: holds.
+        assert_eq!(verdict(&[-4.5, -3.5, -4.0, -4.2]).0, Verdict::Holds);
+        // As far as random within 0.3 nodes: an attraction of 2 nodes is excluded.
+        assert_eq!(verdict(&[0.2, -0.3, 0.1, 0.0]).0, Verdict::DoesNotHold);
+        // Farther than random: also does not hold.
+        assert_eq!(verdict(&[2.0, 2.5, 1.5]).0, Verdict::DoesNotHold);
+        // Seeds scattered over ±5 nodes: inconclusive.
+        assert_eq!(verdict(&[-5.0, 4.0, -3.0, 3.0]).0, Verdict::Inconclusive);
+        // NaN seeds (no extrusion) are left out; one seed left: inconclusive.
+        assert_eq!(verdict(&[f64::NAN, -4.0]).0, Verdict::Inconclusive);
+    }
+}
