@@ -300,6 +300,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     }
     write_tables(dir, &rows, &rests, &key)?;
     p.reporter
+        .stage("stability: the uniform translations and the map's drift");
+    translations(dir, &rows, &rests, &key)?;
+    p.reporter
         .stage("stability: convergence in dt, margin, Krylov dimension and ε");
     let convergence = convergence(dir, &rows, &plan, &rests, &key)?;
     p.reporter.stage("stability: pictures");
@@ -401,6 +404,77 @@ fn write_tables(
         );
     }
     write_text(&dir.join("rest_states.csv"), &rs)
+}
+
+/// One line of `translations.csv`: the growth rates of the two uniform translations (which the
+/// threshold projects out) and the map's drift, at one ζ.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct TranslationRow {
+    zeta: f64,
+    sigma_x: f64,
+    sigma_y: f64,
+    drift: f64,
+}
+
+/// For every configuration Arnoldi measured: the translations' own growth rates
+/// ([`StepMap::translation_rates`]) and the map's drift `|M(x₀) − x₀|` at ζ = 0 and at its
+/// ζ_cr, into `translations.csv` (each kept in `configurations/` as it finishes).
+fn translations(
+    dir: &Path,
+    rows: &[Row],
+    rests: &BTreeMap<String, RestState>,
+    key: &dyn Fn(&Config) -> String,
+) -> Result<(), SweepError> {
+    let done = dir.join("configurations");
+    let mut csv = String::from("gamma,lx,ly,pressure,zeta,sigma_x,sigma_y,drift\n");
+    for r in rows.iter().filter(|r| r.method == "arnoldi") {
+        let c = &r.config;
+        let zetas = [0.0, r.zeta().map_or(f64::NAN, |z| z.0)];
+        for zeta in zetas.into_iter().filter(|z| z.is_finite()) {
+            let fingerprint = format!("{c:?} ζ {zeta:e} dt {DT} steps {STEPS} ε {:e}", ARNOLDI.eps);
+            let file = done.join(format!(
+                "translations-g{}-{}x{}-{}-z{zeta:e}.toml",
+                c.gamma,
+                c.hex.lx,
+                c.hex.ly,
+                pressure_name(c.pressure)
+            ));
+            let row = match kept(&file, &fingerprint) {
+                Some(row) => row,
+                None => {
+                    let mut map = StepMap::new(
+                        &rests[&key(c)].tissue,
+                        &c.params().with_zeta(zeta),
+                        StepParams::new(DT, 1),
+                        STEPS,
+                    )
+                    .map_err(|e| failed(c, e))?;
+                    let [sigma_x, sigma_y] = map
+                        .translation_rates(ARNOLDI.eps)
+                        .map_err(|e| failed(c, e))?;
+                    let row = TranslationRow {
+                        zeta,
+                        sigma_x,
+                        sigma_y,
+                        drift: map.drift(),
+                    };
+                    keep(&file, &fingerprint, row)?
+                }
+            };
+            csv += &format!(
+                "{},{},{},{},{:e},{:e},{:e},{:e}\n",
+                c.gamma,
+                c.hex.lx,
+                c.hex.ly,
+                pressure_name(c.pressure),
+                row.zeta,
+                row.sigma_x,
+                row.sigma_y,
+                row.drift
+            );
+        }
+    }
+    write_text(&dir.join("translations.csv"), &csv)
 }
 
 /// One line of the convergence table: what changed, σ at the reference ζ, its error.
@@ -1001,12 +1075,12 @@ fn settings(
     };
     format!(
         "- Rest state: a hexagonal packing at the paper's density (one cell per {} nodes), discs of radius {}R relaxed at ζ = 0 with dt {} until no field changes by more than {:e} per TU (over {} steps) or {} TU: {box_lines}. Relaxed in {}–{} TU; at the end the largest field rate is {}/TU, the largest cell speed {} (a steady treadmilling of the interfaces: φ stays, v_i ≠ 0 balances the relaxation), and S_rms = {}–{}: the shape anisotropy the packing keeps from the square grid (`rest_states.csv`).\n\
-         - The map: {STEPS} Heun steps of dt {DT} (τ = {} TU), f64, margin 16, about the rest state at each ζ (the state relaxed at ζ = 0; its residual forcing at ζ > 0 is reported as the drift of the map). The two uniform translations are projected out (neutral). σ = ln|μ|/τ of the leading eigenvalue μ of the map's Jacobian.\n\
+         - The map: {STEPS} Heun steps of dt {DT} (τ = {} TU), f64, margin 16, about the rest state at each ζ (the state relaxed at ζ = 0; its residual forcing at ζ > 0 is the drift of the map, |M(x₀) − x₀|, in `translations.csv` at ζ = 0 and at each ζ_cr). The two uniform translations are projected out; on the lattice they are not exactly neutral, and their own growth rates (the Rayleigh quotient t·Jt of each unit generator) are in `translations.csv` at ζ = 0 and at each ζ_cr. σ = ln|μ|/τ of the leading eigenvalue μ of the map's Jacobian.\n\
          - Arnoldi: Krylov dimension {}, `J v ≈ (M(x₀ + εv) − M(x₀))/ε` with ε = {:e} for a unit v (the perturbation is then about 1e-7 per node: truncation error O(ε) against round-off O(1e-16/ε) per node, balanced near 1e-8 relative; checked against ε/10 and 10ε below), Hessenberg eigenproblem by faer; error = the leading Ritz residual. Each evaluation of a bisection starts from the last one's leading mode with a random third mixed in.\n\
          - Perturbation growth: {} perturbations of norm {:e} about the same base, integrated over τ and renormalised (simultaneous power iteration with Rayleigh–Ritz on the {}×{} projected matrix), {} intervals ({} on a cold start); σ from the last rate plus the geometric tail of its approach, error twice that tail. Its convergence is slow because the leading modes form a dense band (spacing ~1e-4/TU), so it is run on fewer configurations.\n\
          - ζ_cr: bisection on [0, {ZETA_HI}] (the bracket first narrowed, up to three times, to ± 1e-4 around the root of the straight line through its ends), to half-width {TOL_ARNOLDI:e} (Arnoldi) and {TOL_GROWTH:e} (growth); its error adds the σ error over dσ/dζ in quadrature.\n\
          {conv_lines}\
-         - Scale `{}`. Files: `zeta_cr.csv`, `growth_rates.csv`, `spectrum.csv` (the leading Ritz values at the last evaluation), `rest_states.csv`, `convergence.csv`, `zeta_cr_gamma.png`, `zeta_cr_box.png`, `growth_rates.png`, `mode.png`.",
+         - Scale `{}`. Files: `zeta_cr.csv`, `growth_rates.csv`, `spectrum.csv` (the leading Ritz values at the last evaluation), `rest_states.csv`, `convergence.csv`, `translations.csv`, `zeta_cr_gamma.png`, `zeta_cr_box.png`, `growth_rates.png`, `mode.png`.",
         g(AREA_PER_CELL),
         relax.init_radius,
         relax.step.dt,

@@ -271,8 +271,28 @@ impl StepMap {
         transfer(self.base.cells(), v, t.cells(), out);
     }
 
-    /// Removes the two uniform translations of the whole tissue from `v` (they are neutral:
-    /// a translated rest state is a rest state, up to the lattice's pinning).
+    /// The growth rates of the two uniform translations of the whole tissue (x, then y after
+    /// orthogonalisation), which [`StepMap::project`] removes: `σ = ln|t·J t|/τ` for each unit
+    /// generator `t` (its Rayleigh quotient: the rate of the translation's own component after
+    /// one application). On a continuum they would be neutral (σ = 0); the lattice pins or
+    /// frees them, so a study says how far they are from it.
+    ///
+    /// # Errors
+    /// [`StabilityError::Step`] when a step fails.
+    pub fn translation_rates(&mut self, eps: f64) -> Result<[f64; 2], StabilityError> {
+        let mut out = vec![0.0; self.len()];
+        let mut rates = [0.0; 2];
+        for (k, rate) in rates.iter_mut().enumerate() {
+            let t = self.translations[k].clone();
+            self.jvp(&t, eps, &mut out)?;
+            *rate = dot(&t, &out).abs().ln() / self.horizon();
+        }
+        Ok(rates)
+    }
+
+    /// Removes the two uniform translations of the whole tissue from `v` (on a continuum they
+    /// are neutral, a translated rest state being a rest state; on the lattice they are pinned
+    /// or freed a little, [`StepMap::translation_rates`]).
     pub fn project(&self, v: &mut [f64]) {
         for t in &self.translations {
             let c = dot(t, v);

@@ -291,4 +291,10 @@ fn the_translation_is_nearly_neutral() {
     let mut p = t.clone();
     map.project(&mut p);
     assert!(norm(&p) < 1e-12, "the projection removes it: {}", norm(&p));
+    // `translation_rates` measures the same mode's own component: within the norm's rate (the
+    // Rayleigh quotient is at most the norm), and as small.
+    let [sx, sy] = map.translation_rates(1e-5).unwrap();
+    eprintln!("translation rates {sx:.3e} {sy:.3e}, norm rate {rate:.3e}");
+    assert!(sx <= rate + 1e-9 && sx.abs() < 1e-3, "{sx} {rate}");
+    assert!(sy.abs() < 1e-3, "{sy}");
 }
