@@ -44,6 +44,19 @@ impl HexBox {
         })
     }
 
+    /// `k × k` copies of this box: `k` times the columns, rows and sides, so that the spacings,
+    /// the residual anisotropy and the packing's alignment to the grid are exactly this box's
+    /// (a box made by [`HexBox::new`] for the larger packing rounds its sides afresh, e.g.
+    /// 24 × 40 cells on 333 × 481 against 4 × (83 × 120) = 332 × 480).
+    pub fn tiled(&self, k: usize) -> Self {
+        Self {
+            cols: self.cols * k,
+            rows: self.rows * k,
+            lx: self.lx * k,
+            ly: self.ly * k,
+        }
+    }
+
     /// Number of cells.
     pub fn n_cells(&self) -> usize {
         self.cols * self.rows

@@ -158,6 +158,16 @@ fn the_box_fits_the_packing() {
     assert!((ax - 83.0 / 6.0).abs() < 1e-12 && (ay - 24.0 / 3f64.sqrt()).abs() < 1e-12);
     assert!((h.anisotropy() - (ax / ay - 1.0)).abs() < 1e-15 && h.anisotropy().abs() < 2e-3);
     assert!(HexBox::new(6, 9, 166.0).is_err());
+    // Tilings keep the spacings exactly; a box made afresh for 24 × 40 cells does not.
+    for k in 1..=4 {
+        let t = h.tiled(k);
+        assert_eq!((t.lx, t.ly, t.n_cells()), (83 * k, 120 * k, 60 * k * k));
+        assert_eq!(t.spacings(), h.spacings());
+        assert_eq!(t.anisotropy(), h.anisotropy());
+    }
+    let fresh = HexBox::new(24, 40, 100.0 * 100.0 / 60.0).unwrap();
+    assert_eq!((fresh.lx, fresh.ly), (333, 481));
+    assert_ne!(fresh.anisotropy(), h.anisotropy());
 }
 
 /// The relaxation stops on its criterion, not its time limit.
