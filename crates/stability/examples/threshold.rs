@@ -1,7 +1,8 @@
 //! ζ_cr of one hexagonal packing by both methods, with each evaluation and the timings.
 //!
 //! `cargo run --release -p stability --example threshold -- COLS ROWS GAMMA PRESSURE`
-//! (`METHODS=arnoldi` for Arnoldi alone)
+//! (`METHODS=arnoldi` for Arnoldi alone; `TILE=k` for k × k copies of the COLS × ROWS box,
+//! an exact tiling; the uniform translations' own growth rates are printed at ζ = 0 and ζ_cr)
 use mechanics::{ModelParams, PressureKind, StepParams};
 use stability::*;
 use std::time::Instant;
@@ -16,7 +17,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     } else {
         PressureKind::Interaction
     };
-    let hex = HexBox::new(cols, rows, 100.0 * 100.0 / 60.0)?;
+    let tile: usize = std::env::var("TILE").map_or(1, |t| t.parse().unwrap());
+    let hex = HexBox::new(cols, rows, 100.0 * 100.0 / 60.0)?.tiled(tile);
     let mut params = ModelParams::paper(0.0).with_pressure(pressure);
     params.energy.gamma = gamma;
     let t0 = Instant::now();
@@ -71,6 +73,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             println!(
                 "   zeta {:.5} sigma {:+.4e} ± {:.1e}",
                 e.zeta, e.sigma, e.sigma_err
+            );
+        }
+        for zeta in [0.0, t.zeta_cr] {
+            let mut map =
+                StepMap::new(&rest.tissue, &params.with_zeta(zeta), opts.step, opts.steps)?;
+            let [sx, sy] = map.translation_rates(1e-5)?;
+            println!(
+                "   translations at zeta {zeta:.5}: sigma_x {sx:+.3e} sigma_y {sy:+.3e}, drift {:.2e}",
+                map.drift()
             );
         }
     }
