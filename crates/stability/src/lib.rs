@@ -13,8 +13,10 @@
 //! - [`arnoldi`]: Arnoldi iteration on `J v ≈ (M(x₀ + εv) − M(x₀))/ε`, with the Hessenberg
 //!   eigenproblem solved by faer; it gives the leading eigenvalues and the leading mode.
 //!
-//! Both remove the two uniform translations of the whole tissue, which are neutral. The
-//! threshold ζ_cr is where the leading σ crosses zero ([`bisect`]).
+//! Both remove the two uniform translations of the whole tissue, which would be neutral on a
+//! continuum; on the lattice they decay or grow slowly, and [`StepMap::translation_rates`]
+//! measures them. The threshold ζ_cr is where the leading σ of the other modes crosses zero
+//! ([`bisect`]).
 
 #![warn(missing_docs)]
 
