@@ -200,13 +200,13 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let mut series_of_scene: Vec<(u64, Vec<f64>, Vec<f64>)> = Vec::new();
     for &rk in &radii {
         for &dens in &densities {
-            let rd = rk * RADIUS;
-            let side = (2.0 * rd).round() as usize + 4;
+            // The disc's default radius, side/2 − 1, is R_d: the scene as `scenes/disc.toml`
+            // writes it.
+            let side = (2.0 * rk * RADIUS).round() as usize + 2;
             let cells = ((dens * rk * rk).round() as usize).max(1);
             let mut sets = vec![
                 format!("domain.lx={side}"),
                 format!("domain.ly={side}"),
-                format!("walls.radius={rd}"),
                 format!("cells.count={cells}"),
                 format!("run.time={t}"),
             ];
@@ -216,7 +216,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             let res = super::sweep(
                 p,
                 SweepJob {
-                    name: format!("rotation-r{rk}-d{dens}-{}", p.scale.name()),
+                    name: format!("rotation-r{rk}-d{dens}-s2-{}", p.scale.name()),
                     scene: DISC_SCENE,
                     sets,
                     varies: vec![
@@ -415,7 +415,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         ),
     ];
     let settings = format!(
-        "- Polar cells (R = 8, docs/model.md §11.1) in a disc of radius R_d ∈ {{{}}}·R (`[walls] kind = \"disc\"`, domain 2R_d + 4 square), at area fractions N R²/R_d² ∈ {{{}}}; alignment to the velocity or to the interface force, J ∈ {{{}}}, α ∈ {{{}}}, D_r = 4.5·10⁻⁴, ζ = 0, the interaction pressure; seeds {}.\n\
+        "- Polar cells (R = 8, docs/model.md §11.1) in a disc of radius R_d ∈ {{{}}}·R (`[walls] kind = \"disc\"` at its default radius, in a square domain of side 2R_d + 2), at area fractions N R²/R_d² ∈ {{{}}}; alignment to the velocity or to the interface force, J ∈ {{{}}}, α ∈ {{{}}}, D_r = 4.5·10⁻⁴, ζ = 0, the interaction pressure; seeds {}.\n\
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩ about the disc's centre at each frame (`rotation` of `analysis/observables.csv`); a run's Ω̄ is its mean over the second half of the active phase, its persistence the share of those frames with the sign of Ω̄. A point rotates when the mean over seeds of |Ω̄| less two standard errors is at least {ROTATES} and the mean persistence at least {PERSISTENT}; it is still when the mean of |Ω̄| plus two standard errors is below {STILL}; otherwise not established. (Undirected motion of N cells gives Ω of spread about 1/√(2N) per frame, less in the time mean.)\n\
          - Claim 1 holds when a point rotates, does not hold when every point is still. Claim 2 holds when a combination rotating in the smallest disc is still in the largest, does not hold when every such combination also rotates in the largest.\n\
