@@ -62,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = Instant::now();
         let t = threshold(&rest.tissue, &params, &method, &opts)?;
         println!(
-            "{}: zeta_cr {:.5} ± {:.5} slope {:.3} in {:.1}s",
+            "{}: zeta_cr {:.4e} ± {:.2e} slope {:.3} in {:.1}s",
             method.name(),
             t.zeta_cr,
             t.err,
