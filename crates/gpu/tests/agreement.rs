@@ -33,6 +33,26 @@ fn gpu_steps(backend: GpuBackend, tissue: &Tissue<f32>, sp: StepParams, steps: u
     sim.into_parts().0
 }
 
+/// The states after `steps` steps of the paper's integrator from `tissue` through a
+/// `Simulation` (so the division clock runs) on the GPU and on the CPU.
+fn on_both_backends(tissue: &Tissue<f32>, steps: u64) -> (Tissue<f32>, Tissue<f32>) {
+    let sp = StepParams::paper();
+    let gpu = GpuBackend::new(tissue, &sp).expect("a Vulkan adapter");
+    let g = gpu_steps(gpu, tissue, sp, steps);
+    let mut sim = Simulation::new(tissue.clone(), sp).stop_iteration(tissue.iteration() + steps);
+    sim.run().unwrap();
+    (g, sim.into_parts().0)
+}
+
+/// Every cell that lived, one line each: identity, parent, birth and how it ended.
+fn lineage(t: &Tissue<f32>) -> Vec<String> {
+    t.proliferation()
+        .unwrap()
+        .lineage()
+        .map(|r| format!("{} {:?} {} {:?}", r.id, r.parent, r.birth, r.death))
+        .collect()
+}
+
 /// The state after `steps` steps of the CPU backend from `tissue`.
 fn cpu_steps<T: Real>(tissue: &Tissue<T>, sp: StepParams, steps: u64) -> Tissue<T> {
     let mut t = tissue.clone();
@@ -750,20 +770,8 @@ fn division_on_the_device_follows_the_cpu() {
         .with_pressure_gate(0.01)
         .with_max_cells(90);
     let tissue = start.with_proliferation(clock);
-    let sp = StepParams::paper();
     let steps = 250;
-    let gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
-    let g = gpu_steps(gpu, &tissue, sp, steps);
-    let mut sim = Simulation::new(tissue.clone(), sp).stop_iteration(tissue.iteration() + steps);
-    sim.run().unwrap();
-    let c = sim.into_parts().0;
-    let lineage = |t: &Tissue<f32>| -> Vec<String> {
-        t.proliferation()
-            .unwrap()
-            .lineage()
-            .map(|r| format!("{} {:?} {} {:?}", r.id, r.parent, r.birth, r.death))
-            .collect()
-    };
+    let (g, c) = on_both_backends(&tissue, steps);
     let (lg, lc) = (lineage(&g), lineage(&c));
     println!(
         "division: {} cells on the GPU, {} on the CPU; {} lineage records, {} born",
@@ -822,20 +830,8 @@ fn stress_based_extrusion_on_the_device_follows_the_cpu() {
         .with_extrusion_pressure(0.05)
         .with_max_cells(90);
     let tissue = start.with_proliferation(clock);
-    let sp = StepParams::paper();
     let steps = 250;
-    let gpu = GpuBackend::new(&tissue, &sp).expect("a Vulkan adapter");
-    let g = gpu_steps(gpu, &tissue, sp, steps);
-    let mut sim = Simulation::new(tissue.clone(), sp).stop_iteration(tissue.iteration() + steps);
-    sim.run().unwrap();
-    let c = sim.into_parts().0;
-    let lineage = |t: &Tissue<f32>| -> Vec<String> {
-        t.proliferation()
-            .unwrap()
-            .lineage()
-            .map(|r| format!("{} {:?} {} {:?}", r.id, r.parent, r.birth, r.death))
-            .collect()
-    };
+    let (g, c) = on_both_backends(&tissue, steps);
     let (lg, lc) = (lineage(&g), lineage(&c));
     let extruded = lc.iter().filter(|r| r.contains("Extrusion")).count();
     println!(

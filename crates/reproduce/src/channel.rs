@@ -226,15 +226,12 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         )?;
         let mut with_flow = Vec::new();
         for r in res.records(None)? {
-            let o = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-            let (times, vx) = (o.f64s("time")?, o.f64s("v_mean_x")?);
-            let late: Vec<f64> = times
-                .iter()
-                .zip(&vx)
-                .filter(|(time, v)| **time >= 200.0 + t / 2.0 && v.is_finite())
-                .map(|(_, v)| v.abs())
-                .collect();
-            let phi = late.iter().sum::<f64>() / late.len().max(1) as f64;
+            let phi = super::late_mean(
+                &r.run.join("analysis/observables.csv"),
+                "v_mean_x",
+                200.0 + t / 2.0,
+                f64::abs,
+            )?;
             with_flow.push((r, phi));
         }
         recs.push((w, with_flow));

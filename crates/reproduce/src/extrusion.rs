@@ -59,10 +59,7 @@ const RULES: [(&str, &str); 2] = [
 ];
 
 fn seeds(scale: Scale) -> study::Seeds {
-    match scale {
-        Scale::Quick => study::Seeds { first: 1, last: 8 },
-        Scale::Paper => study::Seeds { first: 1, last: 20 },
-    }
+    scale.seeds_up_to(8, 20)
 }
 
 /// The verdict on "extrusions concentrate at the defects" from the per-seed means of
@@ -107,9 +104,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         String::from("rule,seed,extrusions,divisions,d_plus_excess,d_minus_excess,cells_end\n");
     for (rule, key) in RULES {
         let mut sets = vec![key.to_string(), format!("run.time={t}")];
-        if p.scale == Scale::Paper {
-            sets.push("integrator.dt=0.2".into());
-        }
+        sets.extend(p.scale.own_dt_set());
         let res = super::sweep(
             p,
             SweepJob {
@@ -177,7 +172,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
          - Statistic: for each extrusion, `d₊ − d₊,random` (and `d₋ − d₋,random`): its distance to the nearest +½ (−½) defect of the frame nearest in time, less the mean distance of a point of that frame's tissue (`analysis/cell_events.csv`); its mean over a run's extrusions, then mean ± standard error over seeds. Rule: holds when the mean plus two standard errors is below 0 (closer than random); does not hold when the mean less two standard errors is above −{MATERIAL} nodes (an attraction of a quarter radius is excluded); inconclusive otherwise.\n\
          - Data: `extrusion.csv` (each run: extrusions, divisions, the two excesses, the final cell count).",
         seeds(p.scale),
-        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        p.scale.own_dt(),
     );
     Ok((claims, settings))
 }

@@ -172,9 +172,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     let relax = 100.0;
     let from = relax + t / 2.0;
     let mut sets = vec![format!("run.time={t}")];
-    if p.scale == Scale::Paper {
-        sets.push("integrator.dt=0.2".into());
-    }
+    sets.extend(p.scale.own_dt_set());
     let res = super::sweep(
         p,
         SweepJob {
@@ -208,22 +206,16 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             .position(|v| *v == r.values[0])
             .expect("a noise of the sweep");
         let s = seeds.binary_search(&r.seed).expect("a seed of the sweep");
-        let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-        let (times, pol) = (tab.f64s("time")?, tab.f64s("polar_order")?);
-        let w: Vec<f64> = times
-            .iter()
-            .zip(&pol)
-            .filter(|(t, o)| **t >= from && o.is_finite())
-            .map(|(_, o)| *o)
-            .collect();
-        order[s][k] = if w.is_empty() {
-            f64::NAN
-        } else {
-            w.iter().sum::<f64>() / w.len() as f64
-        };
+        let obs = r.run.join("analysis/observables.csv");
+        order[s][k] = super::late_mean(&obs, "polar_order", from, |v| v)?;
         runs_csv += &format!("{},{},{:e}\n", r.values[0], r.seed, order[s][k]);
         if s == 0 {
-            in_time.push((format!("D_r = {}", r.values[0]), times, pol));
+            let tab = super::Table::read(&obs)?;
+            in_time.push((
+                format!("D_r = {}", r.values[0]),
+                tab.f64s("time")?,
+                tab.f64s("polar_order")?,
+            ));
         }
     }
     let stats: Vec<(f64, f64)> = (0..d.len())
@@ -314,7 +306,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         g(align_rate),
         noises.join(", "),
         p.scale.seeds(),
-        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        p.scale.own_dt(),
         g(null),
     );
     Ok((claims, settings))

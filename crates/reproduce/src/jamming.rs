@@ -258,9 +258,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         Scale::Paper => 5000.0,
     };
     let mut sets = vec![format!("run.time={t}")];
-    if p.scale == Scale::Paper {
-        sets.push("integrator.dt=0.2".into());
-    }
+    sets.extend(p.scale.own_dt_set());
     let res = super::sweep(
         p,
         SweepJob {
@@ -311,15 +309,12 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             msd.last().copied().unwrap_or(f64::NAN),
         );
         lag_l = lag;
-        let o = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-        let (times, qs) = (o.f64s("time")?, o.f64s("shape_index")?);
-        let late: Vec<f64> = times
-            .iter()
-            .zip(&qs)
-            .filter(|(t, v)| **t >= from && v.is_finite())
-            .map(|(_, v)| *v)
-            .collect();
-        let qm = late.iter().sum::<f64>() / late.len().max(1) as f64;
+        let qm = super::late_mean(
+            &r.run.join("analysis/observables.csv"),
+            "shape_index",
+            from,
+            |v| v,
+        )?;
         ln_msd[gi][si][ai] = v.ln();
         q[gi][si][ai] = qm;
         runs_csv += &format!(
@@ -474,7 +469,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         GAMMAS.join(", "),
         ALPHAS.join(", "),
         p.scale.seeds(),
-        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        p.scale.own_dt(),
         g(lag_l),
     );
     Ok((claims, settings))

@@ -107,6 +107,32 @@ impl Scale {
         self.integrator().join(" ").replace("integrator.", "")
     }
 
+    /// The time step of the figures whose scenes are not the paper's (they keep their scene's
+    /// margin): the scene's 0.5 at the quick scale, the paper's 0.2 at the paper scale.
+    pub(crate) fn own_dt(self) -> f64 {
+        match self {
+            Self::Quick => 0.5,
+            Self::Paper => 0.2,
+        }
+    }
+
+    /// [`Scale::own_dt`] as an override of the scene, where it is not the scene's own.
+    pub(crate) fn own_dt_set(self) -> Option<String> {
+        (self == Self::Paper).then(|| format!("integrator.dt={}", self.own_dt()))
+    }
+
+    /// The seeds `1..=quick` or `1..=paper`, for figures whose statistic needs more seeds than
+    /// [`Scale::seeds`] gives.
+    pub(crate) fn seeds_up_to(self, quick: u64, paper: u64) -> Seeds {
+        Seeds {
+            first: 1,
+            last: match self {
+                Self::Quick => quick,
+                Self::Paper => paper,
+            },
+        }
+    }
+
     /// Its name, as given to `--scale`.
     pub fn name(self) -> &'static str {
         match self {
@@ -592,6 +618,30 @@ impl SweepResult {
             })
             .collect()
     }
+}
+
+/// The mean of `f` of the column `column` of a run's table `path` (e.g.
+/// `analysis/observables.csv`) over its rows at or after the time `from` (the column `time`),
+/// non-finite values left out; NaN without such rows.
+pub(crate) fn late_mean(
+    path: &Path,
+    column: &str,
+    from: f64,
+    f: impl Fn(f64) -> f64,
+) -> Result<f64, SweepError> {
+    let t = Table::read(path)?;
+    let (times, values) = (t.f64s("time")?, t.f64s(column)?);
+    let late: Vec<f64> = times
+        .iter()
+        .zip(&values)
+        .filter(|(t, v)| **t >= from && v.is_finite())
+        .map(|(_, v)| f(*v))
+        .collect();
+    Ok(if late.is_empty() {
+        f64::NAN
+    } else {
+        late.iter().sum::<f64>() / late.len() as f64
+    })
 }
 
 /// The mean and spread over the runs `runs` of the columns `cols` of their table `file`

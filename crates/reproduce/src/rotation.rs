@@ -85,10 +85,7 @@ fn settings(scale: Scale) -> (Vec<f64>, Vec<f64>, f64) {
 /// More seeds than the paper's figures: with 3, a change of the initial placements alone
 /// moved the verdict on the disc's size between "inconclusive" and "does not hold".
 fn seeds(scale: Scale) -> study::Seeds {
-    match scale {
-        Scale::Quick => study::Seeds { first: 1, last: 6 },
-        Scale::Paper => study::Seeds { first: 1, last: 10 },
-    }
+    scale.seeds_up_to(6, 10)
 }
 
 /// What a point does.
@@ -219,9 +216,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 format!("cells.count={cells}"),
                 format!("run.time={t}"),
             ];
-            if p.scale == Scale::Paper {
-                sets.push("integrator.dt=0.2".into());
-            }
+            sets.extend(p.scale.own_dt_set());
             let res = super::sweep(
                 p,
                 SweepJob {
@@ -434,7 +429,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         RATES.join(", "),
         ALPHAS.join(", "),
         seeds(p.scale),
-        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        p.scale.own_dt(),
         SCENE_POINT.0,
         SCENE_POINT.1,
         SCENE_POINT.2,

@@ -61,10 +61,7 @@ pub(crate) const MATERIAL: f64 = 0.05;
 /// More seeds than the paper's figures: a run's late demixing scatters by about 0.03 between
 /// seeds, against the 0.05 that counts.
 fn seeds(scale: Scale) -> study::Seeds {
-    match scale {
-        Scale::Quick => study::Seeds { first: 1, last: 6 },
-        Scale::Paper => study::Seeds { first: 1, last: 10 },
-    }
+    scale.seeds_up_to(6, 10)
 }
 
 /// What a point does.
@@ -189,9 +186,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             format!("population.1.gamma={gb}"),
             format!("run.time={t}"),
         ];
-        if p.scale == Scale::Paper {
-            sets.push("integrator.dt=0.2".into());
-        }
+        sets.extend(p.scale.own_dt_set());
         let res = super::sweep(
             p,
             SweepJob {
@@ -206,20 +201,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let mut per_seed = Vec::new();
         let mut series: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
         for r in res.records(None)? {
-            let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-            let (times, dem) = (tab.f64s("time")?, tab.f64s("demixing")?);
-            let w: Vec<f64> = times
-                .iter()
-                .zip(&dem)
-                .filter(|(t, d)| **t >= from && d.is_finite())
-                .map(|(_, d)| *d)
-                .collect();
-            per_seed.push(if w.is_empty() {
-                f64::NAN
-            } else {
-                w.iter().sum::<f64>() / w.len() as f64
-            });
-            series.push((times, dem));
+            let obs = r.run.join("analysis/observables.csv");
+            per_seed.push(super::late_mean(&obs, "demixing", from, |v| v)?);
+            let tab = super::Table::read(&obs)?;
+            series.push((tab.f64s("time")?, tab.f64s("demixing")?));
         }
         let rows = series.iter().map(|s| s.0.len()).min().unwrap_or(0);
         let mean: Vec<f64> = (0..rows)
@@ -330,7 +315,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
          - Statistic: the demixing parameter (`demixing` of `analysis/observables.csv`: the fraction of touching cells of the same population less its value for labels dealt at random) averaged over the second half of the active phase per run; a point's mean and standard error over seeds. The shuffled-label null has mean 0 by the parameter's construction. A point sorts when its mean exceeds two standard errors and {MATERIAL}; it stays mixed when its mean plus two standard errors is below {MATERIAL}; otherwise not established. A claim holds when one of its points sorts and does not hold when every one stays mixed.\n\
          - Data: `sorting.csv`; plot `sorting_in_time.png` (the mean over seeds of each point in time).",
         seeds(p.scale),
-        if p.scale == Scale::Paper { "0.2" } else { "0.5" },
+        p.scale.own_dt(),
     );
     Ok((claims, settings))
 }

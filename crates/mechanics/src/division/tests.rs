@@ -279,14 +279,9 @@ fn cells_below_the_area_fraction_are_removed() {
     assert!(remove_extruded(&mut t, &mut ws, 0.2, None).is_empty());
 }
 
-/// T5.4: contact inhibition of proliferation. A confluent tissue (the paper's density, 30
-/// cells on 71²) under a fast clock (`T₀ = 40`, `k = 0.05`) divides less with the pressure
-/// gate than without it, over 200 TU, the gate at the median cell pressure of the relaxed
-/// tissue (9.3e-3; the cells' pressures span 5.4e-3 to 1.3e-2). Measured: 170 divisions
-/// without the gate (the tissue reaches its cap of 200 cells), 3 with it, since every
-/// division raises the pressure of the cells around. Asserted: fewer than three quarters.
-#[test]
-fn a_pressure_gate_slows_division_at_confluence() {
+/// The paper's density relaxed to confluence: 30 cells on 71², 200 steps at ζ = 0, with its
+/// evaluation in the workspace (the cells' pressures span 5.4e-3 to 1.3e-2).
+fn relaxed_confluent() -> (Tissue<f64>, Workspace<f64>) {
     let lattice = Lattice::new(71, 71);
     let shape = PatchShape::new(lattice, 14).unwrap();
     let centres = init::positions(lattice, 30, 4.0, &init::Layout::Random { seed: 3 }).unwrap();
@@ -297,6 +292,18 @@ fn a_pressure_gate_slows_division_at_confluence() {
         t0.step(&mut ws0, &StepParams::default()).unwrap();
     }
     t0.refresh(&mut ws0);
+    (t0, ws0)
+}
+
+/// T5.4: contact inhibition of proliferation. A confluent tissue (the paper's density, 30
+/// cells on 71²) under a fast clock (`T₀ = 40`, `k = 0.05`) divides less with the pressure
+/// gate than without it, over 200 TU, the gate at the median cell pressure of the relaxed
+/// tissue (9.3e-3; the cells' pressures span 5.4e-3 to 1.3e-2). Measured: 170 divisions
+/// without the gate (the tissue reaches its cap of 200 cells), 3 with it, since every
+/// division raises the pressure of the cells around. Asserted: fewer than three quarters.
+#[test]
+fn a_pressure_gate_slows_division_at_confluence() {
+    let (t0, ws0) = relaxed_confluent();
     let mut p: Vec<f64> = (0..t0.n_cells())
         .map(|s| cell_pressure(&t0, &ws0, s))
         .collect();
@@ -487,16 +494,7 @@ fn a_removed_cells_identity_is_not_given_again() {
 /// (30 cells on 71², pressures from 5.4e-3 to 1.3e-2), the threshold at its upper quartile.
 #[test]
 fn the_pressure_rule_extrudes_the_compressed_cells() {
-    let lattice = Lattice::new(71, 71);
-    let shape = PatchShape::new(lattice, 14).unwrap();
-    let centres = init::positions(lattice, 30, 4.0, &init::Layout::Random { seed: 3 }).unwrap();
-    let cells = init::discs(lattice, shape, &centres, 4.0, 2.5);
-    let mut t0 = Tissue::new(cells, ModelParams::paper(0.0));
-    let mut ws0 = Workspace::new(t0.cells());
-    for _ in 0..200 {
-        t0.step(&mut ws0, &StepParams::default()).unwrap();
-    }
-    t0.refresh(&mut ws0);
+    let (t0, ws0) = relaxed_confluent();
     let by_id: Vec<(usize, f64)> = (0..t0.n_cells())
         .map(|s| (t0.cell_ids()[s], cell_pressure(&t0, &ws0, s)))
         .collect();
