@@ -1119,12 +1119,19 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
         "1",
     ];
     let full = dir.path().join("full");
+    let started = std::time::Instant::now();
     let o = run(&scene_path("paper.toml"), &full, &args);
+    let whole = started.elapsed().as_millis() as u64;
     assert!(o.status.success(), "{}", stderr(&o));
     let want = run_files(&full);
-    // Kill points spread over the run (it takes about a second).
+    // Kill points spread over the run, as shares of the uninterrupted run's wall time (about a
+    // second; fixed times were passed by a fast machine, which had finished by the last one).
     let mut resumed = 0;
-    for (k, ms) in [150u64, 400, 700].into_iter().enumerate() {
+    for (k, ms) in [15u64, 40, 70]
+        .into_iter()
+        .map(|pct| whole * pct / 100)
+        .enumerate()
+    {
         let out = dir.path().join(format!("killed{k}"));
         let mut child = bin()
             .arg("run")
@@ -1136,10 +1143,13 @@ fn a_run_killed_at_random_points_resumes_bit_for_bit() {
             .spawn()
             .unwrap();
         std::thread::sleep(std::time::Duration::from_millis(ms));
+        if child.try_wait().unwrap().is_some() {
+            continue; // it finished before the kill: nothing was interrupted
+        }
         let _ = child.kill(); // SIGKILL
         child.wait().unwrap();
-        if !out.join("checkpoints").exists() {
-            continue; // killed before the first checkpoint: nothing to resume
+        if !out.join("checkpoints").exists() || rundir::is_complete(&out) {
+            continue; // killed before the first checkpoint, or after the last write
         }
         assert!(
             !rundir::is_complete(&out),
