@@ -19,8 +19,13 @@ pub struct Positions {
 pub struct MsdPoint {
     /// The lag, in the frames' time units (the mean over the pairs of frames that give it).
     pub lag: f64,
-    /// `⟨|r_i(t + lag) − r_i(t)|²⟩` over cells and time origins.
+    /// `⟨|Δr_i − ⟨Δr⟩|²⟩` over cells and time origins, `Δr_i = r_i(t + lag) − r_i(t)` and
+    /// `⟨Δr⟩` its mean over the cells present in both frames: the tissue's drift removed, so
+    /// that a tissue that migrates as a whole has no MSD of its own (its rearrangements
+    /// remain).
     pub msd: f64,
+    /// `⟨|Δr_i|²⟩`, the drift kept.
+    pub msd_raw: f64,
     /// How many (cell, origin) pairs were averaged.
     pub samples: usize,
 }
@@ -33,12 +38,10 @@ pub struct MsdPoint {
 ///
 /// Positions are unwrapped in the periodic box `[lx, ly]` (a step between consecutive frames
 /// is taken as the shortest periodic image, so a cell must move less than half the box
-/// between frames); a side of `f64::INFINITY` is not periodic. With `drift`, the mean
-/// displacement of the cells present in both frames is subtracted from each cell's, so that a
-/// tissue that migrates as a whole has no MSD of its own (its rearrangements remain).
-pub fn msd(frames: &[Positions], box_size: [f64; 2], drift: bool) -> Vec<MsdPoint> {
+/// between frames); a side of `f64::INFINITY` is not periodic. Each point has the MSD with the
+/// tissue's drift removed and kept ([`MsdPoint`]), from one pass over the pairs.
+pub fn msd(frames: &[Positions], box_size: [f64; 2]) -> Vec<MsdPoint> {
     // Unwrapped positions by identity, frame by frame.
-    let mut last: HashMap<usize, [f64; 2]> = HashMap::new();
     let mut raw: HashMap<usize, [f64; 2]> = HashMap::new();
     let mut unwrapped: Vec<HashMap<usize, [f64; 2]>> = Vec::with_capacity(frames.len());
     let shortest = |d: f64, side: f64| {
@@ -51,7 +54,7 @@ pub fn msd(frames: &[Positions], box_size: [f64; 2], drift: bool) -> Vec<MsdPoin
     for f in frames {
         let mut now = HashMap::with_capacity(f.ids.len());
         for (&id, &c) in f.ids.iter().zip(&f.centres) {
-            let u = match (raw.get(&id), last.get(&id)) {
+            let u = match (raw.get(&id), unwrapped.last().and_then(|l| l.get(&id))) {
                 (Some(r), Some(u)) => [
                     u[0] + shortest(c[0] - r[0], box_size[0]),
                     u[1] + shortest(c[1] - r[1], box_size[1]),
@@ -66,32 +69,34 @@ pub fn msd(frames: &[Positions], box_size: [f64; 2], drift: bool) -> Vec<MsdPoin
             .copied()
             .zip(f.centres.iter().copied())
             .collect();
-        last.clone_from(&now);
         unwrapped.push(now);
     }
     (1..=frames.len() / 2)
         .map(|k| {
-            let (mut sum, mut n, mut lag) = (0.0, 0usize, 0.0);
+            let (mut sum, mut sum_raw, mut n, mut lag) = (0.0, 0.0, 0usize, 0.0);
             let origins = frames.len() - k;
             for t in 0..origins {
                 let (a, b) = (&unwrapped[t], &unwrapped[t + k]);
-                let pairs: Vec<[f64; 2]> = a
+                // In the frame's order of cells, so that the sums are the same on every call
+                // (a map's own order is not).
+                let pairs: Vec<[f64; 2]> = frames[t]
+                    .ids
                     .iter()
-                    .filter_map(|(id, p)| b.get(id).map(|q| [q[0] - p[0], q[1] - p[1]]))
+                    .filter_map(|id| {
+                        let (p, q) = (a.get(id)?, b.get(id)?);
+                        Some([q[0] - p[0], q[1] - p[1]])
+                    })
                     .collect();
                 if pairs.is_empty() {
                     continue;
                 }
-                let mean = if drift {
-                    let m = pairs.len() as f64;
-                    pairs
-                        .iter()
-                        .fold([0.0, 0.0], |s, d| [s[0] + d[0] / m, s[1] + d[1] / m])
-                } else {
-                    [0.0, 0.0]
-                };
+                let m = pairs.len() as f64;
+                let mean = pairs
+                    .iter()
+                    .fold([0.0, 0.0], |s, d| [s[0] + d[0] / m, s[1] + d[1] / m]);
                 for d in &pairs {
                     sum += (d[0] - mean[0]).powi(2) + (d[1] - mean[1]).powi(2);
+                    sum_raw += d[0].powi(2) + d[1].powi(2);
                 }
                 n += pairs.len();
                 lag += frames[t + k].time - frames[t].time;
@@ -99,6 +104,7 @@ pub fn msd(frames: &[Positions], box_size: [f64; 2], drift: bool) -> Vec<MsdPoin
             MsdPoint {
                 lag: lag / origins as f64,
                 msd: if n == 0 { f64::NAN } else { sum / n as f64 },
+                msd_raw: if n == 0 { f64::NAN } else { sum_raw / n as f64 },
                 samples: n,
             }
         })
@@ -161,8 +167,8 @@ mod tests {
         }
     }
 
-    /// Ballistic motion across a periodic edge gives `v² t²` exactly; a common drift is
-    /// removed with `drift`, and a cell that leaves is left out of later lags.
+    /// Ballistic motion across a periodic edge gives `v² t²` exactly (drift kept); a common
+    /// drift is removed in `msd`, and a cell that leaves is left out of later lags.
     #[test]
     fn the_msd_of_ballistic_cells_across_the_edge_is_v2_t2() {
         let side = 10.0;
@@ -175,14 +181,14 @@ mod tests {
                 frame(t, &[0, 7], &[[x, y], [5.0, 5.0]])
             })
             .collect();
-        let m = msd(&frames, [side, side], false);
+        let m = msd(&frames, [side, side]);
         // Lags of 1 to 3 frames (half of the 6 frames).
         assert_eq!(m.len(), 3);
         for (k, p) in m.iter().enumerate() {
             let lag = (k + 1) as f64;
             assert!((p.lag - lag).abs() < 1e-12);
             // Half the cells move at speed 5: ⟨d²⟩ = 25 lag²/2.
-            assert!((p.msd - 12.5 * lag * lag).abs() < 1e-9, "{p:?}");
+            assert!((p.msd_raw - 12.5 * lag * lag).abs() < 1e-9, "{p:?}");
             assert_eq!(p.samples, 2 * (6 - k - 1));
         }
         // Both cells drifting together: nothing left with the drift removed.
@@ -196,10 +202,41 @@ mod tests {
                 )
             })
             .collect();
-        assert!(msd(&moving, [side, side], true)
-            .iter()
-            .all(|p| p.msd.abs() < 1e-20));
-        assert!((msd(&moving, [side, side], false)[0].msd - 6.25).abs() < 1e-12);
+        let m = msd(&moving, [side, side]);
+        assert!(m.iter().all(|p| p.msd.abs() < 1e-20));
+        assert!((m[0].msd_raw - 6.25).abs() < 1e-12);
+    }
+
+    /// The same frames give the same bits on every call: the sums run in the frames' order
+    /// of cells, not in a hash map's (which differs from map to map, and made the last digits
+    /// of `msd.csv` change between two analyses of one run).
+    #[test]
+    fn the_msd_is_the_same_on_every_call() {
+        let frames: Vec<Positions> = (0..12)
+            .map(|k| {
+                let ids: Vec<usize> = (0..60).collect();
+                let centres: Vec<[f64; 2]> = ids
+                    .iter()
+                    .map(|&i| {
+                        let a = 0.37 * (i * i + 3 * k) as f64;
+                        [
+                            (5.0 * i as f64 + 1.3 * a.sin()) % 100.0,
+                            (7.0 * i as f64 + 0.9 * a.cos() * k as f64) % 100.0,
+                        ]
+                    })
+                    .collect();
+                frame(k as f64, &ids, &centres)
+            })
+            .collect();
+        let bits = |m: Vec<MsdPoint>| -> Vec<(u64, u64)> {
+            m.iter()
+                .map(|p| (p.msd.to_bits(), p.msd_raw.to_bits()))
+                .collect()
+        };
+        let first = bits(msd(&frames, [100.0, 100.0]));
+        for _ in 0..5 {
+            assert_eq!(bits(msd(&frames, [100.0, 100.0])), first);
+        }
     }
 
     /// A cell that appears or leaves counts only where it is present at both ends.
@@ -210,15 +247,15 @@ mod tests {
             frame(1.0, &[1, 2], &[[1.0, 0.0], [5.0, 5.0]]),
             frame(2.0, &[2], &[[5.0, 7.0]]),
         ];
-        let m = msd(&frames, [f64::INFINITY; 2], false);
+        let m = msd(&frames, [f64::INFINITY; 2]);
         // One lag (half of three frames): cell 1 from 0 to 1 (d² = 1), cell 2 from 1 to 2
         // (d² = 4).
         assert_eq!(m.len(), 1);
         assert_eq!(m[0].samples, 2);
-        assert!((m[0].msd - 2.5).abs() < 1e-12);
+        assert!((m[0].msd_raw - 2.5).abs() < 1e-12);
         // Two frames give their one lag; one frame none.
-        assert_eq!(msd(&frames[..2], [f64::INFINITY; 2], false).len(), 1);
-        assert!(msd(&frames[..1], [f64::INFINITY; 2], false).is_empty());
+        assert_eq!(msd(&frames[..2], [f64::INFINITY; 2]).len(), 1);
+        assert!(msd(&frames[..1], [f64::INFINITY; 2]).is_empty());
         // Five frames, cell 1 only at both ends of lag 2 from t = 0 to 2: absent, so NaN.
         let five = [
             frame(0.0, &[1], &[[0.0, 0.0]]),
@@ -227,9 +264,11 @@ mod tests {
             frame(3.0, &[4], &[[5.0, 7.0]]),
             frame(4.0, &[5], &[[5.0, 7.0]]),
         ];
-        let m = msd(&five, [f64::INFINITY; 2], false);
+        let m = msd(&five, [f64::INFINITY; 2]);
         assert_eq!(m.len(), 2);
-        assert!(m.iter().all(|p| p.samples == 0 && p.msd.is_nan()));
+        assert!(m
+            .iter()
+            .all(|p| p.samples == 0 && p.msd.is_nan() && p.msd_raw.is_nan()));
     }
 
     /// A tanh disc of radius 8 has q = 2√π to 0.5 % (0.1 % measured); an ellipse of the same area with semi-axes

@@ -881,21 +881,16 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         info.events += tracks.events.len();
     }
     write_file(&out.join("observables.csv"), obs.as_bytes())?;
-    let periodic = [lattice.lx as f64, lattice.ly as f64];
-    let (without, with) = (
-        analysis::motion::msd(&positions, periodic, true),
-        analysis::motion::msd(&positions, periodic, false),
-    );
     let mut msd_csv = String::new();
     row!(msd_csv, "{}", rundir::MSD_HEADER);
-    for (a, b) in without.iter().zip(&with) {
+    for p in analysis::motion::msd(&positions, [lattice.lx as f64, lattice.ly as f64]) {
         row!(
             msd_csv,
             "{:.6},{:e},{:e},{}",
-            a.lag,
-            a.msd,
-            b.msd,
-            a.samples
+            p.lag,
+            p.msd,
+            p.msd_raw,
+            p.samples
         );
     }
     write_file(&out.join("msd.csv"), msd_csv.as_bytes())?;

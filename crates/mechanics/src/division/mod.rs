@@ -846,8 +846,6 @@ fn remove_cells<T: Real>(
     (ids, spared)
 }
 
-/// The cells whose area in the evaluation `ws` is below `fraction` of their target area, in
-/// the order of their identities.
 /// The cells (by identity, sorted) that `clock`'s extrusion rules remove after the last
 /// evaluation in `ws`: by area ([`Proliferation::extrusion`]) or by pressure
 /// ([`Proliferation::extrusion_pressure`]).
@@ -868,6 +866,8 @@ fn extruded<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, clock: &Proliferatio
     out
 }
 
+/// The cells whose area in the evaluation `ws` is below `fraction` of their target area, in
+/// the order of their identities.
 fn extruded_by_area<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>, fraction: f64) -> Vec<usize> {
     // Each cell's target radius by its population's override rules (`Populations::params`).
     let mut small: Vec<usize> = (0..tissue.n_cells())
