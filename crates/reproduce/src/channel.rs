@@ -116,26 +116,14 @@ pub(crate) fn exponent(
     };
     let all: Vec<usize> = (0..ratio.len()).collect();
     let (b, wc) = fit(&all);
-    let n = ratio.len();
-    if n < 3 || !b.is_finite() {
+    if !b.is_finite() {
         return (b, f64::NAN, wc);
     }
-    let leave: Vec<f64> = (0..n)
-        .map(|out| {
-            fit(&all
-                .iter()
-                .copied()
-                .filter(|&s| s != out)
-                .collect::<Vec<_>>())
-            .0
-        })
-        .collect();
-    if leave.iter().any(|v| !v.is_finite()) {
-        return (b, f64::NAN, wc);
-    }
-    let m = leave.iter().sum::<f64>() / n as f64;
-    let var = (n as f64 - 1.0) / n as f64 * leave.iter().map(|v| (v - m) * (v - m)).sum::<f64>();
-    (b, var.sqrt(), wc)
+    let err = super::jackknife(ratio.len(), |seeds| {
+        let b = fit(seeds).0;
+        b.is_finite().then_some(b)
+    });
+    (b, err, wc)
 }
 
 /// The verdict on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se` and the onsets: holds within 2

@@ -90,33 +90,15 @@ pub(crate) fn crossing(d: &[f64], order: &[f64]) -> Option<f64> {
 /// The critical noise from per-seed orders `order[seed][k]`, and its jackknife error (NaN
 /// with fewer than three seeds or where a jackknife sample has no crossing).
 pub(crate) fn critical_noise(d: &[f64], order: &[Vec<f64>]) -> (Option<f64>, f64) {
-    let mean_of = |seeds: &[usize]| -> Vec<f64> {
-        (0..d.len())
-            .map(|k| seeds.iter().map(|&s| order[s][k]).sum::<f64>() / seeds.len() as f64)
-            .collect()
-    };
     let all: Vec<usize> = (0..order.len()).collect();
-    let dc = crossing(d, &mean_of(&all));
-    let n = order.len();
-    let Some(dc) = dc else {
+    let Some(dc) = crossing(d, &super::seed_mean(order, &all)) else {
         return (None, f64::NAN);
     };
-    if n < 3 {
-        return (Some(dc), f64::NAN);
-    }
-    let leave: Option<Vec<f64>> = (0..n)
-        .map(|out| {
-            let keep: Vec<usize> = all.iter().copied().filter(|&s| s != out).collect();
-            crossing(d, &mean_of(&keep)).map(f64::ln)
-        })
-        .collect();
-    let Some(leave) = leave else {
-        return (Some(dc), f64::NAN);
-    };
-    let m = leave.iter().sum::<f64>() / n as f64;
-    let var = (n as f64 - 1.0) / n as f64 * leave.iter().map(|v| (v - m) * (v - m)).sum::<f64>();
     // The error of ln D_c, carried to D_c.
-    (Some(dc), dc * var.sqrt())
+    let err = super::jackknife(order.len(), |seeds| {
+        crossing(d, &super::seed_mean(order, seeds)).map(f64::ln)
+    });
+    (Some(dc), dc * err)
 }
 
 /// The verdict on "the cells flock below a critical noise and lose order above it", from the

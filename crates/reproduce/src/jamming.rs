@@ -101,9 +101,7 @@ pub(crate) fn phase((m, se): (f64, f64)) -> Phase {
 pub(crate) fn critical_alpha(alphas: &[f64], ln_msd: &[Vec<f64>]) -> (Option<f64>, f64) {
     let cage = (RADIUS * RADIUS).ln();
     let crossing = |seeds: &[usize]| -> Option<f64> {
-        let m: Vec<f64> = (0..alphas.len())
-            .map(|k| seeds.iter().map(|&s| ln_msd[s][k]).sum::<f64>() / seeds.len() as f64)
-            .collect();
+        let m = super::seed_mean(ln_msd, seeds);
         let k = m.iter().position(|&v| v > cage)?;
         if k == 0 {
             return None;
@@ -115,22 +113,9 @@ pub(crate) fn critical_alpha(alphas: &[f64], ln_msd: &[Vec<f64>]) -> (Option<f64
     let Some(ac) = crossing(&all) else {
         return (None, f64::NAN);
     };
-    let n = all.len();
-    if n < 3 {
-        return (Some(ac), f64::NAN);
-    }
-    let leave: Option<Vec<f64>> = (0..n)
-        .map(|out| {
-            let keep: Vec<usize> = all.iter().copied().filter(|&s| s != out).collect();
-            crossing(&keep).map(f64::ln)
-        })
-        .collect();
-    let Some(leave) = leave else {
-        return (Some(ac), f64::NAN);
-    };
-    let m = leave.iter().sum::<f64>() / n as f64;
-    let var = (n as f64 - 1.0) / n as f64 * leave.iter().map(|v| (v - m).powi(2)).sum::<f64>();
-    (Some(ac), ac * var.sqrt())
+    // The error of ln α_c, carried to α_c.
+    let err = super::jackknife(ln_msd.len(), |seeds| crossing(seeds).map(f64::ln));
+    (Some(ac), ac * err)
 }
 
 /// "A transition line exists": holds when at every γ the lowest propulsion is solid, the

@@ -564,6 +564,32 @@ pub(crate) fn mean_se(v: &[f64]) -> (f64, f64) {
     )
 }
 
+/// The leave-one-out jackknife standard error of an estimate over `n` seeds, `estimate` making
+/// it from a subset of the seed indices `0..n`: `√((n − 1)/n Σ_i (θ₍ᵢ₎ − θ̄)²)` over the
+/// estimates `θ₍ᵢ₎` without seed `i`. NaN with fewer than three seeds, or when a subset has no
+/// estimate.
+pub(crate) fn jackknife(n: usize, estimate: impl Fn(&[usize]) -> Option<f64>) -> f64 {
+    if n < 3 {
+        return f64::NAN;
+    }
+    let leave: Option<Vec<f64>> = (0..n)
+        .map(|out| estimate(&(0..n).filter(|&s| s != out).collect::<Vec<_>>()))
+        .collect();
+    let Some(leave) = leave else {
+        return f64::NAN;
+    };
+    let m = leave.iter().sum::<f64>() / n as f64;
+    let var = (n as f64 - 1.0) / n as f64 * leave.iter().map(|v| (v - m) * (v - m)).sum::<f64>();
+    var.sqrt()
+}
+
+/// The mean over the seeds `seeds` of per-seed rows `rows[seed][k]`, at every `k`.
+pub(crate) fn seed_mean(rows: &[Vec<f64>], seeds: &[usize]) -> Vec<f64> {
+    (0..rows.first().map_or(0, Vec::len))
+        .map(|k| seeds.iter().map(|&s| rows[s][k]).sum::<f64>() / seeds.len() as f64)
+        .collect()
+}
+
 /// A short number for tables and verdicts: 3 significant digits.
 pub(crate) fn g(v: f64) -> String {
     if !v.is_finite() {
