@@ -100,8 +100,10 @@ fn drive(dir: &RunDir, opened: crate::backend::Opened, quiet: bool) -> Result<Ru
 }
 
 fn drive_in<T: Real>(dir: &RunDir, opened: crate::backend::Opened, quiet: bool) -> Result<RunInfo> {
-    let (sim, written) = dir.simulation::<T>()?;
-    let mut sim = crate::backend::attach(sim, opened)?;
+    // The backend attaches before anything is written: a refusal leaves a resumed run's
+    // directory as it was.
+    let (mut sim, written) =
+        dir.simulation_with::<T, _>(|sim| crate::backend::attach(sim, opened).map_err(anyhow_box))?;
     let scene = dir.scene();
     sim.add_output_writer(
         "progress",
@@ -131,6 +133,11 @@ fn drive_in<T: Real>(dir: &RunDir, opened: crate::backend::Opened, quiet: bool) 
         resumed_from: dir.resumed_from(),
         stopped,
     })
+}
+
+/// An `anyhow` error as a boxed standard error, with its chain of causes in the message.
+fn anyhow_box(e: anyhow::Error) -> Box<dyn std::error::Error + Send + Sync> {
+    format!("{e:#}").into()
 }
 
 /// What a run that stopped at `step` with `error` has kept in `out`, and how to go on.

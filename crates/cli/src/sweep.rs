@@ -100,7 +100,7 @@ pub fn sweep(a: &SweepArgs<'_>) -> Result<SweepOutcome> {
             anyhow::bail!(
                 "sweep point {}: [integrator] backend = \"gpu\": a local sweep runs its points on the CPU, several at a time; \
                  run GPU points one at a time with `monolayer run SCENE --set integrator.backend=gpu`, \
-                 or write them as a SLURM job array (`--slurm`), whose tasks each run `monolayer run`",
+                 or write them as a SLURM job array (`--backend slurm`), whose tasks each run `monolayer run`",
                 p.name
             );
         }

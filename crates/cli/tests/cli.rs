@@ -404,6 +404,74 @@ fn a_diverging_run_stops_with_the_step_and_the_cell_and_keeps_its_output() {
     assert!(dir.path().join("out/frames/frame_00000000.npz").exists());
 }
 
+/// Issue 53: a blow-up in the last step of a run is an error, not a complete run. The run
+/// above is run once to find the step that blows up, then again to end exactly on it: on
+/// today's main that second run ended as complete (the check ran only at the start of the
+/// next step). It must fail naming that step, with no `complete` mark, and keep the last good
+/// state: every row finite, and the final frame and checkpoint from before the step.
+#[test]
+fn a_blow_up_in_the_last_step_is_an_error_and_keeps_the_last_good_state() {
+    let args = |time: &str| -> Vec<String> {
+        [
+            "model.gamma=0",
+            "model.zeta=0.01",
+            "integrator.npc=0",
+            "integrator.dt=0.5",
+            "integrator.stability_check=false",
+            "run.relax_time=0",
+            "run.output_every=50",
+            "run.series_every=1",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(std::iter::once(format!("run.time={time}")))
+        .flat_map(|s| ["--set".to_string(), s])
+        .collect()
+    };
+    let first = args("400");
+    let first: Vec<&str> = first.iter().map(String::as_str).collect();
+    let (ok, err, _dir) = run_text(GOOD, &first);
+    assert!(!ok, "the run does not blow up: {err}");
+    // (The last "at step": the first is where the run stopped, before it.)
+    let step: u64 = err
+        .rsplit("at step ")
+        .next()
+        .and_then(|r| r.split(|c: char| !c.is_ascii_digit()).next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no step in {err}"));
+    let time = format!("{}", step as f64 * 0.5);
+    let second = args(&time);
+    let second: Vec<&str> = second.iter().map(String::as_str).collect();
+    let (ok, err, dir) = run_text(GOOD, &second);
+    let out = dir.path().join("out");
+    assert!(
+        !ok,
+        "a run whose last step blows up ended as a success: {err}"
+    );
+    assert!(err.contains(&format!("at step {step} ")), "{err}");
+    assert!(!out.join(rundir::COMPLETE).exists(), "marked complete");
+    let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    let last_row: u64 = series
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap();
+    assert_eq!(last_row, step - 1, "the last row is the last good state");
+    assert!(series
+        .lines()
+        .skip(1)
+        .all(|l| !l.contains("NaN") && !l.contains("inf")));
+    let frame = rundir::last_frame(&out).unwrap();
+    assert_eq!(frame, step - 1, "the final frame is the last good state");
+    let (checkpoint, _) = rundir::checkpoint::checkpoints(&out).pop().unwrap();
+    assert_eq!(
+        checkpoint,
+        step - 1,
+        "the final checkpoint is the last good state"
+    );
+}
+
 /// Every shipped scene parses and validates; `single.toml` runs whole, and its isolated cell
 /// stays at rest (velocity at round-off, see the isolated-cell test) and grows towards its
 /// equilibrium area: 195.5 after the scene's 500 TU, 195.76 at 1000 TU (measured), below

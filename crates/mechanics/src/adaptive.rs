@@ -179,6 +179,9 @@ impl<T: Real> Tissue<T> {
                         .min(params.dt_max);
                     ctrl.err_prev = err;
                 }
+                if let Some(b) = check.phi_bound() {
+                    self.check_new_state(ws, h, b)?;
+                }
                 ctrl.accepted += 1;
                 ctrl.last_rejected = false;
                 self.iteration += 1;

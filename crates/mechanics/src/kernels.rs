@@ -199,16 +199,18 @@ pub(crate) enum Post<'a, T> {
     Nothing,
     /// The predictor into `out`: `out = φ + h k`.
     Predict { h: f64, out: &'a mut [T] },
-    /// The corrector on `old = φ_old`, in place: `old = φ_old + h/2 (k1 + k)`, then the
-    /// centre of mass of the new field into `centres` (by Fourier phase, as
-    /// [`ComTable::centre_of_mass`] computes it after a step): the loop over the cells that
-    /// the step would otherwise need for them.
+    /// The corrector over `k1`, node by node once it has been read: `k1 = φ_old + h/2 (k1 + k)`,
+    /// so that `old = φ_old` survives the step until its check; then the centre of mass of
+    /// the new field into `centres` (by Fourier phase, as [`ComTable::centre_of_mass`]
+    /// computes it after a step) and its range `[min φ, max φ]` into `ranges`: the loop over
+    /// the cells that the step would otherwise need for them.
     Correct {
         h: f64,
-        k1: &'a [T],
-        old: &'a mut [T],
+        k1: &'a mut [T],
+        old: &'a [T],
         com: &'a ComTable,
         centres: &'a mut [[f64; 2]],
+        ranges: &'a mut [[f64; 2]],
     },
 }
 
@@ -221,10 +223,11 @@ enum CellPost<'c, T> {
     },
     Correct {
         h: f64,
-        k1: &'c [T],
-        old: &'c mut [T],
+        k1: &'c mut [T],
+        old: &'c [T],
         com: &'c ComTable,
         centre: &'c mut [f64; 2],
+        range: &'c mut [f64; 2],
     },
 }
 
@@ -468,11 +471,13 @@ pub(crate) fn evaluate<T: Real>(
                 old,
                 com,
                 centre,
+                range,
             } => {
-                for ((e, r1), r2) in old.iter_mut().zip(k1).zip(out) {
-                    *e = T::from_f64(heun_corrector(e.to_f64(), h, r1.to_f64(), r2.to_f64()));
+                for ((e, o), r2) in k1.iter_mut().zip(old).zip(out) {
+                    *e = T::from_f64(heun_corrector(o.to_f64(), h, e.to_f64(), r2.to_f64()));
                 }
-                *centre = com.centre_of_mass(old, shape, xs, map.cell_y(shape, i));
+                *range = field_range(k1);
+                *centre = com.centre_of_mass(k1, shape, xs, map.cell_y(shape, i));
             }
         }
     };
@@ -503,6 +508,7 @@ pub(crate) fn evaluate<T: Real>(
             old,
             com,
             centres,
+            ranges,
         } => {
             assert_eq!(
                 old.len(),
@@ -511,17 +517,20 @@ pub(crate) fn evaluate<T: Real>(
             );
             assert_eq!(k1.len(), phi.len(), "k1 holds every cell");
             assert_eq!(centres.len(), cells.n_cells(), "a centre for every cell");
+            assert_eq!(ranges.len(), cells.n_cells(), "a range for every cell");
             cells_iter
-                .zip(old.par_chunks_mut(plen))
-                .zip(k1.par_chunks(plen).zip(centres.par_iter_mut()))
+                .zip(old.par_chunks(plen))
+                .zip(k1.par_chunks_mut(plen).zip(centres.par_iter_mut()))
+                .zip(ranges.par_iter_mut())
                 .enumerate()
-                .for_each(|(i, ((((out, cell), st), old), (k1, centre)))| {
+                .for_each(|(i, (((((out, cell), st), old), (k1, centre)), range))| {
                     let post = CellPost::Correct {
                         h,
                         k1,
                         old,
                         com,
                         centre,
+                        range,
                     };
                     body(i, out, cell, st, post)
                 });
@@ -674,4 +683,39 @@ fn fill_node_terms(terms: &[Option<&dyn NodeTerm>], scratch: &[f64], out: &mut [
 #[inline(always)]
 fn node_derivative(a: f64, b: f64, c_lap: f64, phi: f64, laplacian: f64) -> f64 {
     a * phi + b + adhesion_derivative(c_lap, 0.0, laplacian)
+}
+
+/// `[min φ, max φ]` of a field, with a non-finite value reported as the range
+/// `[−∞, +∞]`, so that a check of the range also catches NaN (the step's check after its
+/// last corrector). Eight interleaved lanes, which compile to packed min/max; exact in any
+/// order.
+pub(crate) fn field_range<T: Real>(phi: &[T]) -> [f64; 2] {
+    const L: usize = 8;
+    let mut lo = [f64::INFINITY; L];
+    let mut hi = [f64::NEG_INFINITY; L];
+    // NaN is neither below nor above anything: counted apart, as `v != v`.
+    let mut nan = [false; L];
+    let chunks = phi.chunks_exact(L);
+    let tail = chunks.remainder();
+    for c in chunks {
+        for j in 0..L {
+            let v = c[j].to_f64();
+            lo[j] = if v < lo[j] { v } else { lo[j] };
+            hi[j] = if v > hi[j] { v } else { hi[j] };
+            nan[j] |= v.is_nan();
+        }
+    }
+    for (j, v) in tail.iter().enumerate() {
+        let v = v.to_f64();
+        lo[j] = if v < lo[j] { v } else { lo[j] };
+        hi[j] = if v > hi[j] { v } else { hi[j] };
+        nan[j] |= v.is_nan();
+    }
+    if nan.iter().any(|&n| n) {
+        return [f64::NEG_INFINITY, f64::INFINITY];
+    }
+    [
+        lo.iter().copied().fold(f64::INFINITY, f64::min),
+        hi.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    ]
 }

@@ -768,10 +768,10 @@ impl<T: Real> Simulation<T> {
             b.upload(&self.tissue)?;
         }
         let mut result = self.run_loop(start, &mut stop);
-        if let Some(b) = &mut self.backend {
-            let synced = b.sync(&mut self.tissue);
+        if self.backend.is_some() {
+            let synced = self.sync_checked();
             if result.is_ok() {
-                result = synced.map_err(SimulationError::from);
+                result = synced;
             }
         }
         let fin = self.fire(start, Hook::Finalize, &mut stop);
@@ -780,6 +780,27 @@ impl<T: Real> Simulation<T> {
             iterations: self.tissue.iteration() - first,
             wall_time: start.elapsed(),
         })
+    }
+
+    /// The device's state brought back to the host and checked there (the device checks a
+    /// state at the start of each step only, so the last step of a run, and a state a writer
+    /// reads between steps, are checked here): a state that fails the check is not taken, and
+    /// the host keeps the last good state it had (the one it last brought back or uploaded).
+    fn sync_checked(&mut self) -> Result<(), SimulationError> {
+        let Some(backend) = self.backend.as_mut() else {
+            return Ok(());
+        };
+        let Some(bound) = self.check.1.phi_bound() else {
+            return backend
+                .sync(&mut self.tissue)
+                .map_err(SimulationError::from);
+        };
+        let mut fresh = self.tissue.clone();
+        let synced = backend.sync(&mut fresh);
+        // A step the device refused still brings back its last good state.
+        fresh.check_state(bound, self.step_params.dt)?;
+        self.tissue = fresh;
+        synced.map_err(SimulationError::from)
     }
 
     /// The fixes, callbacks and writers after a step on a backend: the host's copy of the
@@ -818,8 +839,9 @@ impl<T: Real> Simulation<T> {
                 Some(Needs::Clock) | None => false,
             };
         if synced {
-            backend.sync(&mut self.tissue)?;
+            self.sync_checked()?;
         }
+        let backend = self.backend.as_mut().expect("checked above");
         if fix_due {
             for (name, timer, fix) in &mut self.fixes {
                 if timer.fires(iteration, time, false) {

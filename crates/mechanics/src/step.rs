@@ -33,6 +33,14 @@ pub trait StepCheck: Send {
     /// # Errors
     /// The reason not to take the step.
     fn check(&mut self, at: CheckPoint, cells: &[CellState]) -> Result<(), StepError>;
+
+    /// The band `b` that the new state of a step must stay in, `[−b, 1 + b]`, finite, checked
+    /// after the step before it replaces the old one (so that a blow-up in a run's last step
+    /// is an error too, and the tissue keeps the last good state); `None` (the default) for
+    /// no check after the step.
+    fn phi_bound(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// Where a [`StepCheck`] is called: the clock of the state about to be stepped and the step.
@@ -96,6 +104,15 @@ impl StepCheck for StateCheck {
         }
         Ok(())
     }
+
+    fn phi_bound(&self) -> Option<f64> {
+        Some(self.bound)
+    }
+}
+
+/// Whether a field's range `[min, max]` is finite and inside `[−b, 1 + b]`.
+fn range_ok(range: [f64; 2], b: f64) -> bool {
+    range[0] >= -b && range[1] <= 1.0 + b
 }
 
 impl<T: Real> Tissue<T> {
@@ -131,14 +148,22 @@ impl<T: Real> Tissue<T> {
         // (tested to be the separate sweeps to the bit). Adhesion and walls add their
         // derivative inside the force pass too (`kernels::NodeTerms`).
         self.start_step(ws, dt, Some(dt), check)?;
+        // The check after the step (issue 53): the new state is finite and inside the band,
+        // before it replaces the old one, so that a step that blows up (the last of a run
+        // included) leaves the last good state and says so.
+        let bound = check.phi_bound();
         for pass in 0..step_params.npc {
-            let done = if pass + 1 < step_params.npc {
-                self.correct::<false>(ws, dt).map(|_| ())
+            if pass + 1 < step_params.npc {
+                if let Err(slot) = self.correct::<false>(ws, dt) {
+                    return Err(self.abandon_step(ws, slot));
+                }
             } else {
-                self.correct_last(ws, dt)
-            };
-            if let Err(slot) = done {
-                return Err(self.abandon_step(ws, slot));
+                self.correct_last(ws, dt, bound)?;
+            }
+        }
+        if step_params.npc == 0 {
+            if let Some(b) = bound {
+                self.check_new_state(ws, dt, b)?;
             }
         }
         self.iteration += 1;
@@ -268,16 +293,23 @@ impl<T: Real> Tissue<T> {
     }
 
     /// The last corrector pass of a fixed step of size `h`: `k2 = R(φ)` of the predicted
-    /// fields, with `φ_old + h/2 (k1 + k2)` written over `ws.phi_old` cell by cell right after
-    /// each cell's `k2`, and its centre of mass into `ws.next_centre`, then swapped in: the
-    /// fields hold the new state and `ws.phi_old` the predicted one. (The adaptive step, which
-    /// may have to go back to `φ_old`, and the earlier passes of several use
-    /// [`Tissue::correct`].)
+    /// fields, with `φ_old + h/2 (k1 + k2)` written over `ws.k1` cell by cell right after
+    /// each cell's `k2`, its centre of mass into `ws.next_centre` and its range into
+    /// `ws.next_range`; then, when the new state passes the check after the step (`bound`:
+    /// see [`StepCheck::phi_bound`]), swapped in: the fields hold the new state, `ws.phi_old`
+    /// the old one and `ws.k1` the predicted one. (The adaptive step, which may have to go
+    /// back to `φ_old`, and the earlier passes of several use [`Tissue::correct`].)
     ///
     /// # Errors
-    /// The slot of a whole-cell force that is not finite, with nothing overwritten (see
-    /// [`Tissue::abandon_step`]).
-    pub(crate) fn correct_last(&mut self, ws: &mut Workspace<T>, h: f64) -> Result<(), usize> {
+    /// A whole-cell force that is not finite, with nothing overwritten (see
+    /// [`Tissue::abandon_step`]), or a new state that fails the check: the tissue is then
+    /// back at the step's start, the last good state.
+    pub(crate) fn correct_last(
+        &mut self,
+        ws: &mut Workspace<T>,
+        h: f64,
+        bound: Option<f64>,
+    ) -> Result<(), StepError> {
         let Workspace {
             phi_old,
             k1,
@@ -286,10 +318,11 @@ impl<T: Real> Tissue<T> {
             cell_state,
             com,
             next_centre,
+            next_range,
             term_scratch,
             ..
         } = ws;
-        self.evaluate_fields(
+        if let Err(slot) = self.evaluate_fields(
             self.step_needs_shapes(),
             k2,
             sums,
@@ -301,15 +334,132 @@ impl<T: Real> Tissue<T> {
                 old: phi_old,
                 com,
                 centres: next_centre,
+                ranges: next_range,
             },
             h,
             Some(com),
-        )?;
-        self.cells.swap_phi(phi_old);
+        ) {
+            return Err(self.abandon_step(ws, slot));
+        }
+        if let Some(b) = bound {
+            let bad = next_range
+                .iter()
+                .zip(next_centre.iter())
+                .position(|(r, c)| !range_ok(*r, b) || !c.iter().all(|x| x.is_finite()));
+            if let Some(slot) = bad {
+                let (range, centre) = (next_range[slot], next_centre[slot]);
+                let nan = !centre.iter().all(|x| x.is_finite());
+                let err = self.after_step_error(slot, range, nan, h, b);
+                // The fields hold the predicted state and `phi_old` the step's start.
+                return Err(self.abandon_with(ws, err));
+            }
+        }
+        self.cells.swap_phi(k1);
         if !self.ext.terms.is_empty() {
             self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
         }
         Ok(())
+    }
+
+    /// The error of a new state (the step from `self.iteration` of size `h`) whose slot
+    /// `slot` has the range `range` (or a non-finite centre, `nan`), outside `[−b, 1 + b]`.
+    fn after_step_error(
+        &self,
+        slot: usize,
+        range: [f64; 2],
+        nan: bool,
+        h: f64,
+        b: f64,
+    ) -> StepError {
+        let (step, time) = (self.iteration + 1, self.time + h);
+        if nan || !range[0].is_finite() || !range[1].is_finite() {
+            StepError::NonFinite {
+                step,
+                time,
+                cell_idx: slot,
+            }
+        } else {
+            StepError::Unstable {
+                step,
+                time,
+                cell_idx: slot,
+                phi: if range[0] < -b { range[0] } else { range[1] },
+                dt: h,
+            }
+        }
+    }
+
+    /// The check after a step whose new state is in the fields (a sweep of its own: the
+    /// adaptive step and Euler's; the fixed Heun step checks inside its last corrector).
+    ///
+    /// # Errors
+    /// A slot outside `[−b, 1 + b]` or not finite; the tissue is then back at the step's
+    /// start, from `ws.phi_old`.
+    pub(crate) fn check_new_state(
+        &mut self,
+        ws: &mut Workspace<T>,
+        h: f64,
+        b: f64,
+    ) -> Result<(), StepError> {
+        match self.first_out_of_band(b) {
+            Some((slot, range)) => {
+                let err = self.after_step_error(slot, range, false, h, b);
+                Err(self.abandon_with(ws, err))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Checks the fields as they are: every value finite and inside `[−b, 1 + b]`
+    /// ([`PHI_BOUND`] by default). A backend's driver checks the state it brings back with
+    /// it, since the device's own check runs at the start of each step only.
+    ///
+    /// # Errors
+    /// [`StepError::NonFinite`] or [`StepError::Unstable`] for the first slot that is not,
+    /// at the tissue's clock.
+    pub fn check_state(&self, b: f64, dt: f64) -> Result<(), StepError> {
+        match self.first_out_of_band(b) {
+            Some((slot, range)) => {
+                let (step, time) = (self.iteration, self.time);
+                Err(if range[0].is_finite() && range[1].is_finite() {
+                    StepError::Unstable {
+                        step,
+                        time,
+                        cell_idx: slot,
+                        phi: if range[0] < -b { range[0] } else { range[1] },
+                        dt,
+                    }
+                } else {
+                    StepError::NonFinite {
+                        step,
+                        time,
+                        cell_idx: slot,
+                    }
+                })
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// The first slot whose field is not finite or leaves `[−b, 1 + b]`, with its range.
+    fn first_out_of_band(&self, b: f64) -> Option<(usize, [f64; 2])> {
+        let plen = self.cells.patch_len();
+        let phi = self.cells.phi();
+        let slot = phi
+            .par_chunks(plen)
+            .position_first(|c| !range_ok(crate::kernels::field_range(c), b))?;
+        Some((
+            slot,
+            crate::kernels::field_range(&phi[slot * plen..(slot + 1) * plen]),
+        ))
+    }
+
+    /// Back to the step's start (in `ws.phi_old`) from a predicted or corrected state that
+    /// failed its check, with `err` as the reason.
+    fn abandon_with(&mut self, ws: &mut Workspace<T>, err: StepError) -> StepError {
+        self.cells.swap_phi(&mut ws.phi_old);
+        self.ext.terms.restore();
+        err
     }
 
     /// The predictor `φ = φ_old + h k1` (forward Euler) from what [`Tissue::start_step`]
@@ -589,6 +739,107 @@ mod tests {
     fn the_fused_step_equals_the_separate_sweeps_to_the_bit() {
         fused_step_is_the_sweeps_to_the_bit::<f64>();
         fused_step_is_the_sweeps_to_the_bit::<f32>();
+    }
+
+    /// A tissue without line tension (γ = 0) at ζ = 0.02 and dt = 2, which blows up within
+    /// a few hundred steps (nothing smooths the interfaces).
+    fn blowing_up<T: Real>() -> Tissue<T> {
+        let mut t = tissue::<T>();
+        t.params_mut().energy.gamma = 0.0;
+        t
+    }
+
+    /// Issue 53: the check runs after every step, the last one included. A step whose new
+    /// state leaves the band (or is not finite) is an error, and the tissue keeps the state
+    /// before it, to the bit: the last good one. The state it refused is bad (the same step
+    /// taken without a check fails `check_state`), and every state before it passed. For
+    /// forward Euler, one and two corrector passes, and the adaptive step.
+    #[test]
+    fn a_step_that_blows_up_is_an_error_and_leaves_the_last_good_state() {
+        for npc in [0, 1, 2] {
+            let sp = StepParams::new(2.0, npc);
+            let mut t = blowing_up::<f64>();
+            let mut ws = Workspace::new(t.cells());
+            let mut failed = None;
+            for _ in 0..3000 {
+                let before = t.clone();
+                match t.step(&mut ws, &sp) {
+                    Ok(()) => t
+                        .check_state(PHI_BOUND, sp.dt)
+                        .expect("a state that passed"),
+                    Err(e) => {
+                        failed = Some((before, e));
+                        break;
+                    }
+                }
+            }
+            let (before, err) = failed.unwrap_or_else(|| panic!("npc {npc}: no blow-up"));
+            assert!(
+                matches!(
+                    err,
+                    StepError::Unstable { .. } | StepError::NonFinite { .. }
+                ),
+                "{err}"
+            );
+            assert_eq!(t.iteration(), before.iteration(), "npc {npc}: the clock");
+            assert!(
+                t.cells()
+                    .phi()
+                    .iter()
+                    .zip(before.cells().phi())
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "npc {npc}: the fields are the last good state"
+            );
+            assert_eq!(t.centres(), before.centres());
+            // The refused step, taken without a check, makes a bad state.
+            let mut unchecked = before.clone();
+            let mut ws = Workspace::new(unchecked.cells());
+            unchecked
+                .step_checked(&mut ws, &sp, &mut ())
+                .expect("no check");
+            assert!(
+                unchecked.check_state(PHI_BOUND, sp.dt).is_err(),
+                "npc {npc}"
+            );
+            // Its step is the one that would have been taken.
+            let step = match err {
+                StepError::Unstable { step, .. } | StepError::NonFinite { step, .. } => step,
+                _ => unreachable!(),
+            };
+            assert_eq!(step, before.iteration() + 1, "npc {npc}: {err}");
+        }
+    }
+
+    /// The adaptive step checks its accepted state too.
+    #[test]
+    fn an_adaptive_step_that_blows_up_leaves_the_last_good_state() {
+        // A tolerance so loose that every step is accepted: the check must catch the blow-up.
+        let params = crate::AdaptiveParams::new(1e9, 2.0);
+        let mut ctrl = crate::Controller::new(2.0);
+        let mut t = blowing_up::<f64>();
+        let mut ws = Workspace::new(t.cells());
+        for _ in 0..3000 {
+            let before = t.clone();
+            match t.step_adaptive(
+                &mut ws,
+                &params,
+                &mut ctrl,
+                f64::INFINITY,
+                &mut StateCheck::default(),
+            ) {
+                Ok(_) => t.check_state(PHI_BOUND, 2.0).expect("a state that passed"),
+                Err(e) => {
+                    assert!(
+                        matches!(e, StepError::Unstable { .. } | StepError::NonFinite { .. }),
+                        "{e}"
+                    );
+                    assert_eq!(t.iteration(), before.iteration());
+                    assert_eq!(t.cells().phi(), before.cells().phi());
+                    return;
+                }
+            }
+        }
+        panic!("no blow-up");
     }
 
     /// Patches are stored in logical order since issue 14, but a checkpoint written before

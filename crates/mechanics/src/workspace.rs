@@ -89,6 +89,8 @@ pub struct Workspace<T: Real = f64> {
     pub(crate) observed_centre: Vec<[f64; 2]>,
     /// The centres of mass of the state a fixed step ends in, computed in its corrector pass.
     pub(crate) next_centre: Vec<[f64; 2]>,
+    /// The range `[min φ, max φ]` of each cell of that state, for the check after the step.
+    pub(crate) next_range: Vec<[f64; 2]>,
     pub(crate) com: ComTable,
     /// The buffers of the physics terms in an evaluation.
     pub(crate) term_scratch: TermScratch,
@@ -128,7 +130,9 @@ impl<T: Real> Workspace<T> {
             + self.sums.heap_bytes()
             + self.cell_state.capacity() * std::mem::size_of::<CellState>()
             + self.velocity_field.heap_bytes()
-            + (self.observed_centre.capacity() + self.next_centre.capacity())
+            + (self.observed_centre.capacity()
+                + self.next_centre.capacity()
+                + self.next_range.capacity())
                 * std::mem::size_of::<[f64; 2]>()
             + self.term_scratch.heap_bytes()
             + self.com.heap_bytes()
@@ -149,6 +153,7 @@ impl<T: Real> Workspace<T> {
             velocity_field: LatticeSums::for_cells(lattice, cells.n_cells(), cells.shape().nx),
             observed_centre: vec![[0.0; 2]; cells.n_cells()],
             next_centre: vec![[0.0; 2]; cells.n_cells()],
+            next_range: vec![[0.0; 2]; cells.n_cells()],
             com: ComTable::new(lattice),
             term_scratch: TermScratch {
                 cell_force: vec![[0.0; 2]; cells.n_cells()],
@@ -173,6 +178,7 @@ impl<T: Real> Workspace<T> {
         for v in [
             &mut self.observed_centre,
             &mut self.next_centre,
+            &mut self.next_range,
             &mut self.term_scratch.cell_force,
         ] {
             v.resize(n, [0.0; 2]);

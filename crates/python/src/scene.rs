@@ -49,7 +49,25 @@ impl PyScene {
     }
 }
 
-/// A Python value as a TOML value: bool, int, float, str, and lists and dicts of them.
+/// The kind of a NumPy scalar or 0-d array (`'b'`, `'i'`, `'u'`, `'f'`, ...), read from its
+/// `dtype` without importing NumPy; `None` for anything else.
+pub(crate) fn numpy_kind(v: &Bound<'_, PyAny>) -> Option<char> {
+    let ndim: usize = v.getattr("ndim").ok()?.extract().ok()?;
+    if ndim != 0 {
+        return None;
+    }
+    let kind: String = v
+        .getattr("dtype")
+        .ok()?
+        .getattr("kind")
+        .ok()?
+        .extract()
+        .ok()?;
+    kind.chars().next()
+}
+
+/// A Python value as a TOML value: bool, int, float, str, and lists and dicts of them, with
+/// NumPy's scalars as the Python types they stand for.
 fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
     if v.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(v.extract()?));
@@ -85,7 +103,23 @@ fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
         }
         return Ok(toml::Value::Array(out));
     }
-    // NumPy scalars and other numbers.
+    // NumPy scalars (and 0-d arrays) by their dtype's kind, so that `np.int64(60)` is an
+    // integer and `np.bool_(True)` a bool where the scene takes one, as their Python types.
+    if let Some(kind) = numpy_kind(v) {
+        return match kind {
+            'b' => Ok(toml::Value::Boolean(v.call_method0("__bool__")?.extract()?)),
+            'i' | 'u' => Ok(toml::Value::Integer(
+                v.call_method0("__index__")?.extract().map_err(|_| {
+                    PyValueError::new_err(format!(
+                        "{key}: {} does not fit a 64-bit integer",
+                        v.str().map(|s| s.to_string()).unwrap_or_default()
+                    ))
+                })?,
+            )),
+            _ => Ok(toml::Value::Float(v.extract()?)),
+        };
+    }
+    // Other numbers (`fractions.Fraction`, `decimal.Decimal`).
     if let Ok(f) = v.extract::<f64>() {
         return Ok(toml::Value::Float(f));
     }
@@ -221,14 +255,14 @@ pub fn sweep_points(
             let v = to_toml(&v?, &key)?;
             texts.push(match v {
                 toml::Value::String(s) => s,
+                // As the command line's `--vary model.zeta=0,0.005` names its points: the
+                // shortest decimal (`0`, not `0.0`), so that both front ends name a point
+                // alike.
+                toml::Value::Float(f) => format!("{f}"),
                 other => other.to_string(),
             });
         }
-        varies.push(
-            format!("{key}={}", texts.join(","))
-                .parse::<study::Vary>()
-                .map_err(bad)?,
-        );
+        varies.push(study::Vary::new(&key, texts).map_err(bad)?);
     }
     let seeds = match seeds {
         Some((a, b)) => Some(format!("{a}-{b}").parse::<study::Seeds>().map_err(bad)?),

@@ -2,8 +2,8 @@
 //! directories (`run`, `resume`) and pictures (`render`) of the command line.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
 
 use mechanics::Precision;
 use mechanics::{CallbackError, Observation, Schedule, Simulation, Tissue};
@@ -108,6 +108,54 @@ fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start the threads: {e}")))
 }
 
+/// The most steps one call takes (2**62: about 10¹⁸, far beyond any run).
+const STEP_MAX: u64 = 1 << 62;
+
+/// A whole number from a Python int or a NumPy integer (anything with `__index__`), in
+/// `0..=max`, for the argument `arg` of `call`: a `ValueError` that names both and the range
+/// otherwise, and a `TypeError` for what is not a whole number.
+pub(crate) fn whole(call: &str, arg: &str, v: &Bound<'_, PyAny>, max: u64) -> PyResult<u64> {
+    let index = v.call_method0("__index__").map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "{call}: {arg} = {}: give a whole number (an int), not a {}",
+            v.repr().map(|r| r.to_string()).unwrap_or_default(),
+            v.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })?;
+    let out_of_range = || {
+        PyValueError::new_err(format!(
+            "{call}: {arg} = {}: give a whole number from 0 to {max}",
+            index.str().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    };
+    let n: i128 = index.extract().map_err(|_| out_of_range())?;
+    if n < 0 || n > i128::from(max) {
+        return Err(out_of_range());
+    }
+    Ok(n as u64)
+}
+
+/// [`whole`] of an optional argument.
+pub(crate) fn opt_whole(
+    call: &str,
+    arg: &str,
+    v: Option<&Bound<'_, PyAny>>,
+    max: u64,
+) -> PyResult<Option<u64>> {
+    v.filter(|v| !v.is_none())
+        .map(|v| whole(call, arg, v, max))
+        .transpose()
+}
+
+/// The most threads a pool is asked for.
+const THREADS_MAX: u64 = 4096;
+
+/// What a call into a simulation that is stepping gets.
+const BUSY: &str = "this Simulation is stepping (its step or run_until is running, in this thread or another), and cannot be read or changed until that returns: a force gets the cells as its argument `cells`, a callback its observation `obs.cells`, and a fix its edit `e` (use those instead of the simulation's own methods); threads that share one simulation must take turns (hold a threading.Lock around each call)";
+
 /// A step error as Python sees it: `RuntimeError` with the message of the command line.
 fn run_error(e: impl std::fmt::Display) -> PyErr {
     PyRuntimeError::new_err(e.to_string())
@@ -121,24 +169,30 @@ pub struct PySimulation {
     scene: PyScene,
     errors: ErrorSlot,
     progress: ProgressSlot,
-    forces: usize,
+    forces: AtomicUsize,
 }
 
 impl PySimulation {
-    fn inner(&mut self) -> &mut Inner {
-        self.inner.get_mut().unwrap_or_else(|p| p.into_inner())
+    /// The simulation, unless it is stepping: a force, callback or fix of this simulation
+    /// that calls one of its methods, or a second thread, gets an error that says why.
+    fn inner(&self) -> PyResult<MutexGuard<'_, Inner>> {
+        match self.inner.try_lock() {
+            Ok(g) => Ok(g),
+            Err(TryLockError::Poisoned(p)) => Ok(p.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(PyRuntimeError::new_err(BUSY)),
+        }
     }
 
     /// Runs to the stop criteria `(iteration, time)` with the lock released, then raises
     /// what stopped it early: Ctrl-C, an error of Python code, a step error.
     fn run_to(
-        &mut self,
+        &self,
         py: Python<'_>,
         stop: (Option<u64>, Option<f64>),
         progress: Option<Py<PyAny>>,
     ) -> PyResult<()> {
         let end = stop.1.unwrap_or(f64::INFINITY);
-        let now = self.time();
+        let now = self.time()?;
         *self.progress.lock().unwrap_or_else(|p| p.into_inner()) = Some(Progress {
             func: progress,
             next: now,
@@ -149,8 +203,9 @@ impl PySimulation {
             },
         });
         let _armed = interrupt::Armed::new(py);
-        let Self { inner, pool, .. } = self;
-        let inner = inner.get_mut().unwrap_or_else(|p| p.into_inner());
+        let mut guard = self.inner()?;
+        let inner: &mut Inner = &mut guard;
+        let pool = &self.pool;
         let result = py.detach(|| {
             pool.install(|| {
                 with_sim!(inner, s => {
@@ -159,6 +214,7 @@ impl PySimulation {
                 })
             })
         });
+        drop(guard);
         self.progress
             .lock()
             .unwrap_or_else(|p| p.into_inner())
@@ -167,7 +223,7 @@ impl PySimulation {
             return Err(e);
         }
         if interrupt::caught() {
-            let (it, t) = (self.iteration(), self.time());
+            let (it, t) = (self.iteration()?, self.time()?);
             return interrupt::deliver(
                 py,
                 format!("stopped after step {it} (t = {t}); the simulation can go on"),
@@ -296,8 +352,67 @@ fn names(states: &[(String, Vec<f64>)]) -> String {
     }
 }
 
-/// Calls `func(edit)` on the state of `tissue`, then applies what it asked.
-fn apply_edit<T: Real>(py: Python<'_>, func: &Py<PyAny>, tissue: &mut Tissue<T>) -> PyResult<()> {
+/// The scene a simulation was built from, to validate an edit's parameters as the scene's
+/// own keys are validated (`set_param("xi", -1)` is refused as `model.xi = -1` would be).
+#[derive(Clone)]
+struct ParamCheck {
+    text: String,
+    set: Vec<String>,
+}
+
+impl ParamCheck {
+    fn new(scene: &PyScene) -> Self {
+        let set = match &scene.path {
+            Some(p) => ::scene::absolute_paths(p, &scene.text, &scene.set)
+                .unwrap_or_else(|_| scene.set.clone()),
+            None => scene.set.clone(),
+        };
+        Self {
+            text: scene.text.clone(),
+            set,
+        }
+    }
+
+    /// The scene key of an edit's parameter.
+    fn key(name: &str) -> String {
+        match name {
+            "omega" => "adhesion.omega".into(),
+            other => format!("model.{other}"),
+        }
+    }
+
+    /// Validates the changes `asked` together, as `--set` overrides of the scene.
+    fn check(&self, asked: &[(String, f64)]) -> PyResult<()> {
+        let mut set = self.set.clone();
+        set.extend(asked.iter().map(|(n, v)| format!("{}={v:?}", Self::key(n))));
+        ::scene::Scene::parse(&self.text, &set)
+            .map(|_| ())
+            .map_err(|e| {
+                let what: Vec<String> = asked
+                    .iter()
+                    .map(|(n, v)| format!("set_param({n:?}, {v})"))
+                    .collect();
+                PyValueError::new_err(format!(
+                    "{}: the scene refuses it as {}: {e}",
+                    what.join(", "),
+                    asked
+                        .iter()
+                        .map(|(n, _)| Self::key(n))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })
+    }
+}
+
+/// Calls `func(edit)` on the state of `tissue`, then applies what it asked, once `check`
+/// has validated its parameters (nothing is applied otherwise).
+fn apply_edit<T: Real>(
+    py: Python<'_>,
+    func: &Py<PyAny>,
+    tissue: &mut Tissue<T>,
+    check: &ParamCheck,
+) -> PyResult<()> {
     let mut ids: Vec<usize> = tissue.cell_ids().to_vec();
     ids.sort_unstable();
     let states = tissue
@@ -318,6 +433,16 @@ fn apply_edit<T: Real>(py: Python<'_>, func: &Py<PyAny>, tissue: &mut Tissue<T>)
     )?;
     func.bind(py).call1((edit.clone(),))?;
     let asked = std::mem::take(&mut edit.borrow_mut().asked);
+    let params: Vec<(String, f64)> = asked
+        .iter()
+        .filter_map(|c| match c {
+            Change::Param(n, v) => Some((n.clone(), *v)),
+            Change::State(..) => None,
+        })
+        .collect();
+    if !params.is_empty() {
+        check.check(&params)?;
+    }
     for change in asked {
         match change {
             Change::Param(name, v) => {
@@ -346,7 +471,8 @@ fn apply_edit<T: Real>(py: Python<'_>, func: &Py<PyAny>, tissue: &mut Tissue<T>)
 impl PySimulation {
     #[new]
     #[pyo3(signature = (scene, threads=None, backend="cpu"))]
-    fn new(scene: PyScene, threads: Option<usize>, backend: &str) -> PyResult<Self> {
+    fn new(scene: PyScene, threads: Option<&Bound<'_, PyAny>>, backend: &str) -> PyResult<Self> {
+        let threads = opt_whole("Simulation", "threads", threads, THREADS_MAX)?.map(|t| t as usize);
         match backend {
             "cpu" => {}
             "gpu" => {
@@ -362,6 +488,11 @@ impl PySimulation {
         }
         let pool = pool(threads)?;
         let s = &scene.scene;
+        if s.backend() != scene::ComputeBackend::Cpu {
+            return Err(PyValueError::new_err(
+                "[integrator] backend = \"gpu\": the Python package is built without the GPU backend, and a Simulation does not move a GPU scene to the CPU without a word; set it to \"cpu\" (scene.set(\"integrator.backend\", \"cpu\")), or run the scene with the command line",
+            ));
+        }
         let build = |e: rundir::StateError| scene_error(None, e);
         let inner = match s.precision() {
             Precision::F64 => {
@@ -373,15 +504,15 @@ impl PySimulation {
         };
         let errors: ErrorSlot = Arc::default();
         let progress: ProgressSlot = Arc::default();
-        let mut sim = Self {
+        let sim = Self {
             inner: Mutex::new(inner),
             pool,
             scene,
             errors: errors.clone(),
             progress: progress.clone(),
-            forces: 0,
+            forces: AtomicUsize::new(0),
         };
-        with_sim!(sim.inner(), s => s.add_callback(
+        with_sim!(&mut *sim.inner()?, s => s.add_callback(
             "python",
             Schedule::IterationInterval(1),
             watcher(errors.clone(), progress.clone(), None),
@@ -397,25 +528,26 @@ impl PySimulation {
 
     /// The model time.
     #[getter]
-    fn time(&mut self) -> f64 {
-        with_sim!(self.inner(), s => s.tissue().time())
+    fn time(&self) -> PyResult<f64> {
+        Ok(with_sim!(&mut *self.inner()?, s => s.tissue().time()))
     }
 
     /// Steps taken.
     #[getter]
-    fn iteration(&mut self) -> u64 {
-        with_sim!(self.inner(), s => s.tissue().iteration())
+    fn iteration(&self) -> PyResult<u64> {
+        Ok(with_sim!(&mut *self.inner()?, s => s.tissue().iteration()))
     }
 
     /// The number of cells.
     #[getter]
-    fn n_cells(&mut self) -> usize {
-        with_sim!(self.inner(), s => s.tissue().n_cells())
+    fn n_cells(&self) -> PyResult<usize> {
+        Ok(with_sim!(&mut *self.inner()?, s => s.tissue().n_cells()))
     }
 
     /// Takes `n` steps (the interpreter's lock released).
-    fn step(&mut self, py: Python<'_>, n: u64) -> PyResult<()> {
-        let it = self.iteration();
+    fn step(&self, py: Python<'_>, n: &Bound<'_, PyAny>) -> PyResult<()> {
+        let it = self.iteration()?;
+        let n = whole("step(n)", "n", n, STEP_MAX - it.min(STEP_MAX))?;
         self.run_to(py, (Some(it + n), None), None)
     }
 
@@ -423,7 +555,7 @@ impl PySimulation {
     /// about 200 times on the way.
     #[pyo3(signature = (until=None, progress=None))]
     fn run_until(
-        &mut self,
+        &self,
         py: Python<'_>,
         until: Option<f64>,
         progress: Option<Py<PyAny>>,
@@ -441,15 +573,30 @@ impl PySimulation {
         if adaptive {
             return self.run_to(py, (None, Some(until)), progress);
         }
-        let now = self.time();
-        let ahead = ((until - now) / dt).round().max(0.0) as u64;
-        let stop = self.iteration() + ahead;
+        let now = self.time()?;
+        // The first step at or after `until` (a clock within 1e-9 steps of it lands on it);
+        // where that is not `until`, a warning says where the run stopped and why.
+        let ahead = ((until - now) / dt - 1e-9).ceil().max(0.0);
+        if ahead >= STEP_MAX as f64 {
+            return Err(PyValueError::new_err(format!(
+                "run_until(until={until}): {ahead:.3e} steps of dt = {dt} from t = {now}; give a time fewer than 2**62 steps ahead"
+            )));
+        }
+        let ahead = ahead as u64;
+        let stop = self.iteration()? + ahead;
+        let lands = now + ahead as f64 * dt;
+        if until > now && (lands - until).abs() > 1e-9 * dt.max(until.abs()) {
+            let msg = format!(
+                "run_until(until={until}) stops at t = {lands} (step {stop}), the first step at or after it: the time step is fixed at dt = {dt}; give a multiple of dt, or set integrator.adaptive = true to land on any time"
+            );
+            py.import("warnings")?.call_method1("warn", (msg,))?;
+        }
         self.run_to(py, (Some(stop), Some(until.max(now) + 0.5 * dt)), progress)
     }
 
     /// The cells' columns (a dict of 1-D NumPy arrays, copies).
-    fn cells<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        with_sim!(self.inner(), s => {
+    fn cells<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        with_sim!(&mut *self.inner()?, s => {
             let (t, ws, _) = s.observe();
             cells_dict(py, t, ws)
         })
@@ -457,15 +604,15 @@ impl PySimulation {
 
     /// Every cell's field on its patch: `(phi, origin, id)`, copies.
     fn phi<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        with_sim!(self.inner(), s => phi_arrays(py, s.tissue()))
+        with_sim!(&mut *self.inner()?, s => phi_arrays(py, s.tissue()))
     }
 
     /// The lattice fields (a dict of NumPy arrays, copies).
-    fn fields<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let (l, f, phi_sum) = with_sim!(self.inner(), s => {
+    fn fields<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let (l, f, phi_sum) = with_sim!(&mut *self.inner()?, s => {
             let (f, phi_sum) = s.fields();
             (s.tissue().lattice(), f, phi_sum)
         });
@@ -473,8 +620,8 @@ impl PySimulation {
     }
 
     /// The observables of the paper's series (a dict of floats).
-    fn observables<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let o = with_sim!(self.inner(), s => s.observe().2);
+    fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let o = with_sim!(&mut *self.inner()?, s => s.observe().2);
         let d = PyDict::new(py);
         for (k, v) in [
             ("v_rms", o.v_rms),
@@ -495,11 +642,12 @@ impl PySimulation {
     /// default; `every` in model time, or `steps`).
     #[pyo3(signature = (func, every=None, steps=None))]
     fn add_callback(
-        &mut self,
+        &self,
         func: Py<PyAny>,
         every: Option<f64>,
-        steps: Option<u64>,
+        steps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
+        let steps = opt_whole("add_callback", "steps", steps, STEP_MAX)?;
         let schedule = schedule(every, steps)?;
         let errors = self.errors.clone();
         macro_rules! callback {
@@ -537,7 +685,7 @@ impl PySimulation {
                 )
             }};
         }
-        match self.inner() {
+        match &mut *self.inner()? {
             Inner::F64(s) => callback!(s, f64),
             Inner::F32(s) => callback!(s, f32),
         }
@@ -548,10 +696,10 @@ impl PySimulation {
     /// (both stages of each step) with the cells' columns `id`, `population`, `x`, `y`,
     /// `vx`, `vy`, `area`.
     #[pyo3(signature = (func, name=None))]
-    fn add_force(&mut self, func: Py<PyAny>, name: Option<String>) -> PyResult<()> {
-        self.forces += 1;
-        let name = name.unwrap_or_else(|| format!("python_force_{}", self.forces));
-        let taken = with_sim!(self.inner(), s => s.tissue().terms().get(&name).is_some());
+    fn add_force(&self, func: Py<PyAny>, name: Option<String>) -> PyResult<()> {
+        let k = self.forces.fetch_add(1, Ordering::SeqCst) + 1;
+        let name = name.unwrap_or_else(|| format!("python_force_{k}"));
+        let taken = with_sim!(&mut *self.inner()?, s => s.tissue().terms().get(&name).is_some());
         if taken {
             return Err(PyValueError::new_err(format!(
                 "a force or term named {name:?} is there already; give another name"
@@ -562,29 +710,37 @@ impl PySimulation {
             func,
             error: self.errors.clone(),
         });
-        with_sim!(self.inner(), s => s.tissue_mut().terms_mut().add(term));
+        with_sim!(&mut *self.inner()?, s => s.tissue_mut().terms_mut().add(term));
         Ok(())
     }
 
     /// Changes the state now: `func(edit)` (a [`PyEdit`]) asks for changes, applied when it
     /// returns, as a fix would between two steps.
-    fn edit(&mut self, py: Python<'_>, func: Py<PyAny>) -> PyResult<()> {
-        with_sim!(self.inner(), s => apply_edit(py, &func, s.tissue_mut()))
+    fn edit(&self, py: Python<'_>, func: Py<PyAny>) -> PyResult<()> {
+        let check = ParamCheck::new(&self.scene);
+        with_sim!(&mut *self.inner()?, s => apply_edit(py, &func, s.tissue_mut(), &check))
     }
 
     /// Calls `func(edit)` after every step at which the schedule fires (every step by
     /// default), before the callbacks: a fix.
     #[pyo3(signature = (func, every=None, steps=None))]
-    fn add_fix(&mut self, func: Py<PyAny>, every: Option<f64>, steps: Option<u64>) -> PyResult<()> {
+    fn add_fix(
+        &self,
+        func: Py<PyAny>,
+        every: Option<f64>,
+        steps: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let steps = opt_whole("add_fix", "steps", steps, STEP_MAX)?;
         let schedule = schedule(every, steps)?;
         let errors = self.errors.clone();
+        let check = ParamCheck::new(&self.scene);
         macro_rules! fix {
             ($s:ident, $T:ty) => {{
                 $s.add_fix(
                     "python fix",
                     schedule,
                     move |t: &mut Tissue<$T>| -> Result<(), CallbackError> {
-                        if let Err(e) = Python::attach(|py| apply_edit(py, &func, t)) {
+                        if let Err(e) = Python::attach(|py| apply_edit(py, &func, t, &check)) {
                             keep(&errors, e);
                         }
                         Ok(())
@@ -592,7 +748,7 @@ impl PySimulation {
                 )
             }};
         }
-        match self.inner() {
+        match &mut *self.inner()? {
             Inner::F64(s) => fix!(s, f64),
             Inner::F32(s) => fix!(s, f32),
         }
@@ -602,7 +758,7 @@ impl PySimulation {
     /// The state as a run directory's frame, drawn by the command line's renderer: PNG bytes.
     #[pyo3(signature = (colour="none", **options))]
     fn render<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         colour: &str,
         options: Option<&Bound<'py, PyDict>>,
@@ -611,7 +767,7 @@ impl PySimulation {
         let dir = tmp.path();
         std::fs::write(dir.join("scene.toml"), self.scene.scene.to_toml())
             .map_err(|e| PyOSError::new_err(e.to_string()))?;
-        let step = with_sim!(self.inner(), s => {
+        let step = with_sim!(&mut *self.inner()?, s => {
             let (t, ws, _) = s.observe();
             rundir::write_frame(dir, t, ws).map_err(|e| PyOSError::new_err(e.to_string()))?;
             if let Some(clock) = t.extensions().proliferation() {
@@ -623,9 +779,9 @@ impl PySimulation {
         Ok(PyBytes::new(py, &pngs.remove(0).1))
     }
 
-    fn __repr__(&mut self) -> String {
-        let (n, t) = with_sim!(self.inner(), s => (s.tissue().n_cells(), s.tissue().time()));
-        format!("Simulation({n} cells at t = {t})")
+    fn __repr__(&self) -> PyResult<String> {
+        let (n, t) = with_sim!(&mut *self.inner()?, s => (s.tissue().n_cells(), s.tissue().time()));
+        Ok(format!("Simulation({n} cells at t = {t})"))
     }
 }
 
@@ -782,9 +938,10 @@ pub fn run_dir(
     scene: &PyScene,
     out: PathBuf,
     overwrite: bool,
-    threads: Option<usize>,
+    threads: Option<&Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Py<PyDict>, Vec<String>)> {
+    let threads = opt_whole("monolayer.run", "threads", threads, THREADS_MAX)?.map(|t| t as usize);
     let s = &scene.scene;
     if s.backend() != scene::ComputeBackend::Cpu {
         return Err(PyValueError::new_err(
@@ -814,9 +971,11 @@ pub fn resume_dir(
     py: Python<'_>,
     dir: PathBuf,
     time: Option<f64>,
-    threads: Option<usize>,
+    threads: Option<&Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Py<PyDict>> {
+    let threads =
+        opt_whole("monolayer.resume", "threads", threads, THREADS_MAX)?.map(|t| t as usize);
     let set: Vec<String> = time
         .map(|t| format!("run.time={t:?}"))
         .into_iter()
@@ -824,5 +983,12 @@ pub fn resume_dir(
     let interrupt = Interrupt::never();
     let run = RunDir::resume(&dir, &set, interrupt.clone())
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    // (Nothing in the directory has changed yet: it does once the run starts.)
+    if run.scene().backend() != scene::ComputeBackend::Cpu {
+        return Err(PyValueError::new_err(format!(
+            "{}: its scene runs on the GPU ([integrator] backend = \"gpu\"), and the Python package is built without the GPU backend; resume it with the command line (monolayer run --resume {0}), or on the CPU with monolayer run --resume {0} --set integrator.backend=cpu",
+            dir.display()
+        )));
+    }
     drive_any(py, &run, threads, progress, interrupt)
 }

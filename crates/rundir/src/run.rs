@@ -110,6 +110,10 @@ pub enum RunError {
     /// The run stopped with an error (the tissue keeps the last good state).
     #[error(transparent)]
     Simulation(#[from] SimulationError),
+    /// What [`RunDir::simulation_with`] was asked to do to the simulation before anything is
+    /// written refused (a backend that cannot start, say).
+    #[error("{0}")]
+    Prepare(Box<dyn std::error::Error + Send + Sync>),
 }
 
 type Result<T> = std::result::Result<T, RunError>;
@@ -335,14 +339,9 @@ impl RunDir {
                     time: scene.file().run.time,
                 });
             }
-            crate::write_scene(dir, &scene)?;
-            // Its analysis described the run before; the frames from the checkpoint on are
-            // written again.
-            let analysis = dir.join("analysis");
-            if analysis.exists() {
-                std::fs::remove_dir_all(&analysis)
-                    .map_err(|e| RunDirError::io("remove", &analysis, e))?;
-            }
+            // Nothing is written yet: the scene, the analysis and the outputs from the
+            // checkpoint on change in `RunDir::simulation`, once the simulation is ready to run
+            // (a refusal before it leaves the directory as it was).
             return Ok(Self {
                 dir: dir.to_path_buf(),
                 scene,
@@ -413,8 +412,25 @@ impl RunDir {
     /// # Errors
     /// A damaged checkpoint, a state that does not fit, I/O errors.
     pub fn simulation<T: Real>(&self) -> Result<(Simulation<T>, Written)> {
+        self.simulation_with(Ok::<_, std::convert::Infallible>)
+    }
+
+    /// [`RunDir::simulation`] with `prepare` applied to the simulation before anything is
+    /// written (a backend attached, say): when it refuses, a resumed run's directory is left
+    /// as it was, byte for byte (its lock file aside).
+    ///
+    /// # Errors
+    /// As [`RunDir::simulation`], and `prepare`'s error as [`RunError::Prepare`].
+    pub fn simulation_with<T: Real, E>(
+        &self,
+        prepare: impl FnOnce(Simulation<T>) -> std::result::Result<Simulation<T>, E>,
+    ) -> Result<(Simulation<T>, Written)>
+    where
+        E: Into<Box<dyn std::error::Error + Send + Sync>>,
+    {
         let scene = &self.scene;
         let schedules = scene.output_schedules();
+        let prepared = |sim| prepare(sim).map_err(|e| RunError::Prepare(e.into()));
         let (mut sim, written) = match &self.start {
             Start::Checkpoint { path, .. } => {
                 let tissue = checkpoint::read_checkpoint::<T>(path, scene)?;
@@ -422,6 +438,16 @@ impl RunDir {
                 let mut sim = scene.simulation_from(tissue);
                 if let Some(c) = checkpoint::read_controller(path)? {
                     sim.set_controller(c);
+                }
+                let mut sim = prepared(sim)?;
+                // The run goes on: its scene (a longer run.time, another backend), and its
+                // analysis, which described the run before, goes; the frames from the
+                // checkpoint on are written again.
+                crate::write_scene(&self.dir, scene)?;
+                let analysis = self.dir.join("analysis");
+                if analysis.exists() {
+                    std::fs::remove_dir_all(&analysis)
+                        .map_err(|e| RunDirError::io("remove", &analysis, e))?;
                 }
                 let w = add_writers_resumed(&mut sim, &self.dir, &schedules, step)?;
                 (sim, w)
@@ -432,7 +458,7 @@ impl RunDir {
                     .map_err(|e| initial_state(Box::new(e)))?;
                 let tissue = crate::state::saved_terms(scene, tissue)
                     .map_err(|e| initial_state(Box::new(e)))?;
-                let mut sim = scene.simulation_from(tissue);
+                let mut sim = prepared(scene.simulation_from(tissue))?;
                 let w = add_writers(&mut sim, &self.dir, &schedules)?;
                 (sim, w)
             }
@@ -441,7 +467,7 @@ impl RunDir {
                 // point reads it here; `monolayer run` reads it before `--overwrite`).
                 let tissue =
                     crate::initial_tissue::<T>(scene).map_err(|e| initial_state(Box::new(e)))?;
-                let mut sim = scene.simulation_from(tissue);
+                let mut sim = prepared(scene.simulation_from(tissue))?;
                 let w = add_writers(&mut sim, &self.dir, &schedules)?;
                 (sim, w)
             }

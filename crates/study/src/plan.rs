@@ -16,20 +16,32 @@ pub struct Vary {
     pub values: Vec<String>,
 }
 
-impl FromStr for Vary {
-    type Err = SweepError;
-
-    fn from_str(s: &str) -> Result<Self, SweepError> {
+impl Vary {
+    /// A key and its values, each given whole (from Python, say), checked as
+    /// [`Vary::from_str`] checks `--vary KEY=V1,V2`; a value cannot hold a comma, which
+    /// separates the values of `--vary` and of the sweep's saved arguments.
+    ///
+    /// # Errors
+    /// [`SweepError::BadVary`], naming the key and what to change.
+    pub fn new(key: &str, values: Vec<String>) -> Result<Self, SweepError> {
+        let arg = format!("{key}={}", values.join(","));
         let bad = |why: &str| SweepError::BadVary {
-            arg: s.to_string(),
+            arg: arg.clone(),
             why: why.to_string(),
         };
-        let (key, values) = s.split_once('=').ok_or_else(|| bad("no '='"))?;
+        if let Some(v) = values.iter().find(|v| v.contains(',')) {
+            return Err(bad(&format!(
+                "the value {v:?} holds a ',', which separates a sweep's values; sweep a key whose values have no comma"
+            )));
+        }
         let key = key.trim();
         if !key.contains('.') || key.starts_with('.') || key.ends_with('.') {
             return Err(bad("the key needs a section, e.g. model.zeta"));
         }
-        let values: Vec<String> = values.split(',').map(|v| v.trim().to_string()).collect();
+        let values: Vec<String> = values.iter().map(|v| v.trim().to_string()).collect();
+        if values.is_empty() {
+            return Err(bad("no value: give at least one"));
+        }
         if values.iter().any(|v| v.is_empty()) {
             return Err(bad("a value is empty"));
         }
@@ -50,6 +62,24 @@ impl FromStr for Vary {
         Ok(Self {
             key: key.to_string(),
             values,
+        })
+    }
+}
+
+impl FromStr for Vary {
+    type Err = SweepError;
+
+    fn from_str(s: &str) -> Result<Self, SweepError> {
+        let (key, values) = s.split_once('=').ok_or_else(|| SweepError::BadVary {
+            arg: s.to_string(),
+            why: "no '='".to_string(),
+        })?;
+        Self::new(key, values.split(',').map(str::to_string).collect()).map_err(|e| match e {
+            SweepError::BadVary { why, .. } => SweepError::BadVary {
+                arg: s.to_string(),
+                why,
+            },
+            other => other,
         })
     }
 }
