@@ -108,6 +108,14 @@ fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start the threads: {e}")))
 }
 
+/// The command line's memory guard ([`rundir::memory::check_memory`]): a scene larger than
+/// the memory this process can still use raises `MemoryError` with the estimate and the keys
+/// to change, instead of an abort in the allocator.
+fn memory_guard(scene: &::scene::Scene) -> PyResult<()> {
+    rundir::memory::check_memory(scene, 1, None, "run it where more memory is free")
+        .map_err(|e| pyo3::exceptions::PyMemoryError::new_err(e.to_string()))
+}
+
 /// The most steps one call takes (2**62: about 10¹⁸, far beyond any run).
 const STEP_MAX: u64 = 1 << 62;
 
@@ -493,6 +501,7 @@ impl PySimulation {
                 "[integrator] backend = \"gpu\": the Python package is built without the GPU backend, and a Simulation does not move a GPU scene to the CPU without a word; set it to \"cpu\" (scene.set(\"integrator.backend\", \"cpu\")), or run the scene with the command line",
             ));
         }
+        memory_guard(s)?;
         let build = |e: rundir::StateError| scene_error(None, e);
         let inner = match s.precision() {
             Precision::F64 => {
@@ -948,6 +957,8 @@ pub fn run_dir(
             "[integrator] backend = \"gpu\": the Python package is built without the GPU backend; run it with the command line, or set integrator.backend = \"cpu\"",
         ));
     }
+    // Before anything is allocated or written: a refused run leaves no directory.
+    memory_guard(s)?;
     let state = rundir::initial_state(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
     let dropped = rundir::not_carried(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
     let mut warnings = s.warnings();
@@ -984,6 +995,7 @@ pub fn resume_dir(
     let run = RunDir::resume(&dir, &set, interrupt.clone())
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     // (Nothing in the directory has changed yet: it does once the run starts.)
+    memory_guard(run.scene())?;
     if run.scene().backend() != scene::ComputeBackend::Cpu {
         return Err(PyValueError::new_err(format!(
             "{}: its scene runs on the GPU ([integrator] backend = \"gpu\"), and the Python package is built without the GPU backend; resume it with the command line (monolayer run --resume {0}), or on the CPU with monolayer run --resume {0} --set integrator.backend=cpu",

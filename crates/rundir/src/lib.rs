@@ -20,6 +20,7 @@
 pub mod checkpoint;
 mod frame;
 pub mod lineage;
+pub mod memory;
 pub mod run;
 mod series;
 mod sidecar;

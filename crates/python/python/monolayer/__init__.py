@@ -380,7 +380,9 @@ def sweep(
 ) -> Iterator[Point]:
     """The points of a sweep of ``scene`` over ``vary`` (``{"model.zeta": [0.002, 0.004]}``)
     and ``seeds`` (a range of consecutive seeds), in the order and with the directory layout
-    of ``monolayer sweep`` (``out/sweep.toml``, ``out/runs/NAME``), for any executor::
+    of ``monolayer sweep`` (``out/args.txt`` and ``out/scene.toml``, the sweep's arguments and
+    scene, and ``out/runs/NAME``), named as the command line names them
+    (``model.zeta=0``, ``model.zeta=0.005``), for any executor::
 
         spawn = multiprocessing.get_context("spawn")  # never fork a process with threads
         with ProcessPoolExecutor(mp_context=spawn) as pool:
