@@ -273,3 +273,130 @@ fn a_state_from_a_mixture_keeps_its_populations() {
         .data;
     assert_ne!(dealt, want);
 }
+
+/// Every file of `dir` (recursively, the lock file aside: it names the last process that
+/// held it) with its bytes.
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().is_some_and(|n| n != rundir::LOCK) {
+                out.insert(
+                    p.strip_prefix(dir).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// Issue 53: a resume that is refused leaves the run directory as it was, byte for byte (its
+/// lock file aside), for every way a resume can be refused: an override of another key, a
+/// complete run, a shorter run.time, the GPU where no Vulkan adapter is (on main this one
+/// rewrote scene.toml and removed the `complete` mark), a run whose scene changed, a run
+/// that another process holds, and no checkpoint.
+#[test]
+fn a_refused_resume_leaves_the_directory_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = run(
+        &scene_path("paper.toml"),
+        &out,
+        &[
+            "domain.lx=40",
+            "domain.ly=40",
+            "cells.count=8",
+            "run.relax_time=2",
+            "run.time=2",
+            "run.output_every=1",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::create_dir_all(out.join("analysis")).unwrap();
+    std::fs::write(out.join("analysis/kept.txt"), "the analysis of the run").unwrap();
+    let resume = |args: &[&str], envs: &[(&str, &str)]| {
+        let mut c = bin();
+        c.args(["run", "--quiet", "--resume"]).arg(&out);
+        for a in args {
+            c.args(["--set", a]);
+        }
+        for (k, v) in envs {
+            c.env(k, v);
+        }
+        c.output().expect("the binary runs")
+    };
+    // No Vulkan driver visible to the loader, whatever this machine has.
+    let no_gpu = [
+        ("VK_ICD_FILENAMES", "/nonexistent.json"),
+        ("VK_DRIVER_FILES", "/nonexistent.json"),
+    ];
+    let cases: &[(&str, &[&str], &[(&str, &str)], &[&str])] = &[
+        ("another key", &["model.zeta=0.1"], &[], &["model.zeta"]),
+        ("a complete run", &[], &[], &["complete"]),
+        ("a shorter run", &["run.time=1"], &[], &["run.time"]),
+        (
+            "the GPU without an adapter",
+            &["run.time=3", "integrator.backend=gpu"],
+            &no_gpu,
+            &["gpu"],
+        ),
+        (
+            "the GPU without an adapter, not extended",
+            &["integrator.backend=gpu"],
+            &no_gpu,
+            &[],
+        ),
+    ];
+    let before = snapshot(&out);
+    assert!(before.contains_key(Path::new(rundir::COMPLETE)));
+    for (what, args, envs, says) in cases {
+        let o = resume(args, envs);
+        refused(&o, says, what);
+        assert!(snapshot(&out) == before, "{what}: the directory changed");
+    }
+    // Held by another process (this one).
+    {
+        let _held = rundir::lock_dir(&out).unwrap();
+        let o = resume(&["run.time=3"], &[]);
+        refused(&o, &["in use by another monolayer process"], "a held lock");
+        assert!(
+            snapshot(&out) == before,
+            "a held lock: the directory changed"
+        );
+    }
+    // A scene that is not its checkpoints' any more.
+    let scene = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+    std::fs::write(
+        out.join("scene.toml"),
+        scene.replace("zeta = 0.005", "zeta = 0.007"),
+    )
+    .unwrap();
+    let before = snapshot(&out);
+    refused(
+        &resume(&["run.time=3"], &[]),
+        &["checkpoint"],
+        "another run's checkpoints",
+    );
+    assert!(
+        snapshot(&out) == before,
+        "another run: the directory changed"
+    );
+    std::fs::write(out.join("scene.toml"), scene).unwrap();
+    // No checkpoint.
+    std::fs::remove_dir_all(out.join("checkpoints")).unwrap();
+    let before = snapshot(&out);
+    refused(
+        &resume(&["run.time=3"], &[]),
+        &["no checkpoint"],
+        "no checkpoint",
+    );
+    assert!(
+        snapshot(&out) == before,
+        "no checkpoint: the directory changed"
+    );
+}
