@@ -17,7 +17,11 @@ pub struct Positions {
 /// The mean squared displacement at one lag.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MsdPoint {
-    /// The lag, in the frames' time units (the mean over the pairs of frames that give it).
+    /// The lag, in the frames' time units: the mean of `t(b) − t(a)` over the samples
+    /// averaged (each pair of frames weighted by the cells present in both, as the MSD is;
+    /// a pair of frames with no cell in common gives no sample and no lag), so that it is
+    /// the time the MSD belongs to also when cells divide, die or leave, or the frames are
+    /// not equally spaced.
     pub lag: f64,
     /// `⟨|Δr_i − ⟨Δr⟩|²⟩` over cells and time origins, `Δr_i = r_i(t + lag) − r_i(t)` and
     /// `⟨Δr⟩` its mean over the cells present in both frames: the tissue's drift removed, so
@@ -74,6 +78,7 @@ pub fn msd(frames: &[Positions], box_size: [f64; 2]) -> Vec<MsdPoint> {
     (1..=frames.len() / 2)
         .map(|k| {
             let (mut sum, mut sum_raw, mut n, mut lag) = (0.0, 0.0, 0usize, 0.0);
+            // (Each pair's lag weighted by its samples: the frames' times are the MSD's.)
             let origins = frames.len() - k;
             for t in 0..origins {
                 let (a, b) = (&unwrapped[t], &unwrapped[t + k]);
@@ -99,10 +104,10 @@ pub fn msd(frames: &[Positions], box_size: [f64; 2]) -> Vec<MsdPoint> {
                     sum_raw += d[0].powi(2) + d[1].powi(2);
                 }
                 n += pairs.len();
-                lag += frames[t + k].time - frames[t].time;
+                lag += pairs.len() as f64 * (frames[t + k].time - frames[t].time);
             }
             MsdPoint {
-                lag: lag / origins as f64,
+                lag: if n == 0 { f64::NAN } else { lag / n as f64 },
                 msd: if n == 0 { f64::NAN } else { sum / n as f64 },
                 msd_raw: if n == 0 { f64::NAN } else { sum_raw / n as f64 },
                 samples: n,
@@ -165,6 +170,33 @@ mod tests {
             ids: ids.to_vec(),
             centres: centres.to_vec(),
         }
+    }
+
+    /// Issue 53: the lag of each point is the time between the frames its samples come from,
+    /// also when cells divide and die and the frames are unevenly spaced. A hand count: frames
+    /// at t = 0, 1, 3, 4, 10; cells 0 and 1 from the start, 1 dies after t = 1, 0 divides
+    /// at t = 3 into 2 and 3, and 2 dies after t = 4. On main the lag was the sum over the
+    /// pairs of frames that had a cell in common divided by every pair (a lag of 2 frames read
+    /// 1.0, its one pair's 3 over three origins, for a true 3).
+    #[test]
+    fn the_lag_is_the_time_of_the_samples_with_divisions_and_deaths() {
+        let at = |t: f64, ids: &[usize]| frame(t, ids, &vec![[1.0, 1.0]; ids.len()]);
+        let frames = vec![
+            at(0.0, &[0, 1]),
+            at(1.0, &[0, 1]),
+            at(3.0, &[0]),
+            at(4.0, &[2, 3]),
+            at(10.0, &[3]),
+        ];
+        let m = msd(&frames, [50.0, 50.0]);
+        assert_eq!(m.len(), 2);
+        // Lag 1 frame: (0,1): ids 0 and 1, Δt 1, two samples; (1,3): id 0, Δt 2; (3,4):
+        // none; (4,10): id 3, Δt 6. Samples 4, lag (2·1 + 2 + 6)/4 = 2.5.
+        assert_eq!(m[0].samples, 4);
+        assert!((m[0].lag - 2.5).abs() < 1e-12, "{:?}", m[0]);
+        // Lag 2 frames: (0,3): id 0, Δt 3; (1,4): none; (3,10): none. One sample, lag 3.
+        assert_eq!(m[1].samples, 1);
+        assert!((m[1].lag - 3.0).abs() < 1e-12, "{:?}", m[1]);
     }
 
     /// Ballistic motion across a periodic edge gives `v² t²` exactly (drift kept); a common
