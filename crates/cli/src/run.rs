@@ -40,16 +40,10 @@ pub fn run(
     quiet: bool,
 ) -> Result<RunInfo> {
     let opened = crate::backend::open(scene)?;
-    let dropped = rundir::not_carried(scene)?;
+    let said = rundir::state_warnings(scene)?;
     let dir = RunDir::create(out, scene.clone(), state, overwrite, Interrupt::install()?)?;
-    for w in scene.warnings() {
+    for w in scene.warnings().into_iter().chain(said) {
         crate::say!("warning: {w}");
-    }
-    if let (Some(from), false) = (scene.init_from(), dropped.is_empty()) {
-        crate::say!(
-            "warning: [cells] from = {from:?}: its arrays {} are not carried: the scene has no part that keeps them; add that part's table to the scene to carry them",
-            dropped.join(", ")
-        );
     }
     drive(&dir, opened, quiet)
 }

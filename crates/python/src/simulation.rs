@@ -479,7 +479,12 @@ fn apply_edit<T: Real>(
 impl PySimulation {
     #[new]
     #[pyo3(signature = (scene, threads=None, backend="cpu"))]
-    fn new(scene: PyScene, threads: Option<&Bound<'_, PyAny>>, backend: &str) -> PyResult<Self> {
+    fn new(
+        py: Python<'_>,
+        scene: PyScene,
+        threads: Option<&Bound<'_, PyAny>>,
+        backend: &str,
+    ) -> PyResult<Self> {
         let threads = opt_whole("Simulation", "threads", threads, THREADS_MAX)?.map(|t| t as usize);
         match backend {
             "cpu" => {}
@@ -502,6 +507,11 @@ impl PySimulation {
             ));
         }
         memory_guard(s)?;
+        // What the command line's `run` warns of, as Python warnings.
+        let said = rundir::state_warnings(s).map_err(|e| scene_error(None, e))?;
+        for w in said {
+            py.import("warnings")?.call_method1("warn", (w,))?;
+        }
         let build = |e: rundir::StateError| scene_error(None, e);
         let inner = match s.precision() {
             Precision::F64 => {
@@ -960,14 +970,8 @@ pub fn run_dir(
     // Before anything is allocated or written: a refused run leaves no directory.
     memory_guard(s)?;
     let state = rundir::initial_state(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
-    let dropped = rundir::not_carried(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
     let mut warnings = s.warnings();
-    if let (Some(from), false) = (s.init_from(), dropped.is_empty()) {
-        warnings.push(format!(
-            "[cells] from = {from:?}: its arrays {} are not carried: the scene has no part that keeps them; add that part's table to the scene to carry them",
-            dropped.join(", ")
-        ));
-    }
+    warnings.extend(rundir::state_warnings(s).map_err(|e| scene_error(scene.path.as_deref(), e))?);
     let interrupt = Interrupt::never();
     let dir = RunDir::create(&out, s.clone(), state, overwrite, interrupt.clone())
         .map_err(|e| PyOSError::new_err(e.to_string()))?;

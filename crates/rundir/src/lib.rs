@@ -39,7 +39,9 @@ pub use lineage::{read_lineage, write_lineage, LINEAGE_HEADER};
 pub use run::{lock_dir, DirLock, Interrupt, Outcome, RunDir, RunError, LOCK};
 pub use series::{SeriesWriter, MSD_HEADER, OBSERVABLES_HEADER, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
-pub use state::{initial_state, initial_tissue, not_carried, read_state, StateError};
+pub use state::{
+    initial_state, initial_tissue, not_carried, read_state, state_warnings, StateError,
+};
 pub use writers::{
     add_checkpoints, add_checkpoints_with, add_writers, add_writers_resumed, FinalToo, Written,
 };

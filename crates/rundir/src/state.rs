@@ -136,7 +136,96 @@ pub fn initial_state(scene: &Scene) -> std::result::Result<Option<Cells<f64>>, S
         error,
     })?;
     scene.check_state(&state)?;
+    check_populations(scene, Path::new(from))?;
     Ok(Some(state))
+}
+
+/// The scene's `[[population]]` counts against the `population` array of the saved state it
+/// starts from, where the file has one (the file's assignment is what the run takes): a
+/// scene that says 6 and 2 of a state holding 4 and 4 is refused with both.
+///
+/// # Errors
+/// [`StateError::Scene`] with both counts and the keys to set.
+fn check_populations(scene: &Scene, from: &Path) -> std::result::Result<(), StateError> {
+    let kinds = &scene.file().population;
+    let read = |error| StateError::Read {
+        from: from.display().to_string(),
+        error,
+    };
+    let names = crate::frame::npz_names(from).map_err(read)?;
+    if kinds.is_empty() || !names.iter().any(|n| n == "population") {
+        return Ok(());
+    }
+    let a = read_npz(from, &["population"]).map_err(read)?;
+    let mut counts = vec![0usize; kinds.len()];
+    for &k in &a[0].data {
+        // A population the scene lacks is refused where the array is read.
+        if let Some(c) = counts.get_mut(k as usize) {
+            *c += 1;
+        }
+    }
+    let want: Vec<usize> = kinds.iter().map(|p| p.count).collect();
+    if counts != want {
+        let list = |c: &[usize]| {
+            c.iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Err(StateError::Scene(SceneError::State {
+            from: from.display().to_string(),
+            problem: format!(
+                "the state's population array has {} cells of populations 0 to {}, the scene's [[population]] counts are {}",
+                list(&counts),
+                kinds.len() - 1,
+                list(&want)
+            ),
+            fix: format!(
+                "set {} (the state's; its cells keep their populations)",
+                counts
+                    .iter()
+                    .enumerate()
+                    .map(|(k, n)| format!("population.{k}.count = {n}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }));
+    }
+    Ok(())
+}
+
+/// What a new user should be told about the saved state `scene` starts from
+/// (`init = "frame"`): its arrays that the scene has no part to carry ([`not_carried`]), and
+/// the scene's keys the state's arrays win over (`[polarity] angle` against the state's
+/// `polarity.theta`). The rules per key are in docs/scenes.md ("Starting from a saved
+/// state").
+///
+/// # Errors
+/// The file cannot be read.
+pub fn state_warnings(scene: &Scene) -> std::result::Result<Vec<String>, StateError> {
+    let Some(from) = scene.init_from() else {
+        return Ok(Vec::new());
+    };
+    let mut out = Vec::new();
+    let dropped = not_carried(scene)?;
+    if !dropped.is_empty() {
+        out.push(format!(
+            "[cells] from = {from:?}: its arrays {} are not carried: the scene has no part that keeps them; add that part's table to the scene to carry them",
+            dropped.join(", ")
+        ));
+    }
+    let names = crate::frame::npz_names(Path::new(from)).map_err(|error| StateError::Read {
+        from: from.to_string(),
+        error,
+    })?;
+    if let Some(angle) = scene.file().polarity.as_ref().and_then(|p| p.angle) {
+        if names.iter().any(|n| n == "polarity.theta") {
+            out.push(format!(
+                "[polarity] angle = {angle}: the cells start with the angles of the state's polarity.theta (from {from:?}), which win over the scene's; remove angle from the scene to say so, or start from a state without polarity.theta"
+            ));
+        }
+    }
+    Ok(out)
 }
 
 /// Why the initial tissue of a scene could not be built.

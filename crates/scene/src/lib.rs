@@ -427,7 +427,9 @@ impl Scene {
     }
 
     /// Checks that a saved state fits the scene: the same lattice and the same number of
-    /// cells (the patch size and precision may differ).
+    /// cells (the patch size and precision may differ), every cell with an interior (its
+    /// field reaching ½), and none in the solid of the scene's walls (more than half of its
+    /// field there).
     ///
     /// # Errors
     /// [`SceneError::State`] naming what differs and the key to change.
@@ -457,6 +459,57 @@ impl Scene {
                 ),
                 fix: format!("set [cells] count = {}", state.n_cells()),
             });
+        }
+        // Each cell has an interior (a field zeroed by an edit of the frame has none, and its
+        // shape index would be NaN in every table).
+        let shape = state.shape();
+        for i in 0..n {
+            let max = state
+                .cell_phi(i)
+                .iter()
+                .copied()
+                .fold(f64::NEG_INFINITY, f64::max);
+            if !(max >= 0.5) {
+                return Err(SceneError::State {
+                    from,
+                    problem: format!(
+                        "cell {i} of the state has no interior: its field never reaches ½ (max φ = {max:.3})"
+                    ),
+                    fix: format!(
+                        "remove cell {i} from the state's arrays (and lower [cells] count by one), or restore its field"
+                    ),
+                });
+            }
+        }
+        // No cell inside the walls: the wall's repulsion would crush it without a word.
+        if let Some(walls) = self.walls() {
+            let active = self.file.run.relax_time <= 0.0;
+            if let Some(field) = walls.field(active) {
+                let map = state.map();
+                for i in 0..n {
+                    let (xs, ys) = (map.cell_x(shape, i), map.cell_y(shape, i));
+                    let (mut total, mut solid) = (0.0, 0.0);
+                    for (a, &x) in xs.iter().enumerate() {
+                        for (b, &y) in ys.iter().enumerate() {
+                            let v = state.cell_phi(i)[a * shape.ny + b].max(0.0);
+                            total += v;
+                            if field.is_solid(x as usize * l.ly + y as usize) {
+                                solid += v;
+                            }
+                        }
+                    }
+                    if solid > 0.5 * total {
+                        return Err(SceneError::State {
+                            from,
+                            problem: format!(
+                                "cell {i} of the state lies in the solid of [walls] ({:.0} % of its field), where the walls would crush it",
+                                100.0 * solid / total
+                            ),
+                            fix: "remove the cell from the state's arrays (and lower [cells] count by one), or change [walls] so that it lies in the open".into(),
+                        });
+                    }
+                }
+            }
         }
         Ok(())
     }
