@@ -400,3 +400,75 @@ fn a_refused_resume_leaves_the_directory_as_it_was() {
         "no checkpoint: the directory changed"
     );
 }
+
+/// Issue 53: reading a run needs no code that reading does not run. A run whose scene names
+/// a term this binary does not register (`[terms.push]`, as a user's own program would have
+/// run it) is rendered, exported to ParaView and analysed (on main each refused: "no term
+/// named push is registered"); its frames' fields are rebuilt with the whole-cell forces the
+/// frames recorded, so the pictures are those of the same run without the table (whose
+/// recorded forces are zero here). Running its scene, which steps the term, is refused by
+/// name.
+#[test]
+fn a_run_with_an_unregistered_term_is_read_but_not_resumed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = run(
+        &scene_path("paper.toml"),
+        &out,
+        &[
+            "domain.lx=40",
+            "domain.ly=40",
+            "cells.count=8",
+            "run.relax_time=2",
+            "run.time=2",
+            "run.output_every=2",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |what: &str, args: &[&str], to: &Path| {
+        let o = bin().args(args).output().unwrap();
+        assert!(o.status.success(), "{what}: {}", stderr(&o));
+        let mut files: Vec<_> = std::fs::read_dir(to)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        files
+            .iter()
+            .map(|p| std::fs::read(p).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let outs = out.display().to_string();
+    let png = |tag: &str| dir.path().join(format!("png-{tag}"));
+    let render = |tag: &str| {
+        let to = png(tag);
+        read(
+            "render",
+            &[
+                "render",
+                &outs,
+                "--colour",
+                "velocity",
+                "--flow",
+                "--out",
+                &to.display().to_string(),
+            ],
+            &to,
+        )
+    };
+    let plain = render("plain");
+    let scene = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+    std::fs::write(
+        out.join("scene.toml"),
+        format!("{scene}\n[terms.push]\nstrength = 0.01\n"),
+    )
+    .unwrap();
+    assert_eq!(render("term"), plain, "the pictures of the same run");
+    let vtk = read("export vtk", &["export", "vtk", &outs], &out.join("vtk"));
+    assert!(!vtk.is_empty());
+    let o = bin().args(["analyze", &outs]).output().unwrap();
+    assert!(o.status.success(), "analyze: {}", stderr(&o));
+    // Stepping it needs the term: refused by name.
+    let o = run(&out.join("scene.toml"), &dir.path().join("again"), &[]);
+    refused(&o, &["push", "register"], "a run of an unregistered term");
+}

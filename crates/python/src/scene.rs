@@ -141,6 +141,25 @@ impl PyScene {
         Self::build(text, Some(path), Vec::new())
     }
 
+    /// The resolved scene of a run directory (`DIR/scene.toml`), read to look at the run, not
+    /// to step it: a `[terms.NAME]` table whose term this program does not register is kept
+    /// (building a `Simulation` of it is refused by name).
+    #[staticmethod]
+    fn read_run(path: PathBuf) -> PyResult<Self> {
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            PyOSError::new_err(format!("cannot read scene file {}: {e}", path.display()))
+        })?;
+        let scene = ::scene::SceneFile::parse(&text, &[])
+            .and_then(|f| f.validate_for_reading())
+            .map_err(|e| scene_error(Some(&path), e))?;
+        Ok(Self {
+            text,
+            path: Some(path),
+            set: Vec::new(),
+            scene,
+        })
+    }
+
     /// A scene from TOML text.
     #[staticmethod]
     fn from_text(text: String) -> PyResult<Self> {

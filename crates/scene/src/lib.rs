@@ -66,6 +66,9 @@ pub struct Scene {
     /// The terms of the `[terms.NAME]` tables, built once by the validation
     /// ([`register_term`]).
     pub(crate) user_terms: Vec<std::sync::Arc<dyn mechanics::terms::CellTerm>>,
+    /// The `[terms.NAME]` tables whose terms this program does not register, kept for reading
+    /// ([`SceneFile::validate_for_reading`]; empty after [`Scene::parse`]).
+    pub(crate) unbuilt: Vec<String>,
 }
 
 /// When the writers of a run directory fire ([`Scene::output_schedules`]).
@@ -301,6 +304,7 @@ impl Scene {
     /// read the state and use [`Scene::tissue_from_state`] (`rundir::initial_tissue` does
     /// both).
     pub fn tissue<T: Real>(&self) -> Result<Tissue<T>, SceneError> {
+        self.check_built()?;
         if let Some(from) = self.init_from() {
             return Err(SceneError::State {
                 from: from.to_string(),
@@ -392,6 +396,31 @@ impl Scene {
         })
     }
 
+    /// The `[terms.NAME]` tables whose terms this program does not register: a scene read for
+    /// reading only ([`SceneFile::validate_for_reading`]) keeps them, and cannot be stepped.
+    pub fn unbuilt_terms(&self) -> &[String] {
+        &self.unbuilt
+    }
+
+    /// Refuses to build a tissue of a scene with an unregistered term, with the error
+    /// [`Scene::parse`] gives for it.
+    fn check_built(&self) -> Result<(), SceneError> {
+        match self.unbuilt.first() {
+            Some(name) => match registry::build(name, &self.file.user_terms[name]) {
+                Err(e) => Err(e),
+                // Registered since: parse the scene again to build it.
+                Ok(_) => Err(SceneError::Term {
+                    name: name.clone(),
+                    key: String::new(),
+                    problem: "the scene was read for reading only, before the term was registered"
+                        .into(),
+                    fix: "parse the scene again (Scene::parse) to step it".into(),
+                }),
+            },
+            None => Ok(()),
+        }
+    }
+
     /// The populations of `[[population]]` (empty without), cells dealt by `[run] seed`.
     pub fn populations(&self) -> mechanics::terms::Populations {
         self.file.populations()
@@ -416,6 +445,7 @@ impl Scene {
     /// # Errors
     /// [`SceneError::State`] when the state's lattice or cell count is not the scene's.
     pub fn tissue_from_state<T: Real>(&self, state: &Cells<f64>) -> Result<Tissue<T>, SceneError> {
+        self.check_built()?;
         self.check_state(state)?;
         let ids = (0..state.n_cells()).collect();
         let placed = Tissue::from_state(state.clone(), self.initial_params(), 0.0, 0, ids);

@@ -105,6 +105,21 @@ impl SceneFile {
     /// # Errors
     /// [`SceneError::Invalid`] for the first problem found.
     pub fn validate(self) -> Result<Scene, SceneError> {
+        self.validate_with(false)
+    }
+
+    /// [`SceneFile::validate`] for a program that reads a run and never steps it (`render`,
+    /// `export vtk`, `analyze`, Python's `Run`): a `[terms.NAME]` table whose term this program
+    /// does not register is kept in the file and listed by [`Scene::unbuilt_terms`], instead
+    /// of refused; building a tissue of the scene then refuses ([`Scene::tissue`]).
+    ///
+    /// # Errors
+    /// As [`SceneFile::validate`], but for unregistered terms.
+    pub fn validate_for_reading(self) -> Result<Scene, SceneError> {
+        self.validate_with(true)
+    }
+
+    fn validate_with(self, reading: bool) -> Result<Scene, SceneError> {
         // One check per section, in the order the keys depend on each other; each names
         // the first bad key and its fix.
         crate::check::domain(&self)?;
@@ -120,9 +135,17 @@ impl SceneFile {
         }
         crate::check::walls(&self)?;
         // The terms of `[terms.NAME]` tables, built once by their registered builders.
+        let registered = crate::registry::registered_terms();
+        let unbuilt: Vec<String> = self
+            .user_terms
+            .keys()
+            .filter(|n| reading && !registered.contains(n))
+            .cloned()
+            .collect();
         let user_terms = self
             .user_terms
             .iter()
+            .filter(|(name, _)| !unbuilt.contains(name))
             .map(|(name, table)| crate::registry::build(name, table))
             .collect::<Result<Vec<_>, _>>()?;
         let (d, c) = (&self.domain, &self.cells);
@@ -143,6 +166,7 @@ impl SceneFile {
                 centres: Vec::new(),
                 walls,
                 user_terms,
+                unbuilt,
             });
         };
         let centres = match init::positions_clear_of(
@@ -181,6 +205,7 @@ impl SceneFile {
             centres,
             walls,
             user_terms,
+            unbuilt,
         })
     }
 

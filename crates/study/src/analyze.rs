@@ -273,7 +273,74 @@ pub(crate) fn read_scene(run_dir: &Path) -> Result<Scene> {
             format!("does not parse with this version of monolayer: {e}"),
         )
     })?;
-    file.validate().map_err(|e| input(&path, e.to_string()))
+    // Read, not stepped: a term this program does not register is no reason to refuse.
+    file.validate_for_reading()
+        .map_err(|e| input(&path, e.to_string()))
+}
+
+/// The terms a frame's tissue is evaluated with: the scene's, or, where the scene names a
+/// term this program does not register ([`Scene::unbuilt_terms`]), the whole-cell forces the
+/// frame recorded (`cell_force`, the sum of every term's), so that the fields recomputed from
+/// it (velocity, stress) are the run's without the term's code. A scene that has built-in
+/// terms beside an unregistered one is refused by name: its recorded sum cannot be split.
+fn frame_terms(path: &Path, scene: &Scene, n: usize) -> Result<mechanics::terms::Terms> {
+    let unbuilt = scene.unbuilt_terms();
+    if unbuilt.is_empty() {
+        return Ok(scene.terms());
+    }
+    let built = scene.terms();
+    if !built.is_empty() {
+        return Err(input(
+            path,
+            format!(
+                "the run's term {} is not registered in this program, and the run has built-in terms beside it, so the fields of its frames cannot be rebuilt from the recorded forces; read it with the program that registers {0} (scene::register_term)",
+                unbuilt.join(", ")
+            ),
+        ));
+    }
+    // A frame without `cell_force` was written by a run with no term in effect (a run writes
+    // it whenever it has terms): no whole-cell force.
+    let names = rundir::npz_names(path).map_err(|e| input(path, e.to_string()))?;
+    let f = if names.iter().any(|n| n == "cell_force") {
+        let a = rundir::read_npz(path, &["cell_force"]).map_err(|e| input(path, e.to_string()))?;
+        a.into_iter().next().map(|a| a.data).unwrap_or_default()
+    } else {
+        vec![0.0; 2 * n]
+    };
+    let f = &f;
+    if f.len() != 2 * n || f.iter().any(|v| !v.is_finite()) {
+        return Err(input(
+            path,
+            format!(
+                "array 'cell_force' holds {} values, not 2 finite values for each of the {n} cells",
+                f.len()
+            ),
+        ));
+    }
+    let mut terms = mechanics::terms::Terms::default();
+    terms.add(std::sync::Arc::new(RecordedForces {
+        name: unbuilt.join("+"),
+        by_id: f.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
+    }));
+    Ok(terms)
+}
+
+/// The whole-cell forces a frame recorded, by cell identity: the forces of terms whose code
+/// this program does not have, for re-evaluating the frame.
+#[derive(Debug)]
+struct RecordedForces {
+    name: String,
+    by_id: Vec<[f64; 2]>,
+}
+
+impl mechanics::terms::CellTerm for RecordedForces {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn force(&self, cell: &mechanics::terms::CellContext<'_>, _: &[f64]) -> [f64; 2] {
+        self.by_id.get(cell.id).copied().unwrap_or([0.0, 0.0])
+    }
 }
 
 /// One frame as it was written, and its state rebuilt as a tissue.
@@ -518,7 +585,7 @@ pub(crate) fn load_frame(
         (0..n).collect(),
     )
     .with_populations(populations)
-    .with_terms(scene.terms());
+    .with_terms(frame_terms(path, scene, n)?);
     if let Some(walls) = scene.walls() {
         tissue = tissue.with_walls(walls);
     }

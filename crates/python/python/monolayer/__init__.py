@@ -289,8 +289,9 @@ class Run:
 
     @property
     def scene(self) -> Scene:
-        """The run's resolved scene."""
-        return Scene.from_toml(str(self.path / "scene.toml"))
+        """The run's resolved scene (read for looking at the run: a term this program does not
+        register is kept, and only stepping the scene needs it)."""
+        return Scene.read_run(str(self.path / "scene.toml"))
 
     @property
     def complete(self) -> bool:

@@ -16,6 +16,11 @@ class Scene:
     def from_toml(path: _Path) -> Scene:
         """A scene read from a TOML file; relative paths in it are taken from its directory."""
     @staticmethod
+    def read_run(path: _Path) -> Scene:
+        """The resolved scene of a run directory, read to look at the run: an unregistered
+        term is kept."""
+        ...
+    @staticmethod
     def from_text(text: str) -> Scene:
         """A scene from TOML text."""
     @staticmethod
