@@ -344,3 +344,130 @@ fn every_scene_key_is_documented_in_docs_scenes_md() {
         "keys without a row in docs/scenes.md: {missing:?}"
     );
 }
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// Issue 53: every message names what exists. Every `--flag` in the libraries' and the
+/// binary's sources is a flag of one of `monolayer`'s subcommands (read from their `--help`)
+/// or of the other program the text is about (cargo, sbatch: listed below), and every
+/// `[section] key` is a key of that scene table (read from serde's own field lists). On main
+/// the GPU sweep's refusal suggested `--slurm`, which no subcommand has.
+#[test]
+fn every_flag_and_key_that_a_message_names_exists() {
+    let mut help = String::new();
+    for sub in [
+        &["run"][..],
+        &["sweep"],
+        &["threshold"],
+        &["reproduce"],
+        &["render"],
+        &["analyze"],
+        &["export", "vtk"],
+    ] {
+        let o = crate::common::bin()
+            .args(sub)
+            .arg("--help")
+            .output()
+            .unwrap();
+        help.push_str(&String::from_utf8_lossy(&o.stdout));
+    }
+    // Flags of the programs a message tells the user to run besides monolayer.
+    let other = [
+        "--release",       // cargo build --release
+        "--features",      // cargo build --features gpu
+        "--example",       // cargo run --example threshold
+        "--signal",        // the sbatch script's directives
+        "--requeue",       //
+        "--output",        //
+        "--open-mode",     //
+        "--ntasks",        //
+        "--mem",           //
+        "--job-name",      //
+        "--cpus-per-task", //
+        "--array",         //
+    ];
+    let sections = scene_keys(None);
+    // Words that follow a table's name in prose, not keys.
+    let prose = [
+        "or", "so", "for", "is", "has", "table", "tables", "counts", "and", "of", "in", "as",
+        "with", "keys", "key", "to",
+    ];
+    let mut files = Vec::new();
+    rust_files(&root().join("crates"), &mut files);
+    assert!(files.len() > 50, "{}", files.len());
+    let mut bad = Vec::new();
+    let mut flags_seen = 0;
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let name = f.strip_prefix(root()).unwrap_or(f).display().to_string();
+        if name.contains("/tests/") {
+            continue;
+        }
+        for (k, line) in text.lines().enumerate() {
+            let at = format!("{name}:{}", k + 1);
+            // `--flag`, not `x--y` or `---`.
+            for (i, _) in line.match_indices("--") {
+                let before = line[..i].chars().last();
+                if before.is_some_and(|c| c.is_alphanumeric() || c == '-') {
+                    continue;
+                }
+                let flag: String = line[i + 2..]
+                    .chars()
+                    .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '-')
+                    .collect();
+                if flag.len() < 2 || !flag.starts_with(|c: char| c.is_ascii_lowercase()) {
+                    continue;
+                }
+                let flag = format!("--{}", flag.trim_end_matches('-'));
+                flags_seen += 1;
+                let known = help.contains(&format!("{flag} "))
+                    || help.contains(&format!("{flag}\n"))
+                    || help.contains(&format!("{flag}="));
+                if !known && !other.contains(&flag.as_str()) {
+                    bad.push(format!("{at}: {flag} is no flag of monolayer"));
+                }
+            }
+            // `[section] key` and `[[section]] key`.
+            for (i, _) in line.match_indices('[') {
+                let rest = &line[i + 1..];
+                let rest = rest.strip_prefix('[').unwrap_or(rest);
+                let Some((section, after)) = rest.split_once(']') else {
+                    continue;
+                };
+                if !sections.iter().any(|s| s == section) || section == "terms" {
+                    continue;
+                }
+                let after = after.strip_prefix(']').unwrap_or(after);
+                let Some(after) = after.strip_prefix(' ') else {
+                    continue;
+                };
+                let key: String = after
+                    .chars()
+                    .take_while(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || *c == '_')
+                    .collect();
+                if key.is_empty() || prose.contains(&key.as_str()) {
+                    continue;
+                }
+                if !scene_keys(Some(section)).contains(&key) {
+                    bad.push(format!("{at}: [{section}] {key} is no key of [{section}]"));
+                }
+            }
+        }
+    }
+    assert!(flags_seen > 50, "{flags_seen}");
+    assert!(
+        bad.is_empty(),
+        "messages that name what does not exist:\n{}",
+        bad.join("\n")
+    );
+}

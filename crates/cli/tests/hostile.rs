@@ -472,3 +472,47 @@ fn a_run_with_an_unregistered_term_is_read_but_not_resumed() {
     let o = run(&out.join("scene.toml"), &dir.path().join("again"), &[]);
     refused(&o, &["push", "register"], "a run of an unregistered term");
 }
+
+/// Issue 53: the messages about the stress-based extrusion name its key. `extrusion_pressure
+/// = 0` is refused before the run (on main it ran, extruded every cell, and the message named
+/// `death_rate or extrusion`); a rule so low that the tissue dies out names
+/// `extrusion_pressure` as the key to raise.
+#[test]
+fn the_extrusion_pressure_messages_name_their_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let small = [
+        "domain.lx=60",
+        "domain.ly=60",
+        "cells.count=12",
+        "division.max_cells=40",
+        "run.relax_time=10",
+        "run.time=40",
+    ];
+    let with = |p: &str| -> Vec<String> {
+        small
+            .iter()
+            .map(|s| s.to_string())
+            .chain([format!("division.extrusion_pressure={p}")])
+            .collect()
+    };
+    for p in ["0", "-0.01"] {
+        let set = with(p);
+        let set: Vec<&str> = set.iter().map(String::as_str).collect();
+        let out = dir.path().join(format!("refused{p}"));
+        let o = run(&scene_path("proliferation.toml"), &out, &set);
+        refused(&o, &["extrusion_pressure", "positive"], p);
+        assert!(!out.exists());
+    }
+    let set = with("1e-9");
+    let set: Vec<&str> = set.iter().map(String::as_str).collect();
+    let o = run(
+        &scene_path("proliferation.toml"),
+        &dir.path().join("gone"),
+        &set,
+    );
+    refused(
+        &o,
+        &["every cell is gone", "raise [division] extrusion_pressure"],
+        "a tissue extruded to the last cell",
+    );
+}

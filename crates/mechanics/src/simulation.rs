@@ -38,6 +38,14 @@ use crate::tissue::Tissue;
 use crate::workspace::Workspace;
 use crate::StepError;
 
+/// The keys that keep a tissue from dying out by `why` (`"death"` or `"extrusion"`).
+fn extinct_fix(why: &str) -> &'static str {
+    match why {
+        "death" => "lower [division] death_rate",
+        _ => "lower [division] extrusion (the area rule) or raise [division] extrusion_pressure (the pressure rule: above the cells' pressures at rest, 0.005–0.013 in the paper's tissue)",
+    }
+}
+
 /// Iterations between re-sortings of the cells in memory by default
 /// ([`Simulation::sort_every`]): cells move a fraction of a node per TU, so every few hundred
 /// steps is plenty.
@@ -150,7 +158,7 @@ pub enum SimulationError {
     },
     /// Every cell died or was extruded: the last one was due to go too, and a tissue cannot
     /// be empty, so the run stops with it in place.
-    #[error("every cell is gone at step {iteration} (t = {time:.3}): the last one (cell {cell}) was due for {why} too, and a tissue cannot be empty, so the run stops here; for a tissue that lasts, lower [division] death_rate or extrusion, or raise the division rate")]
+    #[error("every cell is gone at step {iteration} (t = {time:.3}): the last one (cell {cell}) was due for {why} too, and a tissue cannot be empty, so the run stops here; for a tissue that lasts, {}, or raise the division rate (lower [division] cycle_time)", extinct_fix(why))]
     Extinct {
         /// The iteration.
         iteration: u64,

@@ -135,12 +135,12 @@ pub(crate) fn check(spec: &DivisionSpec, file: &SceneFile) -> Result<(), SceneEr
         }
     }
     if let Some(p) = spec.extrusion_pressure {
-        if !p.is_finite() {
+        if !(p.is_finite() && p > 0.0) {
             return Err(invalid(
                 s,
                 "extrusion_pressure",
                 p,
-                "the extrusion pressure must be a finite pressure",
+                "the extrusion pressure must be a positive, finite pressure: at zero or below it every cell of a confluent tissue, whose pressures are positive, is extruded at once",
                 "use a value above the cells' pressures p_i = Σφ_i P/Σφ_i at rest (0.005–0.013 in the paper's relaxed tissue), or leave it out",
             ));
         }
