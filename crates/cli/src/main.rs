@@ -493,6 +493,9 @@ fn real_main() -> Result<ExitCode> {
             std::fs::write(&out, &table)
                 .with_context(|| format!("cannot write {}", out.display()))?;
             print!("{table}");
+            for note in threshold_notes(&table) {
+                say!("note: {note}");
+            }
             say!("written to {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
@@ -662,4 +665,44 @@ fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         pool = pool.num_threads(monolayer_cli::guard::threads(n)?);
     }
     Ok(pool.build()?)
+}
+
+/// Why a row of `threshold.csv` has no estimate, in words: an empty `zeta_cr` means that the
+/// sweep's activities do not bracket the threshold (the tour's two activities over 100 TU
+/// cannot), which the table alone does not say.
+fn threshold_notes(table: &str) -> Vec<String> {
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    let (Some(cr), Some(lo), Some(hi), Some(act)) = (
+        col("zeta_cr"),
+        col("zeta_cr_lo"),
+        col("zeta_cr_hi"),
+        col("activities"),
+    ) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let v: Vec<&str> = line.split(',').collect();
+        if v.get(cr).is_none_or(|c| !c.is_empty()) {
+            continue;
+        }
+        let (lo, hi, n) = (
+            v.get(lo).copied().unwrap_or(""),
+            v.get(hi).copied().unwrap_or(""),
+            v.get(act).copied().unwrap_or("?"),
+        );
+        let why = match (lo.is_empty(), hi.is_empty()) {
+            (true, false) => format!("the growth of ln v_rms already exceeds ζ = 0's at the smallest activity {hi}, so the threshold lies below it (or the runs are too short to tell ζ = 0 from it)"),
+            (false, true) => format!("no activity up to {lo} grows faster than ζ = 0, so the threshold lies above it"),
+            _ => "no activity could be compared with ζ = 0".to_string(),
+        };
+        out.push(format!(
+            "row {}: no estimate: {why}; the sweep has {n} activit{} beside ζ = 0. A threshold needs activities on both sides of it and runs long enough for the late growth rate (the paper's: --vary model.zeta=0,0.001,0.002,0.003,0.004,0.006,0.008 --set run.time=1000, or `monolayer reproduce threshold`)",
+            k + 1,
+            if n == "1" { "y" } else { "ies" }
+        ));
+    }
+    out
 }

@@ -1768,3 +1768,44 @@ fn the_memory_guard_reads_the_process_limits_and_logs_are_short() {
         stderr(&o)
     );
 }
+
+/// Issue 53: `monolayer threshold` on the tour's sweep (two activities, short runs) says why
+/// its estimate is empty and what to run instead (on main it printed an empty field without
+/// a word).
+#[test]
+fn a_threshold_that_is_not_bracketed_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, GOOD).unwrap();
+    let out = dir.path().join("sweep");
+    let o = bin()
+        .arg("sweep")
+        .arg(&scene)
+        .args([
+            "--vary",
+            "model.zeta=0,0.005",
+            "--seeds",
+            "1-2",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .args(["--set", "run.time=4", "--set", "cells.count=20"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = bin().arg("threshold").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        table.lines().nth(1).is_some_and(|l| l.starts_with(',')),
+        "{table}"
+    );
+    let e = stderr(&o);
+    assert!(
+        e.contains("no estimate")
+            && e.contains("activities on both sides")
+            && e.contains("--vary model.zeta="),
+        "{e}"
+    );
+}
