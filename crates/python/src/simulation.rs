@@ -973,8 +973,14 @@ pub fn run_dir(
     let mut warnings = s.warnings();
     warnings.extend(rundir::state_warnings(s).map_err(|e| scene_error(scene.path.as_deref(), e))?);
     let interrupt = Interrupt::never();
-    let dir = RunDir::create(&out, s.clone(), state, overwrite, interrupt.clone())
-        .map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let dir =
+        RunDir::create(&out, s.clone(), state, overwrite, interrupt.clone()).map_err(|e| {
+            // The command line's flags, as this function's keywords.
+            PyOSError::new_err(e.to_string().replace(
+                "choose another --out or pass --overwrite",
+                "choose another out or pass overwrite=True",
+            ))
+        })?;
     Ok((drive_any(py, &dir, threads, progress, interrupt)?, warnings))
 }
 
