@@ -335,7 +335,14 @@ fn a_refused_resume_leaves_the_directory_as_it_was() {
         ("VK_ICD_FILENAMES", "/nonexistent.json"),
         ("VK_DRIVER_FILES", "/nonexistent.json"),
     ];
-    let cases: &[(&str, &[&str], &[(&str, &str)], &[&str])] = &[
+    // (what, --set overrides, environment, what the message says)
+    type Case<'a> = (
+        &'a str,
+        &'a [&'a str],
+        &'a [(&'a str, &'a str)],
+        &'a [&'a str],
+    );
+    let cases: &[Case] = &[
         ("another key", &["model.zeta=0.1"], &[], &["model.zeta"]),
         ("a complete run", &[], &[], &["complete"]),
         ("a shorter run", &["run.time=1"], &[], &["run.time"]),

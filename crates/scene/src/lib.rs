@@ -499,7 +499,7 @@ impl Scene {
                 .iter()
                 .copied()
                 .fold(f64::NEG_INFINITY, f64::max);
-            if !(max >= 0.5) {
+            if max.is_nan() || max < 0.5 {
                 return Err(SceneError::State {
                     from,
                     problem: format!(
