@@ -386,3 +386,83 @@ fn the_gpu_states_what_max_cells_costs_before_it_pays_it() {
     let e = crate::common::stderr(&run("20"));
     assert!(!e.contains("allocates its buffers"), "{e}");
 }
+
+/// Issue 53 on the GPU: a blow-up in the last step of a run is an error, not a complete run.
+/// As the CPU's test in `cli.rs`: one run finds the step that blows up, a second ends exactly
+/// on it. The device checks a state at the start of each step only; the driver checks the
+/// state it brings back at the end (on main the second run ended as complete) and keeps the
+/// last good one it had, so no frame or checkpoint holds the bad state.
+#[test]
+fn a_blow_up_in_the_last_step_on_the_gpu_is_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let blowing = |out: &Path, time: &str| {
+        let mut set: Vec<String> = [
+            "model.gamma=0",
+            "model.zeta=0.01",
+            "integrator.dt=1",
+            "integrator.stability_check=false",
+            "integrator.backend=\"gpu\"",
+            "run.relax_time=0",
+            "run.output_every=50",
+            "run.series_every=1",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        set.push(format!("run.time={time}"));
+        bin()
+            .arg("run")
+            .arg(paper())
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet")
+            .args(set.iter().flat_map(|s| ["--set".to_string(), s.clone()]))
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap()
+    };
+    // Without line tension and at dt = 1 (Heun), the tissue blows up near t = 144 on lavapipe.
+    let o = blowing(&dir.path().join("first"), "600");
+    if no_adapter(&o) {
+        return;
+    }
+    let err = stderr(&o);
+    assert!(!o.status.success(), "no blow-up: {err}");
+    let step: u64 = err
+        .rsplit("at step ")
+        .next()
+        .and_then(|r| r.split(|c: char| !c.is_ascii_digit()).next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no step in {err}"));
+    let out = dir.path().join("second");
+    let o = blowing(&out, &format!("{step}"));
+    let err = stderr(&o);
+    assert!(
+        !o.status.success(),
+        "a GPU run whose last step blows up ended as a success: {err}"
+    );
+    assert!(err.contains(&format!("at step {step} ")), "{err}");
+    assert!(!out.join(rundir::COMPLETE).exists());
+    let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    assert!(series
+        .lines()
+        .skip(1)
+        .all(|l| !l.contains("NaN") && !l.contains("inf")));
+    // The last frame is a state the host had, at its own step (not the bad one, nor an old
+    // state written under the failing step's number), and its fields are finite.
+    let last = rundir::last_frame(&out).unwrap();
+    assert!(last < step, "frame {last} of a bad state");
+    let phi = rundir::read_npz(
+        &out.join(format!("frames/frame_{last:08}.npz")),
+        &["phi", "step"],
+    )
+    .unwrap();
+    assert!(phi[0].data.iter().all(|v| v.is_finite()));
+    assert_eq!(phi[1].scalar(), Some(last as f64));
+    let rows: Vec<u64> = series
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next()?.parse().ok())
+        .collect();
+    assert!(rows.iter().all(|&r| r < step), "a row of the bad state");
+}

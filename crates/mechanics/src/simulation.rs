@@ -406,6 +406,9 @@ pub struct Simulation<T: Real = f64> {
     fixes: Vec<(String, Timer, Box<dyn Fix<T>>)>,
     sort_scratch: Vec<T>,
     initialized: bool,
+    /// The clock of the host's fields on a backend: when they were last uploaded or brought
+    /// back (the host's clock runs ahead of its fields between syncs).
+    synced_at: (u64, f64),
     backend: Option<Box<dyn Backend<T>>>,
 }
 
@@ -434,6 +437,7 @@ impl<T: Real> Simulation<T> {
             fixes: Vec::new(),
             sort_scratch: Vec::new(),
             initialized: false,
+            synced_at: (0, 0.0),
             backend: None,
         }
     }
@@ -774,6 +778,7 @@ impl<T: Real> Simulation<T> {
                 .into());
             }
             b.upload(&self.tissue)?;
+            self.synced_at = (self.tissue.iteration(), self.tissue.time());
         }
         let mut result = self.run_loop(start, &mut stop);
         if self.backend.is_some() {
@@ -806,8 +811,15 @@ impl<T: Real> Simulation<T> {
         let mut fresh = self.tissue.clone();
         let synced = backend.sync(&mut fresh);
         // A step the device refused still brings back its last good state.
-        fresh.check_state(bound, self.step_params.dt)?;
+        if let Err(e) = fresh.check_state(bound, self.step_params.dt) {
+            // The host keeps the fields it last had, at their own clock.
+            let (iteration, time) = self.synced_at;
+            self.tissue.set_clock(iteration, time);
+            self.apply_activity();
+            return Err(e.into());
+        }
         self.tissue = fresh;
+        self.synced_at = (self.tissue.iteration(), self.tissue.time());
         synced.map_err(SimulationError::from)
     }
 
@@ -862,6 +874,7 @@ impl<T: Real> Simulation<T> {
                 }
             }
             backend.upload(&self.tissue)?;
+            self.synced_at = (iteration, time);
         }
         if call_due {
             self.fire_with(start, Hook::Call, stop, known, !synced)?;
@@ -895,9 +908,10 @@ impl<T: Real> Simulation<T> {
         };
         let Some(ev) = backend.evaluation(&self.tissue, pressure)? else {
             // A queued step failed (the sync says which), or the backend cannot.
-            backend.sync(&mut self.tissue)?;
+            let name = backend.name().to_string();
+            self.sync_checked()?;
             return Err(StepError::Backend {
-                backend: backend.name().to_string(),
+                backend: name,
                 message: "the backend does not bring back its evaluation, which the division clock reads; set [integrator] backend = \"cpu\"".into(),
             }
             .into());
@@ -911,12 +925,14 @@ impl<T: Real> Simulation<T> {
             self.tissue.refresh_target_scale();
             return Ok(());
         }
-        backend.sync(&mut self.tissue)?;
+        self.sync_checked()?;
         let events = self.tissue.proliferate(&mut self.workspace);
+        let backend = self.backend.as_mut().expect("checked above");
         // The device takes the events first, also when the run stops here, so that the last
         // sync finds the cells the host has.
         if !events.divisions.is_empty() || !events.removals.is_empty() {
             backend.upload(&self.tissue)?;
+            self.synced_at = (self.tissue.iteration(), self.tissue.time());
         }
         if let Some((cell, why)) = events.spared {
             return Err(SimulationError::Extinct {
