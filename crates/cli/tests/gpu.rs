@@ -64,6 +64,10 @@ fn ok(o: &Output) {
 /// Two runs on 2 lavapipe threads and one on 1 thread write byte-identical series and
 /// frames; the run says which adapter it stepped on.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn gpu_runs_are_bit_identical_for_any_driver_thread_count() {
     let dir = tempfile::tempdir().unwrap();
     let (a, b, c) = (
@@ -112,6 +116,10 @@ fn series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
 /// v_rms, S_rms and the mean area to f32 round-off amplified over 10 steps (1e-3 of their
 /// value; the backends differ by ~1e-6 in φ per step), and the clock is the same.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_checkpoint_resumes_on_the_other_backend() {
     let dir = tempfile::tempdir().unwrap();
     for (first, second) in [("cpu", "gpu"), ("gpu", "cpu")] {
@@ -247,6 +255,10 @@ fn the_gpu_refuses_more_populations_than_it_holds_before_writing() {
 /// value (f32 round-off amplified over the steps, as across a resume). The polar scenes'
 /// noise and the division clock's draws are the same on both (Philox from the same keys).
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn shipped_scenes_run_on_the_gpu_as_on_the_cpu() {
     let dir = tempfile::tempdir().unwrap();
     // The division scenes on a short clock, so that cells divide within the run (the colony
@@ -393,6 +405,10 @@ fn the_gpu_states_what_max_cells_costs_before_it_pays_it() {
 /// state it brings back at the end (on main the second run ended as complete) and keeps the
 /// last good one it had, so no frame or checkpoint holds the bad state.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_blow_up_in_the_last_step_on_the_gpu_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let blowing = |out: &Path, time: &str| {

@@ -117,6 +117,10 @@ fn polar(tissue: Tissue<f32>, align: Align, propulsion: Propulsion) -> Tissue<f3
 }
 
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn one_evaluation_agrees_with_the_cpu() {
     if common::try_device().is_none() {
         return;
@@ -288,6 +292,10 @@ fn polar_steps_agree(tissue: Tissue<f32>, steps: u64) -> Option<(f64, f64, [f64;
 }
 
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_hundred_passive_steps_agree_with_the_cpu() {
     let Some((dphi, dc)) = steps_agree(paper_tissue(0.0), 100) else {
         return;
@@ -297,6 +305,10 @@ fn a_hundred_passive_steps_agree_with_the_cpu() {
 }
 
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn twenty_active_steps_agree_with_the_cpu() {
     let Some((dphi, dc)) = steps_agree(paper_tissue(0.005), 20) else {
         return;
@@ -308,6 +320,10 @@ fn twenty_active_steps_agree_with_the_cpu() {
 /// Populations of their own constants (`two_populations`): 100 active steps agree with the
 /// CPU to the bounds of the minimal model's.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_hundred_steps_of_two_populations_agree_with_the_cpu() {
     let Some((dphi, dc)) = steps_agree(two_populations(paper_tissue(0.005)), 100) else {
         return;
@@ -318,6 +334,10 @@ fn a_hundred_steps_of_two_populations_agree_with_the_cpu() {
 
 /// Walls (`walled`): 100 active steps agree with the CPU to the minimal model's bounds.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_hundred_steps_in_a_channel_agree_with_the_cpu() {
     let Some((dphi, dc)) = steps_agree(walled(paper_tissue(0.005)), 100) else {
         return;
@@ -328,6 +348,10 @@ fn a_hundred_steps_in_a_channel_agree_with_the_cpu() {
 
 /// Adhesion (`adhering`): 100 active steps agree with the CPU to the minimal model's bounds.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_hundred_steps_with_adhesion_agree_with_the_cpu() {
     let Some((dphi, dc)) = steps_agree(adhering(paper_tissue(0.005)), 100) else {
         return;
@@ -348,6 +372,10 @@ fn a_hundred_steps_with_adhesion_agree_with_the_cpu() {
 /// Rust, from the same keys) is what makes this hold: a different draw, or none, differs by
 /// about 0.1 rad a step.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_hundred_polar_steps_agree_with_the_cpu() {
     let cases = [
         ("velocity, cell", Align::Velocity, Propulsion::Cell),
@@ -375,6 +403,10 @@ fn a_hundred_polar_steps_agree_with_the_cpu() {
 /// agree with the CPU as [`a_hundred_polar_steps_agree_with_the_cpu`] does, so each cell reads
 /// its own population's.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_hundred_polar_steps_of_two_populations_agree_with_the_cpu() {
     let tissue = two_populations(paper_tissue(0.005));
     let polarity = Polarity::new(0.04)
@@ -394,6 +426,10 @@ fn a_hundred_polar_steps_of_two_populations_agree_with_the_cpu() {
 /// An alignment too fast for the step (`J |v| dt > 2`) stops the device's step as it stops
 /// the host's, with the same kind of error, and leaves the state of the step's start.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn an_unstable_alignment_is_refused_on_the_device_as_on_the_host() {
     if common::try_device().is_none() {
         return;
@@ -454,6 +490,10 @@ impl Callback<f32> for Rows {
 /// partial sums: a few kilobytes, never the fields (150 kB here). With the steps' own
 /// observables, two populations and walls, so that every per-cell constant is in play.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn series_rows_read_back_the_observables_not_the_fields() {
     if common::try_device().is_none() {
         return;
@@ -530,6 +570,10 @@ fn series_rows_read_back_the_observables_not_the_fields() {
 /// mid-row) give the state of one array to f32 round-off: only the order in which the
 /// lattice sums add the cells changes (chunk by chunk).
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn chunked_arrays_agree_with_one_array() {
     if common::try_device().is_none() {
         return;
@@ -606,6 +650,10 @@ fn the_memory_estimate_counts_every_array() {
 /// the GPU's f32 arithmetic may add to it, but by no more than a factor 4 (measured: see the
 /// printed figures and docs/performance.md).
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn f32_arithmetic_costs_little_against_f32_storage() {
     if common::try_device().is_none() {
         return;
@@ -633,6 +681,10 @@ fn f32_arithmetic_costs_little_against_f32_storage() {
 /// above 1.3·10⁸ nodes is split) change no sum's order: R and the state after 20 steps are
 /// bit-identical.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn a_split_lattice_is_the_same_to_the_bit() {
     if common::try_device().is_none() {
         return;
@@ -665,6 +717,10 @@ fn a_split_lattice_is_the_same_to_the_bit() {
 /// part the device runs (polarity, adhesion, walls, two populations) and the state in three
 /// chunks, so that every stencil of the cell and force passes is read from the shared patch.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn the_shared_patch_variant_is_the_plain_one_to_the_bit() {
     if common::try_device().is_none() {
         return;
@@ -709,6 +765,10 @@ fn the_shared_patch_variant_is_the_plain_one_to_the_bit() {
 /// evaluation's force and area, kept per cell by `polarity_update`). It fails when the force
 /// pass reads them from the cell buffer, which an observation overwrites.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn observing_a_polar_run_on_the_device_changes_nothing() {
     if common::try_device().is_none() {
         return;
@@ -757,6 +817,10 @@ fn observing_a_polar_run_on_the_device_changes_nothing() {
 /// the host's last `proliferate` leaves them: with the current time's, cell 145 is extruded
 /// at t = 78.2 on the device where it divides on the host.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn division_on_the_device_follows_the_cpu() {
     use mechanics::division::Proliferation;
     if common::try_device().is_none() {
@@ -820,6 +884,10 @@ fn division_on_the_device_follows_the_cpu() {
 /// not bring the pressure back (every cell then reads p_i = 0 and none is extruded: checked,
 /// 90 cells on the device against 22 on the host). Measured: 155 extrusions, 294 records.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn stress_based_extrusion_on_the_device_follows_the_cpu() {
     use mechanics::division::Proliferation;
     if common::try_device().is_none() {

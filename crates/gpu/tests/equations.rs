@@ -392,6 +392,10 @@ fn sample(rng: &mut ChaCha8Rng) -> [f32; IN] {
 const ULPS: f64 = 16.0 * f32::EPSILON as f64 / 2.0;
 
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn every_wgsl_equation_matches_its_rust_reference() {
     let Some(device) = common::try_device() else {
         return;
@@ -484,6 +488,10 @@ fn function_inputs(x: u32) -> array<f32, 10> {
 /// polarity's angle is not wrapped), forces and velocities of both signs, contact inhibition
 /// from none to strong.
 #[test]
+#[cfg_attr(
+    no_vulkan_driver,
+    ignore = "no Vulkan driver was installed when the tests were built (apt-get install mesa-vulkan-drivers libvulkan1, then build again)"
+)]
 fn the_polarity_and_its_noise_match_their_rust_references() {
     use mechanics::terms::{self, Align};
     let Some(device) = common::try_device() else {
