@@ -357,7 +357,8 @@ fn real_main() -> Result<ExitCode> {
         } => {
             if let Some(dir) = resume {
                 let pool = pool(threads)?;
-                let info = pool.install(|| run::resume(&dir, &set, quiet))?;
+                let info =
+                    pool.install(|| run::resume(&dir, &set, quiet, max_memory.as_deref()))?;
                 return Ok(finished(&info, &dir, quiet));
             }
             let (Some(scene), Some(out)) = (scene, out) else {

@@ -64,8 +64,14 @@ pub fn absolute_from(scene_path: &Path, text: &str, set: &[String]) -> Result<Ve
 ///
 /// # Errors
 /// No usable checkpoint, a checkpoint of another run, an override other than `run.time`, a
-/// run already at its end, or what [`run`] can fail with.
-pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<RunInfo> {
+/// run already at its end, a run larger than `--max-memory` (or the memory available), or
+/// what [`run`] can fail with.
+pub fn resume(
+    dir: &Path,
+    set: &[String],
+    quiet: bool,
+    max_memory: Option<&str>,
+) -> Result<RunInfo> {
     // A move to a backend that cannot run the scene is refused before the directory is
     // touched (resuming rewrites its scene.toml and removes its analysis).
     if let Ok(text) = std::fs::read_to_string(dir.join("scene.toml")) {
@@ -74,6 +80,9 @@ pub fn resume(dir: &Path, set: &[String], quiet: bool) -> Result<RunInfo> {
         }
     }
     let run = RunDir::resume(dir, set, Interrupt::install()?)?;
+    // The memory guard of `monolayer run`, before anything is allocated or written (a resume
+    // writes nothing until its simulation is ready).
+    crate::guard::memory(run.scene(), max_memory)?;
     if !quiet {
         for s in run.skipped() {
             crate::say!("note: skipping {s}");

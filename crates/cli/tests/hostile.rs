@@ -366,6 +366,18 @@ fn a_refused_resume_leaves_the_directory_as_it_was() {
         refused(&o, says, what);
         assert!(snapshot(&out) == before, "{what}: the directory changed");
     }
+    // Larger than the memory it is given: the guard of `monolayer run`, before anything.
+    let o = bin()
+        .args(["run", "--quiet", "--max-memory", "1K", "--resume"])
+        .arg(&out)
+        .args(["--set", "run.time=3"])
+        .output()
+        .unwrap();
+    refused(&o, &["--max-memory 1K", "needs about"], "over --max-memory");
+    assert!(
+        snapshot(&out) == before,
+        "over --max-memory: the directory changed"
+    );
     // Held by another process (this one).
     {
         let _held = rundir::lock_dir(&out).unwrap();
