@@ -432,13 +432,7 @@ fn a_blow_up_in_the_last_step_is_an_error_and_keeps_the_last_good_state() {
     let first: Vec<&str> = first.iter().map(String::as_str).collect();
     let (ok, err, _dir) = run_text(GOOD, &first);
     assert!(!ok, "the run does not blow up: {err}");
-    // (The last "at step": the first is where the run stopped, before it.)
-    let step: u64 = err
-        .rsplit("at step ")
-        .next()
-        .and_then(|r| r.split(|c: char| !c.is_ascii_digit()).next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no step in {err}"));
+    let step = crate::common::error_step(&err);
     let time = format!("{}", step as f64 * 0.5);
     let second = args(&time);
     let second: Vec<&str> = second.iter().map(String::as_str).collect();

@@ -444,12 +444,7 @@ fn a_blow_up_in_the_last_step_on_the_gpu_is_an_error() {
     }
     let err = stderr(&o);
     assert!(!o.status.success(), "no blow-up: {err}");
-    let step: u64 = err
-        .rsplit("at step ")
-        .next()
-        .and_then(|r| r.split(|c: char| !c.is_ascii_digit()).next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no step in {err}"));
+    let step = crate::common::error_step(&err);
     let out = dir.path().join("second");
     let o = blowing(&out, &format!("{step}"));
     let err = stderr(&o);

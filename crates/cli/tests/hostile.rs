@@ -274,6 +274,24 @@ fn a_state_from_a_mixture_keeps_its_populations() {
     assert_ne!(dealt, want);
 }
 
+/// A small paper run (8 cells on 40², 2 TU of relaxation and 2 of activity) into `out`, with
+/// frames as `output_every` says.
+fn small_paper_run(out: &Path, output_every: &str) {
+    let o = run(
+        &scene_path("paper.toml"),
+        out,
+        &[
+            "domain.lx=40",
+            "domain.ly=40",
+            "cells.count=8",
+            "run.relax_time=2",
+            "run.time=2",
+            output_every,
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 /// Every file of `dir` (recursively, the lock file aside: it names the last process that
 /// held it) with its bytes.
 fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
@@ -304,19 +322,7 @@ fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8
 fn a_refused_resume_leaves_the_directory_as_it_was() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let o = run(
-        &scene_path("paper.toml"),
-        &out,
-        &[
-            "domain.lx=40",
-            "domain.ly=40",
-            "cells.count=8",
-            "run.relax_time=2",
-            "run.time=2",
-            "run.output_every=1",
-        ],
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    small_paper_run(&out, "run.output_every=1");
     std::fs::create_dir_all(out.join("analysis")).unwrap();
     std::fs::write(out.join("analysis/kept.txt"), "the analysis of the run").unwrap();
     let resume = |args: &[&str], envs: &[(&str, &str)]| {
@@ -431,19 +437,7 @@ fn a_refused_resume_leaves_the_directory_as_it_was() {
 fn a_run_with_an_unregistered_term_is_read_but_not_resumed() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let o = run(
-        &scene_path("paper.toml"),
-        &out,
-        &[
-            "domain.lx=40",
-            "domain.ly=40",
-            "cells.count=8",
-            "run.relax_time=2",
-            "run.time=2",
-            "run.output_every=2",
-        ],
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
+    small_paper_run(&out, "run.output_every=2");
     let read = |what: &str, args: &[&str], to: &Path| {
         let o = bin().args(args).output().unwrap();
         assert!(o.status.success(), "{what}: {}", stderr(&o));

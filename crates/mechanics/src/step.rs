@@ -110,6 +110,34 @@ impl StepCheck for StateCheck {
     }
 }
 
+/// The error of a state at `(step, time)` whose slot `slot` has the range `range` outside
+/// `[−b, 1 + b]` (or a non-finite centre, `nan`): [`StepError::NonFinite`] when anything is
+/// not finite, [`StepError::Unstable`] with the offending bound otherwise.
+fn range_error(
+    slot: usize,
+    range: [f64; 2],
+    nan: bool,
+    (step, time): (u64, f64),
+    dt: f64,
+    b: f64,
+) -> StepError {
+    if nan || !range[0].is_finite() || !range[1].is_finite() {
+        StepError::NonFinite {
+            step,
+            time,
+            cell_idx: slot,
+        }
+    } else {
+        StepError::Unstable {
+            step,
+            time,
+            cell_idx: slot,
+            phi: if range[0] < -b { range[0] } else { range[1] },
+            dt,
+        }
+    }
+}
+
 /// Whether a field's range `[min, max]` is finite and inside `[−b, 1 + b]`.
 fn range_ok(range: [f64; 2], b: f64) -> bool {
     range[0] >= -b && range[1] <= 1.0 + b
@@ -371,22 +399,7 @@ impl<T: Real> Tissue<T> {
         h: f64,
         b: f64,
     ) -> StepError {
-        let (step, time) = (self.iteration + 1, self.time + h);
-        if nan || !range[0].is_finite() || !range[1].is_finite() {
-            StepError::NonFinite {
-                step,
-                time,
-                cell_idx: slot,
-            }
-        } else {
-            StepError::Unstable {
-                step,
-                time,
-                cell_idx: slot,
-                phi: if range[0] < -b { range[0] } else { range[1] },
-                dt: h,
-            }
-        }
+        range_error(slot, range, nan, (self.iteration + 1, self.time + h), h, b)
     }
 
     /// The check after a step whose new state is in the fields (a sweep of its own: the
@@ -419,24 +432,14 @@ impl<T: Real> Tissue<T> {
     /// at the tissue's clock.
     pub fn check_state(&self, b: f64, dt: f64) -> Result<(), StepError> {
         match self.first_out_of_band(b) {
-            Some((slot, range)) => {
-                let (step, time) = (self.iteration, self.time);
-                Err(if range[0].is_finite() && range[1].is_finite() {
-                    StepError::Unstable {
-                        step,
-                        time,
-                        cell_idx: slot,
-                        phi: if range[0] < -b { range[0] } else { range[1] },
-                        dt,
-                    }
-                } else {
-                    StepError::NonFinite {
-                        step,
-                        time,
-                        cell_idx: slot,
-                    }
-                })
-            }
+            Some((slot, range)) => Err(range_error(
+                slot,
+                range,
+                false,
+                (self.iteration, self.time),
+                dt,
+                b,
+            )),
             None => Ok(()),
         }
     }

@@ -242,7 +242,13 @@ impl PySimulation {
 }
 
 /// `every` (model time) or `steps` (iterations) as a schedule.
-fn schedule(every: Option<f64>, steps: Option<u64>) -> PyResult<Schedule> {
+/// `steps` is a Python int or NumPy integer ([`opt_whole`], named after `call`).
+fn schedule(
+    call: &str,
+    every: Option<f64>,
+    steps: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Schedule> {
+    let steps = opt_whole(call, "steps", steps, STEP_MAX)?;
     match (every, steps) {
         (Some(t), None) if t > 0.0 && t.is_finite() => Ok(Schedule::TimeInterval(t)),
         (None, Some(n)) if n > 0 => Ok(Schedule::IterationInterval(n)),
@@ -666,8 +672,7 @@ impl PySimulation {
         every: Option<f64>,
         steps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let steps = opt_whole("add_callback", "steps", steps, STEP_MAX)?;
-        let schedule = schedule(every, steps)?;
+        let schedule = schedule("add_callback", every, steps)?;
         let errors = self.errors.clone();
         macro_rules! callback {
             ($s:ident, $T:ty) => {{
@@ -749,8 +754,7 @@ impl PySimulation {
         every: Option<f64>,
         steps: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let steps = opt_whole("add_fix", "steps", steps, STEP_MAX)?;
-        let schedule = schedule(every, steps)?;
+        let schedule = schedule("add_fix", every, steps)?;
         let errors = self.errors.clone();
         let check = ParamCheck::new(&self.scene);
         macro_rules! fix {

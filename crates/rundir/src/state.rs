@@ -109,16 +109,26 @@ pub fn not_carried(scene: &Scene) -> std::result::Result<Vec<String>, StateError
     let Some(from) = scene.init_from() else {
         return Ok(Vec::new());
     };
-    let names = crate::frame::npz_names(Path::new(from)).map_err(|error| StateError::Read {
+    Ok(not_carried_of(scene, &array_names(from)?))
+}
+
+/// The arrays of the state file `from`.
+fn array_names(from: &str) -> std::result::Result<Vec<String>, StateError> {
+    crate::frame::npz_names(Path::new(from)).map_err(|error| StateError::Read {
         from: from.to_string(),
         error,
-    })?;
+    })
+}
+
+/// [`not_carried`] of a file whose arrays are `names`.
+fn not_carried_of(scene: &Scene, names: &[String]) -> Vec<String> {
     let ext = scene.configured_extensions();
     let carried: Vec<String> = ext.frame_arrays().into_iter().map(|a| a.name).collect();
-    Ok(names
-        .into_iter()
+    names
+        .iter()
         .filter(|n| !CORE_ARRAYS.contains(&n.as_str()) && !carried.contains(n))
-        .collect())
+        .cloned()
+        .collect()
 }
 
 /// The saved state `scene` starts from (`init = "frame"`; `None` for the other layouts),
@@ -207,17 +217,15 @@ pub fn state_warnings(scene: &Scene) -> std::result::Result<Vec<String>, StateEr
         return Ok(Vec::new());
     };
     let mut out = Vec::new();
-    let dropped = not_carried(scene)?;
+    // The file's arrays, read once for both warnings.
+    let names = array_names(from)?;
+    let dropped = not_carried_of(scene, &names);
     if !dropped.is_empty() {
         out.push(format!(
             "[cells] from = {from:?}: its arrays {} are not carried: the scene has no part that keeps them; add that part's table to the scene to carry them",
             dropped.join(", ")
         ));
     }
-    let names = crate::frame::npz_names(Path::new(from)).map_err(|error| StateError::Read {
-        from: from.to_string(),
-        error,
-    })?;
     if let Some(angle) = scene.file().polarity.as_ref().and_then(|p| p.angle) {
         if names.iter().any(|n| n == "polarity.theta") {
             out.push(format!(

@@ -91,3 +91,13 @@ pub fn quarter_scene(text: &str) -> String {
     }
     out
 }
+
+/// The step a step error names (`... at step N (t = ...)`): the last "at step" of a message,
+/// since the first is where the run stopped, before it.
+pub fn error_step(err: &str) -> u64 {
+    err.rsplit("at step ")
+        .next()
+        .and_then(|r| r.split(|c: char| !c.is_ascii_digit()).next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no step in {err}"))
+}
