@@ -334,6 +334,32 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
     assert!(!dir.path().join("out/series.csv").exists());
     let (ok, err, _d) = run_text(GOOD, &["--max-memory", "lots"]);
     assert!(!ok && err.contains("give a size such as 8G"), "{err}");
+    // A --max-memory above what the machine has lets the estimate through; the allocator's
+    // refusal is then the same kind of error, before the directory is written, and not an
+    // abort in the first large allocation (issue 53: a 256 GiB lattice aborted with
+    // "memory allocation of 206158430208 bytes failed" and left run.json behind). The kernel
+    // refuses 256 GiB at once unless it overcommits without a check (vm.overcommit_memory = 1).
+    let overcommits = std::fs::read_to_string("/proc/sys/vm/overcommit_memory")
+        .is_ok_and(|m| m.trim() == "1");
+    if !overcommits {
+        let (ok, err, dir) = run_text(
+            GOOD,
+            &[
+                "--set",
+                "domain.lx=65536",
+                "--set",
+                "domain.ly=65536",
+                "--max-memory",
+                "100000T",
+            ],
+        );
+        assert!(!ok, "a run the allocator refuses must fail");
+        for n in ["needs about", "allocator refused", "[domain] lx and ly"] {
+            assert!(err.contains(n), "{err:?} lacks {n:?}");
+        }
+        assert!(!err.contains("memory allocation of"), "{err}");
+        assert!(!dir.path().join("out").exists(), "nothing is written");
+    }
     let (ok, err, _d) = run_text(
         GOOD,
         &["--set", "domain.lx=20000", "--set", "domain.ly=20000"],

@@ -886,16 +886,26 @@ pub fn render_dir<'py>(
         .collect())
 }
 
-/// Drives the run directory `dir` to its end (or a Ctrl-C) with the lock released.
+/// Drives the run directory `dir` to its end (or a Ctrl-C) with the lock released, on
+/// `pool`. A run that cannot be built is refused before its first step; `fresh` is then the
+/// directory this call created, removed again so that the refusal leaves nothing behind.
 fn drive<T: Real>(
     py: Python<'_>,
     dir: &RunDir,
-    threads: Option<usize>,
+    pool: rayon::ThreadPool,
     progress: Option<Py<PyAny>>,
     interrupt: Interrupt,
+    fresh: Option<&std::path::Path>,
 ) -> PyResult<Py<PyDict>> {
-    let pool = pool(threads)?;
-    let (mut sim, written) = dir.simulation::<T>().map_err(run_error)?;
+    let (mut sim, written) = match dir.simulation::<T>() {
+        Ok(built) => built,
+        Err(e) => {
+            if let Some(out) = fresh {
+                let _ = std::fs::remove_dir_all(out);
+            }
+            return Err(run_error(e));
+        }
+    };
     let errors: ErrorSlot = Arc::default();
     let now = sim.tissue().time();
     let end = dir.scene().end_time();
@@ -941,13 +951,14 @@ fn drive<T: Real>(
 fn drive_any(
     py: Python<'_>,
     dir: &RunDir,
-    threads: Option<usize>,
+    pool: rayon::ThreadPool,
     progress: Option<Py<PyAny>>,
     interrupt: Interrupt,
+    fresh: Option<&std::path::Path>,
 ) -> PyResult<Py<PyDict>> {
     match dir.scene().precision() {
-        Precision::F64 => drive::<f64>(py, dir, threads, progress, interrupt),
-        Precision::F32 => drive::<f32>(py, dir, threads, progress, interrupt),
+        Precision::F64 => drive::<f64>(py, dir, pool, progress, interrupt, fresh),
+        Precision::F32 => drive::<f32>(py, dir, pool, progress, interrupt, fresh),
     }
 }
 
@@ -973,6 +984,8 @@ pub fn run_dir(
     }
     // Before anything is allocated or written: a refused run leaves no directory.
     memory_guard(s)?;
+    let pool = pool(threads)?;
+    let fresh = !out.exists();
     let state = rundir::initial_state(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
     let mut warnings = s.warnings();
     warnings.extend(rundir::state_warnings(s).map_err(|e| scene_error(scene.path.as_deref(), e))?);
@@ -985,7 +998,11 @@ pub fn run_dir(
                 "choose another out or pass overwrite=True",
             ))
         })?;
-    Ok((drive_any(py, &dir, threads, progress, interrupt)?, warnings))
+    let fresh = fresh.then_some(out.as_path());
+    Ok((
+        drive_any(py, &dir, pool, progress, interrupt, fresh)?,
+        warnings,
+    ))
 }
 
 /// Continues the run in `dir` from its latest checkpoint to the end of its scene (to
@@ -1016,5 +1033,6 @@ pub fn resume_dir(
             dir.display()
         )));
     }
-    drive_any(py, &run, threads, progress, interrupt)
+    let pool = pool(threads)?;
+    drive_any(py, &run, pool, progress, interrupt, None)
 }

@@ -148,6 +148,14 @@ def test_a_scene_too_large_for_memory_is_a_memory_error_and_writes_nothing(tmp_p
     assert not out.exists()
 
 
+def test_a_refused_run_leaves_no_directory(root, tmp_path):
+    # threads = 0 was refused only after the directory held run.json and scene.toml.
+    out = tmp_path / "never"
+    with pytest.raises(ValueError, match="threads = 0"):
+        ml.run(small_paper(root), out, threads=0, progress=False)
+    assert not out.exists()
+
+
 def test_a_sweep_names_its_points_as_the_command_line_and_refuses_a_comma(tmp_path):
     names = [p.name for p in ml.sweep(single(), {"model.zeta": [0.0, 0.005]}, None, None)]
     # As `monolayer sweep --vary model.zeta=0,0.005` names them (not `model.zeta=0.0`).

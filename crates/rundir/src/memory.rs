@@ -14,7 +14,7 @@ pub struct MemoryError {
     pub message: String,
     /// The estimate, in bytes.
     pub needed: f64,
-    /// The limit, in bytes.
+    /// The limit, in bytes (zero where the allocator refused the estimate itself).
     pub limit: f64,
 }
 
@@ -130,10 +130,10 @@ pub fn check_memory(
     limit: Option<(f64, String)>,
     flag: &str,
 ) -> Result<(), MemoryError> {
-    let Some((limit, what)) = limit.or_else(memory_limit) else {
-        return Ok(());
-    };
     let est = scene.memory_estimate() * runs.max(1) as f64;
+    let Some((limit, what)) = limit.or_else(memory_limit) else {
+        return reserve(scene, est);
+    };
     if est > limit {
         let f = scene.file();
         let shape = scene.patch_shape();
@@ -166,5 +166,28 @@ pub fn check_memory(
             limit,
         });
     }
-    Ok(())
+    reserve(scene, est)
+}
+
+/// Asks the allocator once for the whole estimate and gives it back at once, so that a run
+/// the limits allow but the allocator would refuse (a `--max-memory` above what the machine
+/// has, the kernel's overcommit rule, an estimate that no limit could be read for) is this
+/// error, and not an abort in the first large allocation after the run directory is written.
+/// Nothing is touched: the pages are only mapped and unmapped, which takes microseconds.
+fn reserve(scene: &Scene, est: f64) -> Result<(), MemoryError> {
+    let bytes = est.ceil().min(isize::MAX as f64) as usize;
+    if Vec::<u8>::new().try_reserve_exact(bytes).is_ok() {
+        return Ok(());
+    }
+    Err(MemoryError {
+        message: format!(
+            "the run needs about {} ({} cell(s) on a {}×{} lattice), and the allocator refused that much memory; reduce [cells] count, [domain] lx and ly or [integrator] margin, or run it on a machine with more memory",
+            gib(est),
+            scene.max_cells(),
+            scene.file().domain.lx,
+            scene.file().domain.ly,
+        ),
+        needed: est,
+        limit: 0.0,
+    })
 }
