@@ -339,8 +339,8 @@ fn bad_scenes_are_rejected_with_the_key_and_the_fix() {
     // abort in the first large allocation (issue 53: a 256 GiB lattice aborted with
     // "memory allocation of 206158430208 bytes failed" and left run.json behind). The kernel
     // refuses 256 GiB at once unless it overcommits without a check (vm.overcommit_memory = 1).
-    let overcommits = std::fs::read_to_string("/proc/sys/vm/overcommit_memory")
-        .is_ok_and(|m| m.trim() == "1");
+    let overcommits =
+        std::fs::read_to_string("/proc/sys/vm/overcommit_memory").is_ok_and(|m| m.trim() == "1");
     if !overcommits {
         let (ok, err, dir) = run_text(
             GOOD,

@@ -292,3 +292,89 @@ print("ok")
         String::from_utf8_lossy(&py.stderr)
     );
 }
+
+/// The cells' ParaView file holds every per-cell array the frame has for the scene's parts,
+/// from the one table the render arrows and Python's cell table read (issue 48): with
+/// `[polarity]` and two populations, `polarity.theta`, the vector `polarity` `(p_x, p_y, 0)`
+/// and `population` (int32), each equal to the frame's own array row by row, as VTK's own
+/// reader reads them.
+#[test]
+fn the_cells_file_holds_every_part_array_of_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[domain]\nlx = 60\nly = 60\n[cells]\ncount = 8\nradius = 6.0\n\
+         [[population]]\nname = \"a\"\ncount = 5\n[[population]]\nname = \"b\"\ncount = 3\n\
+         [polarity]\nalpha = 0.04\nrotational_diffusion = 1e-3\n\
+         [run]\nrelax_time = 2.0\ntime = 4.0\noutput_every = 2.0\n",
+    )
+    .unwrap();
+    let run = dir.path().join("run");
+    let o = bin()
+        .arg("run")
+        .arg(&scene)
+        .arg("--out")
+        .arg(&run)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = bin()
+        .args(["export", "vtk"])
+        .arg(&run)
+        .arg("-q")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let have = Command::new("python3")
+        .args(["-c", "import vtkmodules.vtkIOXML, numpy"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have {
+        assert!(
+            std::env::var("CI").is_err(),
+            "CI must install vtk (see .ci/run)"
+        );
+        eprintln!("the vtk Python package is not installed: skipping VTK's reader");
+        return;
+    }
+    let script = format!(
+        r#"
+import glob, os
+import numpy as np
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+from vtkmodules.util.numpy_support import vtk_to_numpy
+run = "{run}"
+frames = sorted(glob.glob(os.path.join(run, "frames", "frame_*.npz")))
+assert len(frames) >= 2
+for f in frames:
+    z = np.load(f)
+    step = os.path.basename(f)[len("frame_"):-len(".npz")]
+    r = vtkXMLPolyDataReader(); r.SetFileName(os.path.join(run, "vtk", f"cells_{{step}}.vtp")); r.Update()
+    pd = r.GetOutput().GetPointData()
+    names = [pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays())]
+    for name in ("polarity.theta", "polarity", "population"):
+        assert name in names, (name, names)
+    theta = vtk_to_numpy(pd.GetArray("polarity.theta"))
+    assert np.array_equal(theta, z["polarity.theta"]), (theta, z["polarity.theta"])
+    p = vtk_to_numpy(pd.GetArray("polarity"))
+    assert p.shape == (8, 3) and np.array_equal(p[:, :2], z["polarity"]) and not p[:, 2].any()
+    pop = vtk_to_numpy(pd.GetArray("population"))
+    assert pop.dtype == np.int32 and np.array_equal(pop, z["population"]), (pop, z["population"])
+    assert sorted(set(pop.tolist())) == [0, 1]
+print("ok")
+"#,
+        run = run.display()
+    );
+    let py = Command::new("python3")
+        .args(["-c", &script])
+        .output()
+        .unwrap();
+    assert!(
+        py.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&py.stdout),
+        String::from_utf8_lossy(&py.stderr)
+    );
+}

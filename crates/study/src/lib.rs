@@ -42,7 +42,10 @@
 #![deny(missing_docs)]
 
 pub mod analyze;
+mod error;
+mod frame;
 mod plan;
+mod region;
 mod slurm;
 mod spec;
 pub mod summary;

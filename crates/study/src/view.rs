@@ -15,7 +15,6 @@
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use analysis::defects::detect;
 use analysis::smooth::box_smooth;
 use mechanics::division::{Ending, LineageRecord};
 use mechanics::{TissueFields, Workspace};
@@ -27,10 +26,11 @@ use rundir::vtk::{write_pvd, write_vti, write_vtp, VtkArray, VtkValues};
 use rundir::RunDirError;
 use scene::Scene;
 
-use crate::analyze::{
-    default_box, list_frames, load_frame, read_scene, AnalyzeError, FrameList, FrameNotes,
-    LoadedFrame,
+use crate::error::AnalyzeError;
+use crate::frame::{
+    default_box, list_frames, load_frame, read_scene, FrameList, FrameNotes, LoadedFrame,
 };
+pub use crate::region::{in_tissue, TISSUE_COVER, TISSUE_Q};
 
 /// What stops a render or an export.
 #[derive(Debug, thiserror::Error)]
@@ -235,7 +235,7 @@ impl Run {
             }
         };
         let lineage = rundir::read_lineage(run_dir).map_err(|e| {
-            ViewError::Run(crate::analyze::input(
+            ViewError::Run(crate::error::input(
                 &run_dir.join("lineage.csv"),
                 e.to_string(),
             ))
@@ -257,14 +257,14 @@ impl Run {
         let mut tracks: std::collections::BTreeMap<usize, Vec<[f64; 2]>> = Default::default();
         for (step, path) in self.all.iter().filter(|(s, _)| *s <= last) {
             let err = |e: rundir::RunDirError| {
-                ViewError::Run(crate::analyze::input(
+                ViewError::Run(crate::error::input(
                     path,
                     format!("{e} (frame at step {step})"),
                 ))
             };
             let a = rundir::read_npz(path, &["centre"]).map_err(err)?;
             let centres: Vec<[f64; 2]> = a[0].data.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-            let ids = crate::analyze::frame_ids(path, centres.len())?;
+            let ids = crate::frame::frame_ids(path, centres.len())?;
             for (id, c) in ids.into_iter().zip(centres) {
                 tracks.entry(id).or_default().push(c);
             }
@@ -280,7 +280,7 @@ impl Run {
             self.scene.lattice(),
         )?;
         if let Some(lineage) = &self.lineage {
-            crate::analyze::check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
+            crate::frame::check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
         }
         Ok(frame)
     }
@@ -315,51 +315,6 @@ fn cell_means(frame: &LoadedFrame, nx: usize, ny: usize, field: &[f64]) -> Vec<f
             num / den
         })
         .collect()
-}
-
-/// Draws one frame.
-/// The least share of the smoothing box that cells must cover (box-smoothed `Σ φ_i`) for
-/// `render` to draw the director and defects there: half, so that the thin gaps at cell
-/// junctions count as tissue and the gaps between initial discs (a third covered at the
-/// paper's density and R/2 discs) do not.
-pub const TISSUE_COVER: f64 = 0.5;
-
-/// The least smoothed `|Q|` where `render` draws the director and defects: a twentieth of the
-/// deformation of a cell in a confluent tissue at the paper's parameters (`|S_i|` ≈ 1–2), far
-/// above that of the round initial discs (zero but for the lattice's anisotropy).
-pub const TISSUE_Q: f64 = 0.05;
-
-/// Where `render` draws the director (a mask over the nodes) and which defects of the smoothed
-/// `Q` (`qxx`, `qxy`) it draws: where cells cover at least [`TISSUE_COVER`] of the smoothing box
-/// of side `side` (`phi_sum` is `Σ φ_i`), and `|Q|` is at least [`TISSUE_Q`], at the node for the
-/// director and averaged over the box around a defect (`|Q|` vanishes at a defect's core).
-///
-/// # Errors
-/// A box that does not fit the lattice.
-pub fn in_tissue(
-    l: phasefield::Lattice,
-    side: usize,
-    phi_sum: &[f64],
-    qxx: &[f64],
-    qxy: &[f64],
-) -> Result<(Vec<bool>, Vec<analysis::defects::Defect>)> {
-    let smooth = |v: &[f64]| box_smooth(l, v, side).map_err(|e| ViewError::Options(e.to_string()));
-    let cover = smooth(phi_sum)?;
-    let q_mag: Vec<f64> = qxx.iter().zip(qxy).map(|(a, b)| a.hypot(*b)).collect();
-    let q_around = smooth(&q_mag)?;
-    let tissue = (0..cover.len())
-        .map(|k| cover[k] >= TISSUE_COVER && q_mag[k] >= TISSUE_Q)
-        .collect();
-    let defects = detect(l, qxx, qxy)
-        .into_iter()
-        .filter(|d| {
-            let x = (d.x.round() as usize) % l.lx;
-            let y = (d.y.round() as usize) % l.ly;
-            let k = x * l.ly + y;
-            cover[k] >= TISSUE_COVER && q_around[k] >= TISSUE_Q
-        })
-        .collect();
-    Ok((tissue, defects))
 }
 
 /// The lineage record of the cell `id`, if the run has one.
@@ -489,9 +444,10 @@ fn picture(
             // is noise). Tissue is where cells cover at least TISSUE_COVER of the smoothing box
             // and |Q| is at least TISSUE_Q: at the node for a director segment, averaged over
             // the box around it for a defect (|Q| vanishes at a defect's own core).
-            let (phi_sum, _) = phi_sum_and_owner(frame, shape.nx, shape.ny);
+            let (phi_sum, _) = frame.phi_sum_and_owner(shape.nx, shape.ny);
             let phi_sum: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
-            let (tissue, defects) = in_tissue(l, side, &phi_sum, &qxx, &qxy)?;
+            let (tissue, defects) = in_tissue(l, side, &phi_sum, &qxx, &qxy)
+                .map_err(|e| ViewError::Options(e.to_string()))?;
             if opts.defects {
                 p.defects = defects;
             }
@@ -548,10 +504,11 @@ fn picture(
             .collect();
     }
     if opts.polarity {
-        if let Some(theta) = frame.tissue.terms().state("polarity") {
+        // The parts' first per-cell vector (a 2-column array of the frame: `polarity`).
+        if let Some(v) = frame.part_arrays().into_iter().find(|a| a.columns == 2) {
             p.polarity = Some(CellArrows {
                 centres: frame.centres.clone(),
-                directions: theta.iter().map(|t| [t.cos(), t.sin()]).collect(),
+                directions: v.values.chunks_exact(2).map(|d| [d[0], d[1]]).collect(),
             });
         }
     }
@@ -675,31 +632,6 @@ pub fn render_run(
     })
 }
 
-/// `Σ_i φ_i` at every node, and the cell with the largest `φ_i` where that exceeds ½ (−1
-/// elsewhere).
-pub(crate) fn phi_sum_and_owner(frame: &LoadedFrame, nx: usize, ny: usize) -> (Vec<f32>, Vec<i32>) {
-    let l = frame.tissue.lattice();
-    let mut sum = vec![0.0f64; l.len()];
-    let mut best = vec![0.5f64; l.len()];
-    let mut owner = vec![-1i32; l.len()];
-    for (i, o) in frame.origins.iter().enumerate() {
-        let phi = &frame.phi[i * nx * ny..(i + 1) * nx * ny];
-        for u in 0..nx {
-            let x = (o[0] + u) % l.lx;
-            for v in 0..ny {
-                let k = x * l.ly + (o[1] + v) % l.ly;
-                let f = phi[u * ny + v];
-                sum[k] += f;
-                if f > best[k] {
-                    best[k] = f;
-                    owner[k] = i as i32;
-                }
-            }
-        }
-    }
-    (sum.into_iter().map(|v| v as f32).collect(), owner)
-}
-
 fn f32s(v: &[f64]) -> VtkValues {
     VtkValues::F32(v.iter().map(|&x| x as f32).collect())
 }
@@ -715,7 +647,7 @@ fn interleave(parts: &[&[f64]]) -> VtkValues {
 
 /// The point arrays of one frame's `.vti` (see [`export_vtk`]).
 fn field_arrays(frame: &LoadedFrame, f: &TissueFields, nx: usize, ny: usize) -> Vec<VtkArray> {
-    let (phi_sum, owner) = phi_sum_and_owner(frame, nx, ny);
+    let (phi_sum, owner) = frame.phi_sum_and_owner(nx, ny);
     let zero = vec![0.0; f.vx.len()];
     let (dx, dy): (Vec<f64>, Vec<f64>) = f
         .qxx
@@ -756,7 +688,6 @@ fn field_arrays(frame: &LoadedFrame, f: &TissueFields, nx: usize, ny: usize) -> 
 
 /// The points and point arrays of one frame's `.vtp` (see [`export_vtk`]).
 fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
-    let n = frame.centres.len();
     let points = frame.centres.iter().map(|c| [c[0], c[1], 0.0]).collect();
     let axis: Vec<f64> = frame
         .shapes
@@ -792,18 +723,21 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
         VtkArray::new("area", 1, VtkValues::F64(frame.areas.clone())),
     ];
     let mut arrays = arrays;
-    let tissue = &frame.tissue;
-    if !tissue.populations().is_empty() {
-        let pops = (0..n).map(|id| tissue.populations().population(id) as i32);
-        arrays.push(VtkArray::new(
-            "population",
-            1,
-            VtkValues::I32(pops.collect()),
-        ));
-    }
-    if let Some(theta) = tissue.terms().state("polarity") {
-        let p = theta.iter().flat_map(|t| [t.cos(), t.sin(), 0.0]).collect();
-        arrays.push(VtkArray::new("polarity", 3, VtkValues::F64(p)));
+    // Every per-cell array of the parts, as Python's cell table has them: a whole number as
+    // int32, a 2-column array as a vector `(x, y, 0)`.
+    for a in frame.part_arrays() {
+        let values = match (a.columns, a.integer) {
+            (1, true) => VtkValues::I32(a.values.iter().map(|&v| v as i32).collect()),
+            (2, _) => VtkValues::F64(
+                a.values
+                    .chunks_exact(2)
+                    .flat_map(|v| [v[0], v[1], 0.0])
+                    .collect(),
+            ),
+            _ => VtkValues::F64(a.values.clone()),
+        };
+        let components = if a.columns == 2 { 3 } else { a.columns };
+        arrays.push(VtkArray::new(a.name, components, values));
     }
     (points, arrays)
 }
@@ -813,7 +747,7 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
 /// | file | what |
 /// |---|---|
 /// | `fields_STEP.vti` | ImageData `lx × ly × 1`, spacing 1; point arrays (float32 unless said): `phi_sum` `Σ_i φ_i`; `cell_id` (int32) the cell with the largest `φ_i` at the node, −1 where none exceeds ½; `velocity` `(v_x, v_y, 0)`; `Q` `(Q_xx, Q_xy)`; `director` `|Q| (cos θ, sin θ, 0)`; `pressure`; `sigma_xx`, `sigma_yy`, `sigma_xy`; with `[walls]` `wall`, the wall field `w` in effect at the frame's time |
-/// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area`; with `[[population]]` `population` (int32), with `[polarity]` `polarity` `(p_x, p_y, 0)` |
+/// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area`; and every per-cell array of the scene's parts, as the frame has it (a whole number as int32, a 2-column array as a vector `(x, y, 0)`): with `[polarity]` `polarity.theta` and `polarity` `(p_x, p_y, 0)`, with `[[population]]` `population` (int32) |
 /// | `fields.pvd`, `cells.pvd` | the time series (each file with its frame's time) |
 ///
 /// Every file also holds its time as the field `TimeValue`. `progress(done, total)` is called
@@ -865,47 +799,4 @@ pub fn export_vtk(
         notes: run.notes.clone(),
         files: vec![a, b],
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use phasefield::Lattice;
-
-    /// A `+½` defect near the centre of a 40² lattice: `Q = s (cos 2θ, sin 2θ)` with
-    /// `θ = ½ atan2(y, x)` about it, `s` the magnitude.
-    fn plus_half(l: Lattice, s: f64) -> (Vec<f64>, Vec<f64>) {
-        let (mut qxx, mut qxy) = (vec![0.0; l.len()], vec![0.0; l.len()]);
-        for x in 0..l.lx {
-            for y in 0..l.ly {
-                let phi = (y as f64 - 20.3).atan2(x as f64 - 20.3);
-                qxx[x * l.ly + y] = s * phi.cos();
-                qxy[x * l.ly + y] = s * phi.sin();
-            }
-        }
-        (qxx, qxy)
-    }
-
-    /// The defect is drawn in covered, ordered tissue; not where cells cover a third of the
-    /// box (the gaps between initial discs), nor where `|Q|` is below the threshold (round
-    /// discs); the director mask follows the same rules node by node.
-    #[test]
-    fn defects_and_the_director_are_drawn_only_in_tissue() {
-        let l = Lattice::new(40, 40);
-        let full = vec![1.0; l.len()];
-        let sparse = vec![0.3; l.len()];
-        let (qxx, qxy) = plus_half(l, 1.0);
-        let (mask, d) = in_tissue(l, 9, &full, &qxx, &qxy).unwrap();
-        // Every defect of the field is kept (the periodic seams add three to the one placed).
-        assert_eq!(d, detect(l, &qxx, &qxy));
-        assert!(d
-            .iter()
-            .any(|d| (d.x - 20.5).abs() < 1.0 && (d.charge - 0.5).abs() < 1e-12));
-        assert!(mask.iter().filter(|&&m| m).count() > l.len() - 10);
-        let (mask, d) = in_tissue(l, 9, &sparse, &qxx, &qxy).unwrap();
-        assert!(d.is_empty() && mask.iter().all(|&m| !m));
-        let (weak_xx, weak_xy) = plus_half(l, 0.5 * TISSUE_Q);
-        let (mask, d) = in_tissue(l, 9, &full, &weak_xx, &weak_xy).unwrap();
-        assert!(d.is_empty() && mask.iter().all(|&m| !m));
-    }
 }

@@ -95,6 +95,16 @@ pub trait CellTerm: Send + Sync + fmt::Debug + std::any::Any {
         Vec::new()
     }
 
+    /// Tissue-level observables the term defines from its state, over the cells whose
+    /// identities are `ids` (`x` holds `state_names().len()` values per identity), each as
+    /// `(name, value)`: the polar order `|⟨p_i⟩|` of [`Polarity`], for example. The analysis
+    /// of a run (`observables.csv`) reads them here, so that a term brings its own; empty (the
+    /// default) for none.
+    fn observables(&self, x: &[f64], ids: &[usize]) -> Vec<(&'static str, f64)> {
+        let _ = (x, ids);
+        Vec::new()
+    }
+
     /// The initial state of cell `id` into `out` (`state_names().len()` values); `keys(k)` is
     /// a distinct [`NoiseKey`] for each `k`, to draw from.
     fn initial_state(&self, id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {
@@ -316,6 +326,15 @@ impl Terms {
             }
         }
         out
+    }
+
+    /// Every term's tissue-level observables ([`CellTerm::observables`]) over the cells
+    /// whose identities are `ids`, term by term in the order added.
+    pub fn observables(&self, ids: &[usize]) -> Vec<(&'static str, f64)> {
+        self.entries
+            .iter()
+            .flat_map(|e| e.term.observables(&e.x, ids))
+            .collect()
     }
 
     /// Every quantity the terms derive from their state ([`CellTerm::derived`]) as

@@ -242,6 +242,16 @@ impl CellTerm for Polarity {
         )]
     }
 
+    /// `polar_order`: `|⟨p_i⟩|`, the length of the mean unit polarity (1 when all point the
+    /// same way, about `1/√N` for random angles; NaN for no cell).
+    fn observables(&self, x: &[f64], ids: &[usize]) -> Vec<(&'static str, f64)> {
+        let (c, s) = ids
+            .iter()
+            .fold((0.0, 0.0), |(c, s), &id| (c + x[id].cos(), s + x[id].sin()));
+        let n = ids.len() as f64;
+        vec![("polar_order", (c / n).hypot(s / n))]
+    }
+
     fn initial_state(&self, _id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {
         out[0] = match self.initial_angle {
             Some(theta) => theta,
@@ -287,5 +297,25 @@ impl CellTerm for Polarity {
         } else {
             0.0
         };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The polar order is 1 for cells that all point one way, 0 for two opposite pairs, and
+    /// reads only the cells it is given (the third cell, pointing elsewhere, is left out).
+    #[test]
+    fn the_polar_order_is_the_length_of_the_mean_polarity() {
+        let p = Polarity::new(0.01);
+        let x = [0.3, 0.3, 2.0, 0.3];
+        let order = |x: &[f64], ids: &[usize]| p.observables(x, ids)[0];
+        assert_eq!(order(&x, &[0, 1, 3]).0, "polar_order");
+        assert!((order(&x, &[0, 1, 3]).1 - 1.0).abs() < 1e-15);
+        assert!(order(&x, &[0, 1, 2]).1 < 0.9);
+        let pi = std::f64::consts::PI;
+        let opposite = [0.0, pi, 0.5 * pi, -0.5 * pi];
+        assert!(order(&opposite, &[0, 1, 2, 3]).1 < 1e-15);
     }
 }
