@@ -2,7 +2,7 @@
 //! on any margin and precision, and a state that does not fit is refused before anything is
 //! written.
 
-use crate::common::paper;
+use crate::common::{check_rejected, paper};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -200,14 +200,7 @@ fn a_state_that_does_not_fit_is_refused_with_the_key_and_the_fix() {
         let out = dir.path().join(format!("bad{i}"));
         let mut set = vec!["cells.init=\"frame\""];
         set.extend_from_slice(extra);
-        let o = run(&paper(), &out, &set, &[]);
-        let e = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success(), "{set:?} ran");
-        for w in *want {
-            assert!(e.contains(w), "{set:?}: {w:?} not in {e}");
-        }
-        assert!(!e.contains("panicked"), "{e}");
-        assert!(!out.exists(), "{set:?} made {}", out.display());
+        check_rejected(&paper(), &out, &set, want);
     }
 }
 

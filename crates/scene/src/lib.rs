@@ -578,3 +578,19 @@ impl Scene {
         }
     }
 }
+
+/// `Scene::parse(base, overrides)` must be refused with every string of `expect` in the
+/// message (the key, the value, the fix): the one check of a bad value's refusal that the
+/// scene's validation tests share (the command line's tests have its twin,
+/// `crates/cli/tests/common`, which also checks the exit status and that nothing is written).
+#[cfg(test)]
+pub(crate) fn check_rejected(base: &str, overrides: &[&str], expect: &[&str]) {
+    let set: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let e = match Scene::parse(base, &set) {
+        Ok(_) => panic!("{overrides:?} must be refused"),
+        Err(e) => e.to_string(),
+    };
+    for w in expect {
+        assert!(e.contains(w), "{overrides:?}: {e:?} lacks {w:?}");
+    }
+}

@@ -357,7 +357,8 @@ pub(crate) fn check_lineage(
             .filter(|r| r.id == id);
         let reason = match alive {
             None => format!("cell {id} of this frame is not in lineage.csv"),
-            Some(r) if r.birth > time + 1e-9 => format!(
+            // A founder is there from the start, whatever its cycle's phase says.
+            Some(r) if r.parent.is_some() && r.birth > time + 1e-9 => format!(
                 "cell {id} of this frame (t = {time}) was born at t = {} by lineage.csv",
                 r.birth
             ),

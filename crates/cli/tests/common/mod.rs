@@ -101,3 +101,31 @@ pub fn error_step(err: &str) -> u64 {
         .and_then(|n| n.parse().ok())
         .unwrap_or_else(|| panic!("no step in {err}"))
 }
+
+/// `monolayer run BASE --set OVERRIDE ...` must be refused: exit status 1, every string of
+/// `expect` in the message (the key, the value, the fix), no panic, and no run directory
+/// written (`out` must not exist before). The one check of a bad value's refusal that the
+/// validation tests share.
+pub fn check_rejected(base: &Path, out: &Path, overrides: &[&str], expect: &[&str]) {
+    let mut c = bin();
+    c.arg("run").arg(base).arg("--out").arg(out).arg("--quiet");
+    for s in overrides {
+        c.arg("--set").arg(s);
+    }
+    let o = c.output().expect("the binary runs");
+    let err = stderr(&o);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{overrides:?} must be refused: {err}"
+    );
+    for e in expect {
+        assert!(err.contains(e), "{overrides:?}: {err:?} lacks {e:?}");
+    }
+    assert!(!err.contains("panicked"), "{overrides:?}: {err}");
+    assert!(
+        !out.exists(),
+        "{overrides:?}: the refused run wrote {}",
+        out.display()
+    );
+}

@@ -154,7 +154,9 @@ pub struct LineageRecord {
     pub id: usize,
     /// Its mother's identity (`None` for a founder).
     pub parent: Option<usize>,
-    /// When it was born (0 for a founder).
+    /// When it was born; for a founder, when its cycle started: the clock's start less a
+    /// uniform fraction of its cycle, so that founders do not divide together (it can lie
+    /// before the run, or inside its relaxation, while the founder is already there).
     pub birth: f64,
     /// When its life ended, and how (`None` while it lives).
     pub death: Option<(f64, Ending)>,
