@@ -126,6 +126,13 @@ impl<T: Real> Tissue<T> {
         self.iteration = iteration;
         self.time = time;
     }
+
+    /// Counts one step of `dt` taken (by a backend: the host's copy of the fields is brought
+    /// up to date later, [`Backend::sync`]); every step of the tissue's own counts itself.
+    pub(crate) fn advance_clock(&mut self, dt: f64) {
+        self.iteration += 1;
+        self.time += dt;
+    }
 }
 
 /// The parts of the extensions `ext` (with the model's `params`) that a backend supporting only

@@ -863,16 +863,7 @@ impl<T: Real> Simulation<T> {
         }
         let backend = self.backend.as_mut().expect("checked above");
         if fix_due {
-            for (name, timer, fix) in &mut self.fixes {
-                if timer.fires(iteration, time, false) {
-                    fix.apply(&mut self.tissue)
-                        .map_err(|source| SimulationError::Callback {
-                            name: name.clone(),
-                            iteration,
-                            source,
-                        })?;
-                }
-            }
+            apply_fixes(&mut self.fixes, &mut self.tissue)?;
             backend.upload(&self.tissue)?;
             self.synced_at = (iteration, time);
         }
@@ -963,9 +954,8 @@ impl<T: Real> Simulation<T> {
             let it = self.tissue.iteration();
             if let Some(backend) = &mut self.backend {
                 backend.step(&self.tissue, &self.step_params)?;
-                let before = self.tissue.time;
-                self.tissue.iteration += 1;
-                self.tissue.time += self.step_params.dt;
+                let before = self.tissue.time();
+                self.tissue.advance_clock(self.step_params.dt);
                 self.apply_activity();
                 self.proliferate_on_device(before)?;
                 self.after_device_step(start, stop)?;
@@ -1001,18 +991,29 @@ impl<T: Real> Simulation<T> {
                     why: why.name(),
                 });
             }
-            for (name, timer, fix) in &mut self.fixes {
-                if timer.fires(iteration, time, false) {
-                    fix.apply(&mut self.tissue)
-                        .map_err(|source| SimulationError::Callback {
-                            name: name.clone(),
-                            iteration,
-                            source,
-                        })?;
-                }
-            }
+            apply_fixes(&mut self.fixes, &mut self.tissue)?;
             self.fire(start, Hook::Call, stop)?;
         }
         Ok(())
     }
+}
+
+/// The fixes whose schedule fires at the tissue's clock, in the order added: each changes the
+/// tissue between steps (the host's copy; a device takes it back afterwards).
+fn apply_fixes<T: Real>(
+    fixes: &mut [(String, Timer, Box<dyn Fix<T>>)],
+    tissue: &mut Tissue<T>,
+) -> Result<(), SimulationError> {
+    let (iteration, time) = (tissue.iteration(), tissue.time());
+    for (name, timer, fix) in fixes {
+        if timer.fires(iteration, time, false) {
+            fix.apply(tissue)
+                .map_err(|source| SimulationError::Callback {
+                    name: name.clone(),
+                    iteration,
+                    source,
+                })?;
+        }
+    }
+    Ok(())
 }

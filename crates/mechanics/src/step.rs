@@ -194,8 +194,7 @@ impl<T: Real> Tissue<T> {
                 self.check_new_state(ws, dt, b)?;
             }
         }
-        self.iteration += 1;
-        self.time += dt;
+        self.advance_clock(dt);
         if step_params.npc > 0 {
             // The last corrector pass measured the new centres (`Post::Correct`).
             self.move_patches_to(&ws.next_centre);
@@ -698,8 +697,7 @@ mod tests {
         for _ in 0..sp.npc {
             t.correct::<false>(ws, sp.dt).expect("finite forces");
         }
-        t.iteration += 1;
-        t.time += sp.dt;
+        t.advance_clock(sp.dt);
         t.update_centres(&ws.com);
     }
 
