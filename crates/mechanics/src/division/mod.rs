@@ -351,20 +351,16 @@ impl Proliferation {
         1.0 + ((now - r.birth - r.cycle) / self.growth_time).clamp(0.0, 1.0)
     }
 
-    /// Fills `out` (by identity) with the target-area scale of every cell of `tissue` at its
-    /// time; empty without a growth phase. Grows `out` only when identities are added.
-    fn fill_target_scale<T: Real>(&self, tissue: &Tissue<T>, out: &mut Vec<f64>) {
-        self.fill_target_scale_at(tissue, tissue.time(), out);
-    }
-
-    /// [`Proliferation::fill_target_scale`] at the time `now`.
-    fn fill_target_scale_at<T: Real>(&self, tissue: &Tissue<T>, now: f64, out: &mut Vec<f64>) {
+    /// Fills `out` (by identity, below `next_id`) with the target-area scale at `now` of the
+    /// living cells `ids`; empty without a growth phase. Grows `out` only when identities are
+    /// added.
+    fn fill_target_scale(&self, ids: &[usize], next_id: usize, now: f64, out: &mut Vec<f64>) {
         if self.growth_time <= 0.0 {
             out.clear();
             return;
         }
-        out.resize(tissue.next_id(), 1.0);
-        for &id in tissue.cell_ids() {
+        out.resize(next_id, 1.0);
+        for &id in ids {
             out[id] = self
                 .record_of(id)
                 .map_or(1.0, |r| self.target_scale(r, now));
@@ -492,17 +488,24 @@ impl Proliferation {
         tissue: &mut Tissue<T>,
         ws: &mut Workspace<T>,
     ) -> Vec<Division> {
-        self.divide_due_except(tissue, ws, &[])
+        let due = self.due_divisions(tissue, ws, &[]);
+        let (divisions, places) = divide_cells(tissue, ws, due);
+        self.record_divisions(&divisions, &places, tissue.time());
+        divisions
     }
 
-    /// [`Proliferation::divide_due`], leaving out the cells `skip` (sorted; those about to be
-    /// removed).
-    fn divide_due_except<T: Real>(
-        &mut self,
-        tissue: &mut Tissue<T>,
-        ws: &mut Workspace<T>,
+    /// The divisions due in `tissue` now, decided from it and the evaluation in `ws` without
+    /// changing either: every cell whose age has reached its cycle and growth, but those in
+    /// `skip` (sorted; the cells about to be removed) and those the pressure gate holds back,
+    /// in the order of identities, as many as the cap leaves room for; each as its identity,
+    /// its slot and the direction of its split (its long axis, or a random one for a round
+    /// cell or `axis = "random"`).
+    fn due_divisions<T: Real>(
+        &self,
+        tissue: &Tissue<T>,
+        ws: &Workspace<T>,
         skip: &[usize],
-    ) -> Vec<Division> {
+    ) -> Vec<PlannedDivision> {
         let now = tissue.time();
         let mut due: Vec<(usize, usize)> = (0..tissue.n_cells())
             .map(|slot| (tissue.cell_ids()[slot], slot))
@@ -516,24 +519,23 @@ impl Proliferation {
             due.retain(|&(_, slot)| cell_pressure(tissue, ws, slot) <= p_max);
         }
         due.sort_unstable();
-        let mut out = Vec::with_capacity(due.len());
-        for (id, slot) in due {
-            if tissue.n_cells() >= self.max_cells {
-                break;
-            }
-            // The step computes S_i only when something needs it (activity, or a term): the
-            // mother's own, from her field. A round cell (to round-off) has no long axis.
-            let long = match self.axis {
-                SplitAxis::Long => {
-                    let (s, scale) = shape_tensor(tissue, slot);
-                    let (magnitude, axis) = s.axis();
-                    (magnitude > ROUND * scale).then(|| [axis.x, axis.y])
-                }
-                SplitAxis::Random => None,
-            };
-            let direction = match long {
-                Some(axis) => axis,
-                None => {
+        // Each division adds a cell: the cap is reached after this many.
+        due.truncate(self.max_cells.saturating_sub(tissue.n_cells()));
+        due.into_iter()
+            .map(|(id, slot)| {
+                // The step computes S_i only when something needs it (activity, or a term):
+                // the mother's own, from her field (a division changes only its mother's
+                // field, so every mother's is as the step left it). A round cell (to
+                // round-off) has no long axis.
+                let long = match self.axis {
+                    SplitAxis::Long => {
+                        let (s, scale) = shape_tensor(tissue, slot);
+                        let (magnitude, axis) = s.axis();
+                        (magnitude > ROUND * scale).then(|| [axis.x, axis.y])
+                    }
+                    SplitAxis::Random => None,
+                };
+                let direction = long.unwrap_or_else(|| {
                     let theta = 2.0
                         * std::f64::consts::PI
                         * NoiseKey {
@@ -544,10 +546,22 @@ impl Proliferation {
                         }
                         .uniform();
                     [theta.cos(), theta.sin()]
+                });
+                PlannedDivision {
+                    id,
+                    slot,
+                    direction,
                 }
-            };
-            let place = tissue.centres()[slot];
-            let d = tissue.divide(slot, direction);
+            })
+            .collect()
+    }
+
+    /// Records `divisions` in the lineage at `now`: each mother ends by division at her
+    /// place (`places`, her centre before the split), each daughter is born with her own
+    /// cycle, one generation on.
+    fn record_divisions(&mut self, divisions: &[Division], places: &[[f64; 2]], now: f64) {
+        for (d, &place) in divisions.iter().zip(places) {
+            let id = d.mother;
             let generation = self.lineage[id].generation + 1;
             self.lineage[id].death = Some((now, Ending::Division));
             self.lineage[id].place = place;
@@ -563,12 +577,7 @@ impl Proliferation {
                     cycle,
                 });
             }
-            out.push(d);
         }
-        if !out.is_empty() {
-            ws.fit(tissue.cells());
-        }
-        out
     }
 
     /// Records the end of the cell `id` at `time`, at `place`, for `why` (call it with the
@@ -649,17 +658,17 @@ impl<T: Real> Tissue<T> {
     /// The same tissue with a cell-cycle clock (and its extrusion rule and death rate), which
     /// [`Tissue::proliferate`] applies.
     pub fn with_proliferation(mut self, clock: Proliferation) -> Self {
-        self.set_target_scale(&clock);
         self.ext.proliferation = Some(Box::new(clock));
+        self.refresh_target_scale_at(self.time);
         self
     }
 
-    /// Sets each identity's target-area factor from `clock` (the growth phase) at the
-    /// tissue's time.
-    fn set_target_scale(&mut self, clock: &Proliferation) {
-        let mut scale = std::mem::take(&mut self.ext.target_scale);
-        clock.fill_target_scale(self, &mut scale);
-        self.ext.target_scale = scale;
+    /// Sets each identity's target-area factor from the clock (the growth phase) at `now`;
+    /// nothing without a clock.
+    fn refresh_target_scale_at(&mut self, now: f64) {
+        if let Some(clock) = self.ext.proliferation.as_deref() {
+            clock.fill_target_scale(&self.cell_id, self.next_id, now, &mut self.ext.target_scale);
+        }
     }
 
     /// The clock and the lineage, if cells divide.
@@ -671,10 +680,7 @@ impl<T: Real> Tissue<T> {
     /// leaves them: for a device's driver after a step without events, so that what the host
     /// evaluates (a frame, an observation) sees them.
     pub(crate) fn refresh_target_scale(&mut self) {
-        if let Some(clock) = self.ext.proliferation.take() {
-            self.set_target_scale(&clock);
-            self.ext.proliferation = Some(clock);
-        }
+        self.refresh_target_scale_at(self.time);
     }
 
     /// Whether [`Tissue::proliferate`] could do anything after this step, judged without the
@@ -693,15 +699,11 @@ impl<T: Real> Tissue<T> {
         if !self.active {
             return false;
         }
-        let Some(clock) = self.ext.proliferation.take() else {
+        self.refresh_target_scale_at(before);
+        let Some(clock) = self.proliferation() else {
             return false;
         };
-        let mut scale = std::mem::take(&mut self.ext.target_scale);
-        clock.fill_target_scale_at(self, before, &mut scale);
-        self.ext.target_scale = scale;
-        let pending = timed || !extruded(self, ws, &clock).is_empty();
-        self.ext.proliferation = Some(clock);
-        pending
+        timed || !extruded(self, ws, clock).is_empty()
     }
 
     /// Applies the clock after a step: the divisions that are due, then deaths at the death
@@ -719,10 +721,11 @@ impl<T: Real> Tissue<T> {
         if !self.active {
             return CellEvents::default();
         }
-        let Some(mut clock) = self.ext.proliferation.take() else {
+        // The clock decides from a read-only view of the tissue and the evaluation...
+        let Some(clock) = self.proliferation() else {
             return CellEvents::default();
         };
-        let mut removals: Vec<(usize, Ending)> = extruded(self, ws, &clock)
+        let mut removals: Vec<(usize, Ending)> = extruded(self, ws, clock)
             .into_iter()
             .map(|id| (id, Ending::Extrusion))
             .collect();
@@ -733,10 +736,19 @@ impl<T: Real> Tissue<T> {
         }
         let mut skip: Vec<usize> = removals.iter().map(|&(id, _)| id).collect();
         skip.sort_unstable();
-        let divisions = clock.divide_due_except(self, ws, &skip);
-        let (removals, spared) = remove_cells(self, ws, removals, Some(&mut clock));
-        self.set_target_scale(&clock);
-        self.ext.proliferation = Some(clock);
+        let due = clock.due_divisions(self, ws, &skip);
+        // ...the tissue changes, and the clock records what happened.
+        let (divisions, mothers) = divide_cells(self, ws, due);
+        let (removed, spared) = remove_cells(self, ws, removals);
+        let now = self.time;
+        if let Some(clock) = self.ext.proliferation.as_deref_mut() {
+            clock.record_divisions(&divisions, &mothers, now);
+            for &(id, why, place) in &removed {
+                clock.removed(id, now, place, why);
+            }
+        }
+        self.refresh_target_scale_at(now);
+        let removals = removed.into_iter().map(|(id, why, _)| (id, why)).collect();
         CellEvents {
             divisions,
             removals,
@@ -807,45 +819,72 @@ pub fn remove_extruded<T: Real>(
         .into_iter()
         .map(|id| (id, Ending::Extrusion))
         .collect();
-    remove_cells(tissue, ws, small, lineage)
-        .0
-        .into_iter()
-        .map(|(id, _)| id)
-        .collect()
+    let (removed, _) = remove_cells(tissue, ws, small);
+    if let Some(l) = lineage {
+        for &(id, why, place) in &removed {
+            l.removed(id, tissue.time(), place, why);
+        }
+    }
+    removed.into_iter().map(|(id, _, _)| id).collect()
 }
 
-/// Removes the cells `ids` in their order, each recorded in `lineage` (when given) as ending
-/// for its reason at the tissue's time and its centre, while more than one cell is left;
-/// fits `ws` when any went. Returns those removed.
-/// The cells [`remove_cells`] removed, and the last one it had to keep (see
-/// [`CellEvents::spared`]).
-type Removed = (Vec<(usize, Ending)>, Option<(usize, Ending)>);
+/// A division the clock has decided on: the mother's identity and slot, and the direction of
+/// the split.
+struct PlannedDivision {
+    id: usize,
+    slot: usize,
+    direction: [f64; 2],
+}
 
+/// Splits each planned mother in its order ([`Tissue::divide`]) and fits `ws` when any did.
+/// Returns the divisions and each mother's centre before her split, for the lineage.
+fn divide_cells<T: Real>(
+    tissue: &mut Tissue<T>,
+    ws: &mut Workspace<T>,
+    planned: Vec<PlannedDivision>,
+) -> (Vec<Division>, Vec<[f64; 2]>) {
+    let mut places = Vec::with_capacity(planned.len());
+    let divisions: Vec<Division> = planned
+        .into_iter()
+        .map(|p| {
+            debug_assert_eq!(tissue.cell_ids()[p.slot], p.id);
+            places.push(tissue.centres()[p.slot]);
+            tissue.divide(p.slot, p.direction)
+        })
+        .collect();
+    if !divisions.is_empty() {
+        ws.fit(tissue.cells());
+    }
+    (divisions, places)
+}
+
+/// The cells [`remove_cells`] removed, each with why and its centre when it went, and the
+/// last one it had to keep (see [`CellEvents::spared`]).
+type Removed = (Vec<(usize, Ending, [f64; 2])>, Option<(usize, Ending)>);
+
+/// Removes the cells `ids` in their order while more than one cell is left, and fits `ws`
+/// when any went.
 fn remove_cells<T: Real>(
     tissue: &mut Tissue<T>,
     ws: &mut Workspace<T>,
-    mut ids: Vec<(usize, Ending)>,
-    mut lineage: Option<&mut Proliferation>,
+    ids: Vec<(usize, Ending)>,
 ) -> Removed {
-    let now = tissue.time();
     let mut spared = None;
-    ids.retain(|&(id, why)| {
+    let mut removed = Vec::with_capacity(ids.len());
+    for (id, why) in ids {
         if tissue.n_cells() == 1 {
             spared = Some((id, why));
-            return false;
+            continue;
         }
         let slot = slot_of(tissue, id);
         let place = tissue.centres()[slot];
         tissue.remove(slot);
-        if let Some(l) = lineage.as_deref_mut() {
-            l.removed(id, now, place, why);
-        }
-        true
-    });
-    if !ids.is_empty() {
+        removed.push((id, why, place));
+    }
+    if !removed.is_empty() {
         ws.fit(tissue.cells());
     }
-    (ids, spared)
+    (removed, spared)
 }
 
 /// The cells (by identity, sorted) that `clock`'s extrusion rules remove after the last
