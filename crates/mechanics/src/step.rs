@@ -260,7 +260,8 @@ impl<T: Real> Tissue<T> {
         }
         self.cells.swap_phi(phi_old);
         if !self.ext.terms.is_empty() {
-            self.with_terms_view(cell_state, |terms, view| terms.begin(view));
+            let (terms, view) = self.terms_and_view(cell_state);
+            terms.begin(&view);
         }
         if let Some(h) = predict {
             self.ext.terms.predict(h);
@@ -293,16 +294,25 @@ impl<T: Real> Tissue<T> {
         }
     }
 
-    /// Calls `f` with the terms and what they see of every slot (the terms are moved out
-    /// for the call, which allocates nothing).
-    fn with_terms_view(
-        &mut self,
-        cell_state: &[CellState],
-        f: impl FnOnce(&mut crate::terms::Terms, &CellsView<'_>),
-    ) {
-        let mut terms = std::mem::take(&mut self.ext.terms);
-        f(&mut terms, &self.terms_view(cell_state, 0.0));
-        self.ext.terms = terms;
+    /// The terms, to change their state, with what they see of every slot (the per-cell
+    /// quantities `cells`): borrowed from disjoint fields of the tissue, so nothing is moved.
+    fn terms_and_view<'a>(
+        &'a mut self,
+        cells: &'a [CellState],
+    ) -> (&'a mut crate::terms::Terms, CellsView<'a>) {
+        let view = CellsView {
+            time: self.time,
+            stage: 0.0,
+            cells,
+            by_id: None,
+            ids: &self.cell_id,
+            centres: &self.centre,
+            centre_of: None,
+            active: self.active,
+            populations: &self.ext.populations,
+            iteration: self.iteration,
+        };
+        (&mut self.ext.terms, view)
     }
 
     /// Back to the state before the step, from a corrector whose evaluation refused to start
@@ -383,7 +393,8 @@ impl<T: Real> Tissue<T> {
         }
         self.cells.swap_phi(k1);
         if !self.ext.terms.is_empty() {
-            self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
+            let (terms, view) = self.terms_and_view(cell_state);
+            terms.correct(&view, h);
         }
         Ok(())
     }
@@ -507,7 +518,8 @@ impl<T: Real> Tissue<T> {
             Some(com),
         )?;
         if !self.ext.terms.is_empty() {
-            self.with_terms_view(cell_state, |terms, view| terms.correct(view, h));
+            let (terms, view) = self.terms_and_view(cell_state);
+            terms.correct(&view, h);
         }
         let updates = self
             .cells
