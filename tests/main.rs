@@ -3,6 +3,7 @@
 mod analysis_tests;
 mod guard_tests;
 mod mechanics_tests;
+mod module_graph;
 mod patch_tests;
 mod phasefield_tests;
 mod regression;

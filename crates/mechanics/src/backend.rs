@@ -148,6 +148,30 @@ pub fn unsupported(ext: &Extensions, params: &ModelParams, supported: &[Part]) -
         .collect()
 }
 
+impl<T: phasefield::Real> crate::Workspace<T> {
+    /// Takes what a device's last evaluation computed as this workspace's last evaluation:
+    /// the cells' quantities, and the pressure where it came with them (the division clock's
+    /// inputs, [`crate::Tissue::proliferate`]).
+    ///
+    /// # Panics
+    /// If the counts do not fit the workspace (fit it to the tissue first).
+    pub(crate) fn take_device_evaluation(&mut self, ev: &DeviceEvaluation) {
+        assert_eq!(ev.cells.len(), self.cell_state.len(), "a state per cell");
+        self.cell_state.copy_from_slice(&ev.cells);
+        if let Some(p) = &ev.pressure {
+            let lattice = self.sums.lattice();
+            let ly = lattice.ly;
+            assert_eq!(p.len(), lattice.len(), "a pressure per lattice node");
+            for x in 0..lattice.lx {
+                let (_, col) = self
+                    .sums
+                    .columns_read_write::<0>([], crate::SumField::P.index(), x);
+                col.copy_from_slice(&p[x * ly..(x + 1) * ly]);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::{Arc, Mutex};

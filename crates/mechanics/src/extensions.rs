@@ -22,7 +22,7 @@
 //! A part added later adds a variant to [`Part`]; the `match`es on it below (which have no
 //! wildcard) then fail to compile until its arrays, bytes and comparison are written.
 
-use crate::division::{Ending, LineageRecord, Proliferation};
+use crate::clock::{Ending, LineageRecord, Proliferation};
 use crate::params::ModelParams;
 use crate::terms::{Populations, Terms};
 use crate::walls::Walls;

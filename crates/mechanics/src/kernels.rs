@@ -12,10 +12,7 @@
 //! The per-cell passes (1 and 3) sweep each patch as one run of a padded copy
 //! (`phasefield::kernel::PaddedPatch`, each thread's own), with the lattice sums they read
 //! gathered beside it; the scatter (2) writes lattice columns, so it goes column by column.
-//! This is machinery: nothing here is public but [`thread_scratch_bytes`], the size of each
-//! thread's scratch, for memory estimates.
-
-use std::cell::RefCell;
+//! This is machinery: nothing here is public. Each thread's scratch is in [`crate::scratch`].
 
 use nalgebra::Vector2;
 use phasefield::kernel::{add_lanes, PaddedParts, PaddedPatch, StencilRun, LANES};
@@ -27,12 +24,12 @@ use crate::equations::{
     heun_predictor, nematic_density, pressure, pressure_cell_part, pressure_self_coefficient,
     pressure_self_part_with, rhs, velocity,
 };
+use crate::evaluation::{CellState, SumField, N_SUMS};
 use crate::geometry::TracelessTensor;
 use crate::node_terms::NodeTerm;
 use crate::params::{ModelParams, PressureKind};
 use crate::scatter::{scatter, LatticeSums};
 use crate::terms::{CellConstants, Populations};
-use crate::workspace::{CellState, SumField, N_SUMS};
 
 // Where each lattice sum is stored.
 const I_S2: usize = SumField::S2.index();
@@ -40,45 +37,7 @@ const I_QXX: usize = SumField::Qxx.index();
 const I_QXY: usize = SumField::Qxy.index();
 const I_P: usize = SumField::P.index();
 
-/// The lattice sums the force pass reads, gathered beside each patch: `P`, `s2`, `Q_xx`, `Q_xy`.
-const N_GATHERED: usize = 4;
-
-thread_local! {
-    /// Each thread's copy of the patch it works on, in the padded layout of [`PaddedPatch`]
-    /// (one run per patch), with the four lattice fields the force pass reads gathered beside
-    /// it (`P`, `s2`, `Q_xx`, `Q_xy`): sized for every thread of the pool when a workspace is
-    /// made ([`prepare_scratch`]), and grown only when a thread meets a larger patch, so a step
-    /// allocates nothing. A cell's results depend only on its own values, never on what the
-    /// scratch held before, so they do not depend on which thread computed them.
-    static PADDED: RefCell<PaddedPatch<N_GATHERED>> = RefCell::new(PaddedPatch::new());
-
-    /// Each thread's gathered node-term coefficients (`a`, `b` of [`NodeTerms`]) beside the
-    /// patch in [`PADDED`], in the same layout: used only with adhesion or walls, and made on
-    /// the first evaluation that has them.
-    static NODE_TERMS: RefCell<PaddedPatch<2>> = RefCell::new(PaddedPatch::new());
-}
-
-/// Sizes the scratch of every thread of the current rayon pool (the global one outside a pool)
-/// for patches of this shape, so that no step allocates it: [`crate::Workspace::new`] calls
-/// this. A thread of another pool makes its scratch on its first evaluation instead.
-pub(crate) fn prepare_scratch(shape: &PatchShape) {
-    rayon::broadcast(|_| PADDED.with_borrow_mut(|padded| padded.prepare(shape)));
-}
-
-/// Bytes of heap memory held by the scratch of the threads of the current rayon pool (the
-/// global one outside a pool).
-pub(crate) fn scratch_bytes() -> usize {
-    rayon::broadcast(|_| PADDED.with_borrow(|padded| padded.heap_bytes()))
-        .into_iter()
-        .sum()
-}
-
-/// The bytes of one thread's scratch for patches of this shape: what
-/// [`crate::Workspace::heap_bytes`] counts for each thread of a pool that has met no larger
-/// patch.
-pub fn thread_scratch_bytes(shape: &PatchShape) -> usize {
-    PaddedPatch::<N_GATHERED>::bytes_for(shape)
-}
+use crate::scratch::{NODE_TERMS, N_GATHERED, PADDED};
 
 /// Pass 1 for one cell: area, range and, with `SHAPE`, the deformation tensor.
 #[inline(always)]

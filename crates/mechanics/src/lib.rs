@@ -55,8 +55,10 @@
 
 pub mod adaptive;
 pub mod backend;
+mod clock;
 pub mod division;
 pub mod equations;
+mod evaluation;
 pub mod extensions;
 mod fields;
 mod geometry;
@@ -65,6 +67,7 @@ mod node_terms;
 mod observables;
 mod params;
 mod scatter;
+mod scratch;
 mod simulation;
 mod step;
 pub mod terms;
@@ -73,20 +76,21 @@ pub mod walls;
 mod workspace;
 
 pub use adaptive::{AdaptiveParams, Controller};
+pub use evaluation::{CellState, SumField};
 pub use extensions::{Extensions, Part};
 pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
-pub use kernels::thread_scratch_bytes;
 pub use nalgebra::Vector2;
 pub use observables::{CellObservables, Observables};
 pub use params::{ModelParams, Precision, PressureKind, StepParams, ACTIVITY_DT};
+pub use scratch::thread_scratch_bytes;
 pub use simulation::{
     Callback, CallbackError, Fix, Needs, Observation, RunInfo, Schedule, Simulation,
     SimulationError, DEFAULT_SORT_EVERY,
 };
 pub use step::{CheckPoint, StateCheck, StepCheck, PHI_BOUND};
 pub use tissue::Tissue;
-pub use workspace::{CellState, SumField, Workspace};
+pub use workspace::Workspace;
 
 /// The types most programs need: `use mechanics::prelude::*;`.
 pub mod prelude {

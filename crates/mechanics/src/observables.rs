@@ -2,8 +2,9 @@
 
 use phasefield::Real;
 
+use crate::evaluation::CellState;
 use crate::tissue::Tissue;
-use crate::workspace::{CellState, Workspace};
+use crate::workspace::Workspace;
 
 /// Scalar summary of one state, computed on output steps only.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -5,13 +5,14 @@ use phasefield::{ComTable, Real};
 use rayon::prelude::*;
 
 use crate::equations::{adhesion_coefficient, heun_corrector, heun_predictor, wall_coefficients};
+use crate::evaluation::{CellState, N_SUMS};
 use crate::kernels::{evaluate, EvalInput, EvalScratch, Post};
 use crate::node_terms::{Adhesion, NodeTerm, WallTerm};
 use crate::params::StepParams;
 use crate::scatter::LatticeSums;
 use crate::terms::CellsView;
 use crate::tissue::Tissue;
-use crate::workspace::{CellState, TermScratch, Workspace, N_SUMS};
+use crate::workspace::{TermScratch, Workspace};
 use crate::StepError;
 
 /// How far outside `[0, 1]` a phase field may go before the step is declared unstable.

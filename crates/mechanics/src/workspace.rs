@@ -1,75 +1,11 @@
 //! The scratch memory of a step ([`Workspace`]) and what an evaluation leaves in it:
 //! per-cell quantities ([`CellState`]) and the lattice sums ([`SumField`]).
 
-use nalgebra::Vector2;
 use phasefield::{Cells, ComTable, Real};
 
-use crate::geometry::TracelessTensor;
+use crate::evaluation::N_SUMS;
+pub use crate::evaluation::{CellState, SumField};
 use crate::scatter::LatticeSums;
-
-/// Fields of the lattice-wide sums of one evaluation.
-pub(crate) const N_SUMS: usize = 6;
-
-/// A lattice-wide sum left in the [`Workspace`] by an evaluation (read it with
-/// [`Workspace::sum`] or [`Workspace::sum_field`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[non_exhaustive]
-pub enum SumField {
-    /// `s1 = Σ_i φ_i`.
-    S1,
-    /// `s2 = Σ_i φ_i²`.
-    S2,
-    /// `U = Σ_i U_i`, the part of the pressure that is a sum of single-cell terms
-    /// ([`crate::equations::pressure_cell_part`]).
-    U,
-    /// `Q_xx = Σ_i φ_i S_i,xx`.
-    Qxx,
-    /// `Q_xy = Σ_i φ_i S_i,xy`.
-    Qxy,
-    /// The tissue pressure `P` ([`crate::equations::pressure`] of `s1`, `s2` and `U`),
-    /// computed once per lattice node after the sums, for the force pass to read (where every
-    /// cell over a node computed it again from the three sums).
-    P,
-}
-
-impl SumField {
-    /// Every field, in storage order.
-    pub const ALL: [SumField; N_SUMS] =
-        [Self::S1, Self::S2, Self::U, Self::Qxx, Self::Qxy, Self::P];
-
-    /// Index in the storage of the sums.
-    #[inline(always)]
-    pub(crate) const fn index(self) -> usize {
-        match self {
-            Self::S1 => 0,
-            Self::S2 => 1,
-            Self::U => 2,
-            Self::Qxx => 3,
-            Self::Qxy => 4,
-            Self::P => 5,
-        }
-    }
-}
-
-/// Per-cell quantities derived from the fields by one evaluation (by slot).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-#[non_exhaustive]
-pub struct CellState {
-    /// Area `A_i = Σ_x φ_i²`.
-    pub area: f64,
-    /// Deformation tensor `S_i` (docs/model.md §3).
-    pub shape: TracelessTensor,
-    /// Interface force `F_i` (pressure and active stress).
-    pub force: Vector2<f64>,
-    /// The whole-cell force of the physics terms, `Σ f_i` (`crate::terms`); zero without.
-    pub cell_force: Vector2<f64>,
-    /// Velocity `v_i = (F_i + Σ f_i) / ξ`.
-    pub velocity: Vector2<f64>,
-    /// Smallest `φ_i` on the patch.
-    pub phi_min: f64,
-    /// Largest `φ_i` on the patch.
-    pub phi_max: f64,
-}
 
 /// Scratch memory for [`crate::Tissue::step`] and the observations: built once, reused,
 /// never serialised (after rapier's pipeline and faer's scratch memory).
@@ -136,14 +72,14 @@ impl<T: Real> Workspace<T> {
                 * std::mem::size_of::<[f64; 2]>()
             + self.term_scratch.heap_bytes()
             + self.com.heap_bytes()
-            + crate::kernels::scratch_bytes()
+            + crate::scratch::scratch_bytes()
     }
 
     /// Scratch memory for a tissue of this size.
     pub fn new(cells: &Cells<T>) -> Self {
         let n = cells.n_cells() * cells.patch_len();
         let lattice = cells.lattice();
-        crate::kernels::prepare_scratch(cells.shape());
+        crate::scratch::prepare_scratch(cells.shape());
         Self {
             phi_old: vec![T::default(); n],
             k1: vec![T::default(); n],
@@ -199,28 +135,6 @@ impl<T: Real> Workspace<T> {
     /// The per-cell quantities of slot `slot` in the last evaluation.
     pub fn cell(&self, slot: usize) -> &CellState {
         &self.cell_state[slot]
-    }
-
-    /// Takes what a device's last evaluation computed as this workspace's last evaluation:
-    /// the cells' quantities, and the pressure where it came with them (the division clock's
-    /// inputs, [`crate::Tissue::proliferate`]).
-    ///
-    /// # Panics
-    /// If the counts do not fit the workspace (fit it to the tissue first).
-    pub(crate) fn take_device_evaluation(&mut self, ev: &crate::backend::DeviceEvaluation) {
-        assert_eq!(ev.cells.len(), self.cell_state.len(), "a state per cell");
-        self.cell_state.copy_from_slice(&ev.cells);
-        if let Some(p) = &ev.pressure {
-            let lattice = self.sums.lattice();
-            let ly = lattice.ly;
-            assert_eq!(p.len(), lattice.len(), "a pressure per lattice node");
-            for x in 0..lattice.lx {
-                let (_, col) = self
-                    .sums
-                    .columns_read_write::<0>([], SumField::P.index(), x);
-                col.copy_from_slice(&p[x * ly..(x + 1) * ly]);
-            }
-        }
     }
 
     /// The sum `field` of the last evaluation at lattice node `node = x * ly + y`.

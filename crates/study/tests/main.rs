@@ -1,6 +1,4 @@
-//! Sweeps and damaged frames end to end, and the module graph: one test executable, a module
-//! per topic.
+//! Sweeps and damaged frames end to end: one test executable, a module per topic.
 
 mod damaged_frames;
-mod module_graph;
 mod sweep;

@@ -7,8 +7,8 @@ use rayon::prelude::*;
 
 use super::NodeTerm;
 use crate::equations::{adhesion_derivative, adhesion_pressure};
+use crate::evaluation::{SumField, N_SUMS};
 use crate::scatter::LatticeSums;
-use crate::workspace::{SumField, N_SUMS};
 
 /// Adhesion of coefficient `c` ([`crate::equations::adhesion_coefficient`]).
 #[derive(Debug, Clone, Copy)]

@@ -28,8 +28,8 @@ pub(crate) mod walls;
 pub(crate) use adhesion::Adhesion;
 pub(crate) use walls::WallTerm;
 
+use crate::evaluation::N_SUMS;
 use crate::scatter::LatticeSums;
-use crate::workspace::N_SUMS;
 
 /// A free-energy term that acts at the nodes (module docs).
 pub(crate) trait NodeTerm: Sync {

@@ -8,8 +8,8 @@ use phasefield::WallField;
 
 use super::NodeTerm;
 use crate::equations::{wall_derivative, wall_pressure};
+use crate::evaluation::{SumField, N_SUMS};
 use crate::scatter::LatticeSums;
-use crate::workspace::{SumField, N_SUMS};
 
 /// The walls of an evaluation: the field in effect and its coefficients
 /// ([`crate::equations::wall_coefficients`]).

@@ -37,7 +37,7 @@ pub use noise::{normal_of_words, philox4x32_10, uniform_of_word, NoiseKey};
 pub use polarity::{alignment_rate, alignment_target, propulsion, Align, Polarity, Propulsion};
 pub use populations::{CellConstants, Population, Populations};
 
-use crate::workspace::CellState;
+use crate::evaluation::CellState;
 
 /// What a term sees of one cell when it is asked for a force or a rate.
 #[derive(Debug, Clone, Copy)]
