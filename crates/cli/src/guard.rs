@@ -43,12 +43,23 @@ pub fn memory(scene: &Scene, max_memory: Option<&str>) -> Result<()> {
 /// # Errors
 /// As [`memory`].
 pub fn memory_of(scene: &Scene, runs: usize, max_memory: Option<&str>) -> Result<()> {
-    let limit = match max_memory {
+    rundir::memory::check_memory(scene, runs, limit(max_memory)?, MORE_MEMORY)?;
+    Ok(())
+}
+
+/// How the command line raises the memory limit, for the guard's message.
+pub const MORE_MEMORY: &str = "give a larger --max-memory";
+
+/// The limit `--max-memory` gives, with its name for messages (`None`: the memory this
+/// process can use).
+///
+/// # Errors
+/// A `--max-memory` that does not parse.
+pub fn limit(max_memory: Option<&str>) -> Result<Option<(f64, String)>> {
+    Ok(match max_memory {
         Some(m) => Some((parse_bytes(m)?, format!("--max-memory {m}"))),
         None => None,
-    };
-    rundir::memory::check_memory(scene, runs, limit, "give a larger --max-memory")?;
-    Ok(())
+    })
 }
 
 /// The thread count to use for `--threads n`: at least 1, and at most the machine's cores

@@ -369,13 +369,13 @@ fn real_main() -> Result<ExitCode> {
             let set = run::absolute_from(&scene, &text, &set)?;
             let parsed = Scene::parse(&text, &set)
                 .with_context(|| format!("in scene {}", scene.display()))?;
-            monolayer_cli::guard::memory(&parsed, max_memory.as_deref())
-                .with_context(|| format!("in scene {}", scene.display()))?;
-            // Read before --out is prepared: --overwrite may remove the frame it names.
-            let state = rundir::initial_state(&parsed)
+            // The memory guard, the saved state (read before --out is prepared: --overwrite
+            // may remove the frame it names) and the warnings, as every front end has them.
+            let limit = monolayer_cli::guard::limit(max_memory.as_deref())?;
+            let new = rundir::prepare_new_run(&parsed, limit, monolayer_cli::guard::MORE_MEMORY)
                 .with_context(|| format!("in scene {}", scene.display()))?;
             let pool = pool(threads)?;
-            let info = pool.install(|| run::run(&parsed, state, &out, overwrite, quiet))?;
+            let info = pool.install(|| run::run(&parsed, new, &out, overwrite, quiet))?;
             Ok(finished(&info, &out, quiet))
         }
         Command::Sweep {

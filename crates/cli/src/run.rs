@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mechanics::{Callback, CallbackError, Needs, Observation, Precision};
-use phasefield::{Cells, Real};
+use phasefield::Real;
 use rundir::{FinalToo, Interrupt, Outcome, RunDir, RunError};
 use scene::Scene;
 
@@ -26,23 +26,29 @@ pub struct RunInfo {
     pub stopped: Option<(u64, f64, i32)>,
 }
 
-/// Runs a valid scene, writing into `out` (prepared by [`RunDir::create`]), from `state` when
-/// the scene starts from a saved one (`rundir::initial_state`, read before `out` is
-/// prepared). On a step error the output written so far is kept and the error is returned.
+/// Runs a valid scene, writing into `out` (prepared by [`RunDir::create`]), from what
+/// [`rundir::prepare_new_run`] checked and read before `out` was touched (the saved state the
+/// scene starts from, and the warnings, said once the directory is taken). On a step error
+/// the output written so far is kept and the error is returned.
 ///
 /// # Errors
 /// When the directory is held by another process, cannot be written, or the run stops early.
 pub fn run(
     scene: &Scene,
-    state: Option<Cells<f64>>,
+    new: rundir::NewRun,
     out: &Path,
     overwrite: bool,
     quiet: bool,
 ) -> Result<RunInfo> {
     let opened = crate::backend::open(scene)?;
-    let said = rundir::state_warnings(scene)?;
-    let dir = RunDir::create(out, scene.clone(), state, overwrite, Interrupt::install()?)?;
-    for w in scene.warnings().into_iter().chain(said) {
+    let dir = RunDir::create(
+        out,
+        scene.clone(),
+        new.state,
+        overwrite,
+        Interrupt::install()?,
+    )?;
+    for w in new.warnings {
         crate::say!("warning: {w}");
     }
     drive(&dir, opened, quiet)

@@ -112,9 +112,12 @@ fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
 /// the memory this process can still use raises `MemoryError` with the estimate and the keys
 /// to change, instead of an abort in the allocator.
 fn memory_guard(scene: &::scene::Scene) -> PyResult<()> {
-    rundir::memory::check_memory(scene, 1, None, "run it where more memory is free")
+    rundir::memory::check_memory(scene, 1, None, MORE_MEMORY)
         .map_err(|e| pyo3::exceptions::PyMemoryError::new_err(e.to_string()))
 }
+
+/// What Python can do about a run too large for the memory (no flag raises the limit).
+const MORE_MEMORY: &str = "run it where more memory is free";
 
 /// The most steps one call takes (2**62: about 10¹⁸, far beyond any run).
 const STEP_MAX: u64 = 1 << 62;
@@ -982,16 +985,18 @@ pub fn run_dir(
             "[integrator] backend = \"gpu\": the Python package is built without the GPU backend; run it with the command line, or set integrator.backend = \"cpu\"",
         ));
     }
-    // Before anything is allocated or written: a refused run leaves no directory.
-    memory_guard(s)?;
+    // Before anything is allocated or written, as the command line checks it: a refused
+    // run leaves no directory.
+    let new = rundir::prepare_new_run(s, None, MORE_MEMORY).map_err(|e| match e {
+        rundir::PrepareError::Memory(m) => pyo3::exceptions::PyMemoryError::new_err(m.to_string()),
+        other => scene_error(scene.path.as_deref(), other),
+    })?;
     let pool = pool(threads)?;
     let fresh = !out.exists();
-    let state = rundir::initial_state(s).map_err(|e| scene_error(scene.path.as_deref(), e))?;
-    let mut warnings = s.warnings();
-    warnings.extend(rundir::state_warnings(s).map_err(|e| scene_error(scene.path.as_deref(), e))?);
+    let warnings = new.warnings;
     let interrupt = Interrupt::never();
     let dir =
-        RunDir::create(&out, s.clone(), state, overwrite, interrupt.clone()).map_err(|e| {
+        RunDir::create(&out, s.clone(), new.state, overwrite, interrupt.clone()).map_err(|e| {
             // The command line's flags, as this function's keywords.
             PyOSError::new_err(e.to_string().replace(
                 "choose another --out or pass --overwrite",

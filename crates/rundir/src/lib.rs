@@ -40,7 +40,8 @@ pub use run::{lock_dir, DirLock, Interrupt, Outcome, RunDir, RunError, LOCK};
 pub use series::{SeriesWriter, MSD_HEADER, OBSERVABLES_HEADER, SERIES_HEADER};
 pub use sidecar::{write_run_json, AXES};
 pub use state::{
-    initial_state, initial_tissue, not_carried, read_state, state_warnings, StateError,
+    initial_state, initial_tissue, not_carried, prepare_new_run, read_state, state_warnings,
+    NewRun, PrepareError, StateError,
 };
 pub use writers::{
     add_checkpoints, add_checkpoints_with, add_writers, add_writers_resumed, FinalToo, Written,

@@ -236,6 +236,49 @@ pub fn state_warnings(scene: &Scene) -> std::result::Result<Vec<String>, StateEr
     Ok(out)
 }
 
+/// What a new run of a scene needs before its directory is written, checked and read once
+/// for every front end (`monolayer run`, Python's `monolayer.run`): the memory guard passed,
+/// the saved state it starts from read (before `--overwrite` may remove the file it names),
+/// and every warning to give about the scene and that state.
+#[derive(Debug)]
+pub struct NewRun {
+    /// The saved state of `[cells] from` (`init = "frame"`), for [`crate::RunDir::create`].
+    pub state: Option<Cells<f64>>,
+    /// What the user should be told (the scene's [`Scene::warnings`], then
+    /// [`state_warnings`]), to print once the directory is taken.
+    pub warnings: Vec<String>,
+}
+
+/// Why a new run was refused before anything was written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PrepareError {
+    /// The run would not fit in memory ([`crate::memory::check_memory`]).
+    #[error(transparent)]
+    Memory(#[from] crate::memory::MemoryError),
+    /// The saved state cannot be read or does not fit the scene.
+    #[error(transparent)]
+    State(#[from] StateError),
+}
+
+/// Checks and reads what a new run of `scene` needs ([`NewRun`]) before anything is written:
+/// the memory guard with `limit` (or the memory this process can use; `flag` is the front
+/// end's way to raise it), then the saved state and the warnings.
+///
+/// # Errors
+/// [`PrepareError`]: a run too large, or a saved state that cannot be used.
+pub fn prepare_new_run(
+    scene: &Scene,
+    limit: Option<(f64, String)>,
+    flag: &str,
+) -> std::result::Result<NewRun, PrepareError> {
+    crate::memory::check_memory(scene, 1, limit, flag)?;
+    let state = initial_state(scene)?;
+    let mut warnings = scene.warnings();
+    warnings.extend(state_warnings(scene)?);
+    Ok(NewRun { state, warnings })
+}
+
 /// Why the initial tissue of a scene could not be built.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
