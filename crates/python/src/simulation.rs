@@ -789,20 +789,15 @@ impl PySimulation {
         colour: &str,
         options: Option<&Bound<'py, PyDict>>,
     ) -> PyResult<Bound<'py, PyBytes>> {
-        let tmp = tempfile::tempdir().map_err(|e| PyOSError::new_err(e.to_string()))?;
-        let dir = tmp.path();
-        std::fs::write(dir.join("scene.toml"), self.scene.scene.to_toml())
-            .map_err(|e| PyOSError::new_err(e.to_string()))?;
-        let step = with_sim!(&mut *self.inner()?, s => {
+        // Drawn in memory, as `monolayer render` draws the frame of this state.
+        let opts = render_options(None, colour, options)?;
+        let scene = &self.scene.scene;
+        let png = with_sim!(&mut *self.inner()?, s => {
             let (t, ws, _) = s.observe();
-            rundir::write_frame(dir, t, ws).map_err(|e| PyOSError::new_err(e.to_string()))?;
-            if let Some(clock) = t.extensions().proliferation() {
-                rundir::write_lineage(dir, clock).map_err(|e| PyOSError::new_err(e.to_string()))?;
-            }
-            t.iteration()
+            study::view::render_state(scene, t, ws, &opts)
+                .map_err(|e| PyValueError::new_err(e.to_string().replace("--", "")))?
         });
-        let mut pngs = render_in(dir, Some(vec![step]), colour, options)?;
-        Ok(PyBytes::new(py, &pngs.remove(0).1))
+        Ok(PyBytes::new(py, &png))
     }
 
     fn __repr__(&self) -> PyResult<String> {
@@ -820,7 +815,34 @@ fn render_in(
     colour: &str,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Vec<(u64, Vec<u8>)>> {
-    use study::view::{render_run, Colour, Frames, RenderOptions};
+    let opts = render_options(steps, colour, options)?;
+    let out = tempfile::tempdir().map_err(|e| PyOSError::new_err(e.to_string()))?;
+    let info = study::view::render_run(dir, out.path(), &opts, &mut |_, _| {})
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    info.files
+        .iter()
+        .map(|f| {
+            let step = f
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .and_then(|s| s.strip_prefix("frame_"))
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(0);
+            std::fs::read(f)
+                .map(|b| (step, b))
+                .map_err(|e| PyOSError::new_err(format!("{}: {e}", f.display())))
+        })
+        .collect()
+}
+
+/// The render options of `monolayer render` from Python's arguments: the frames `steps`
+/// (all for `None`), `colour`, and the boolean options and `size`, `range`.
+fn render_options(
+    steps: Option<Vec<u64>>,
+    colour: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<study::view::RenderOptions> {
+    use study::view::{Colour, Frames, RenderOptions};
     let mut opts = RenderOptions {
         colour: colour
             .parse::<Colour>()
@@ -854,23 +876,7 @@ fn render_in(
             }
         }
     }
-    let out = tempfile::tempdir().map_err(|e| PyOSError::new_err(e.to_string()))?;
-    let info = render_run(dir, out.path(), &opts, &mut |_, _| {})
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    info.files
-        .iter()
-        .map(|f| {
-            let step = f
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .and_then(|s| s.strip_prefix("frame_"))
-                .and_then(|s| s.parse().ok())
-                .unwrap_or(0);
-            std::fs::read(f)
-                .map(|b| (step, b))
-                .map_err(|e| PyOSError::new_err(format!("{}: {e}", f.display())))
-        })
-        .collect()
+    Ok(opts)
 }
 
 /// Frames of a run directory drawn by the command line's renderer: `[(step, PNG bytes)]`.

@@ -1,7 +1,7 @@
 //! An RGB picture in memory and the few drawing primitives the tissue pictures need: thick
 //! lines and discs, clipped to a rectangle, and PNG output.
 
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use crate::RenderError;
@@ -41,7 +41,23 @@ impl Picture {
         [self.rgb[k], self.rgb[k + 1], self.rgb[k + 2]]
     }
 
-    /// Writes the picture as a PNG, through a temporary name.
+    /// The picture encoded as a PNG (8-bit RGB, fast compression), in memory.
+    ///
+    /// # Errors
+    /// The encoder's message.
+    pub fn png_bytes(&self) -> Result<Vec<u8>, String> {
+        let mut out = Vec::new();
+        let mut enc = png::Encoder::new(&mut out, self.width, self.height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.set_compression(png::Compression::Fast);
+        let mut w = enc.write_header().map_err(|e| e.to_string())?;
+        w.write_image_data(&self.rgb).map_err(|e| e.to_string())?;
+        w.finish().map_err(|e| e.to_string())?;
+        Ok(out)
+    }
+
+    /// Writes the picture as a PNG ([`Picture::png_bytes`]), through a temporary name.
     ///
     /// # Errors
     /// [`RenderError::Draw`] when the file cannot be written.
@@ -52,14 +68,10 @@ impl Picture {
         };
         let tmp = path.with_extension("png.partial");
         let write = || -> Result<(), String> {
-            let f = std::fs::File::create(&tmp).map_err(|e| e.to_string())?;
-            let mut enc = png::Encoder::new(BufWriter::new(f), self.width, self.height);
-            enc.set_color(png::ColorType::Rgb);
-            enc.set_depth(png::BitDepth::Eight);
-            enc.set_compression(png::Compression::Fast);
-            let mut w = enc.write_header().map_err(|e| e.to_string())?;
-            w.write_image_data(&self.rgb).map_err(|e| e.to_string())?;
-            w.finish().map_err(|e| e.to_string())
+            let bytes = self.png_bytes()?;
+            let mut f = BufWriter::new(std::fs::File::create(&tmp).map_err(|e| e.to_string())?);
+            f.write_all(&bytes).map_err(|e| e.to_string())?;
+            f.flush().map_err(|e| e.to_string())
         };
         write().map_err(&draw)?;
         std::fs::rename(&tmp, path).map_err(|e| draw(e.to_string()))

@@ -7,8 +7,8 @@
 use std::path::{Path, PathBuf};
 
 use analysis::smooth::paper_box_side;
-use mechanics::Tissue;
-use phasefield::{Cells, Lattice, PatchShape};
+use mechanics::{Tissue, Workspace};
+use phasefield::{Cells, Lattice, PatchShape, Real};
 use rundir::{read_npz, Array, FRAME_FORMAT, FRAME_FORMATS_READ};
 use scene::{Scene, SceneFile};
 
@@ -259,6 +259,73 @@ pub(crate) struct LoadedFrame {
 }
 
 impl LoadedFrame {
+    /// A tissue's state as a frame of it would hold it, without writing one: the cells in
+    /// increasing identity with their quantities from the evaluation in `ws` (an observation
+    /// of this very state), and the tissue rebuilt from them with its parts' state by row, as
+    /// [`load_frame`] rebuilds it from the frame `rundir::write_frame` writes (the cell-cycle
+    /// clock aside, as there; the tissue's own parameters and terms, where a frame has the
+    /// scene's).
+    ///
+    /// # Errors
+    /// The parts' state does not restore (a tissue whose parts disagree with its cells).
+    pub(crate) fn from_state<T: Real>(tissue: &Tissue<T>, ws: &Workspace<T>) -> Result<Self> {
+        let shape = tissue.cells().shape().clone();
+        let len = shape.nx * shape.ny;
+        let slots = tissue.slots();
+        let n = slots.len();
+        let ids: Vec<usize> = slots.iter().map(|&s| tissue.cell_ids()[s]).collect();
+        let cs = ws.cell_states();
+        let mut phi = vec![0.0; n * len];
+        for (chunk, &slot) in phi.chunks_exact_mut(len).zip(&slots) {
+            tissue.cells().unrolled_into(slot, chunk);
+        }
+        let origins: Vec<[usize; 2]> = slots
+            .iter()
+            .map(|&s| tissue.cells().map().origin[s])
+            .collect();
+        let cells = Cells::from_unrolled(tissue.lattice(), shape, &origins, &phi);
+        let mut rebuilt = Tissue::from_state(
+            cells,
+            *tissue.params(),
+            tissue.time(),
+            tissue.iteration(),
+            (0..n).collect(),
+        );
+        rebuilt.set_active(tissue.active());
+        // The parts' per-cell arrays, the rows of the living cells (what a frame writes).
+        let arrays = tissue.extensions().frame_arrays();
+        let mut ext = tissue.extensions().clone().with_proliferation(None);
+        ext.restore_arrays(
+            n,
+            mechanics::extensions::Source::Frame,
+            |name| {
+                Ok(arrays.iter().find(|a| a.name == name).map(|a| {
+                    let w = a.columns;
+                    ids.iter()
+                        .flat_map(|&i| a.values[i * w..(i + 1) * w].iter().copied())
+                        .collect()
+                }))
+            },
+            |name, why| {
+                crate::error::AnalyzeError::Options(format!("the state's array {name} {why}"))
+            },
+        )?;
+        let pick = |f: &dyn Fn(&mechanics::CellState) -> [f64; 2]| -> Vec<[f64; 2]> {
+            slots.iter().map(|&s| f(&cs[s])).collect()
+        };
+        Ok(Self {
+            tissue: rebuilt.with_extensions(ext),
+            step: tissue.iteration(),
+            origins,
+            phi,
+            shapes: pick(&|c| c.shape.components()),
+            centres: slots.iter().map(|&s| ws.centres()[s]).collect(),
+            velocities: pick(&|c| [c.velocity.x, c.velocity.y]),
+            areas: slots.iter().map(|&s| cs[s].area).collect(),
+            ids,
+        })
+    }
+
     /// The per-cell arrays of the frame's parts, row by row (the tissue numbers its cells by
     /// row): every array a frame writes for them ([`mechanics::Extensions::frame_arrays`]:
     /// each cell's population, the terms' state and what they derive, such as `polarity`).

@@ -317,11 +317,6 @@ fn cell_means(frame: &LoadedFrame, nx: usize, ny: usize, field: &[f64]) -> Vec<f
         .collect()
 }
 
-/// The lineage record of the cell `id`, if the run has one.
-fn lineage_of(run: &Run, id: usize) -> Option<&LineageRecord> {
-    record(run.lineage.as_deref()?, id)
-}
-
 /// The record of `id` in a lineage in increasing identity (as `lineage.csv` has it).
 fn record(lineage: &[LineageRecord], id: usize) -> Option<&LineageRecord> {
     lineage
@@ -340,8 +335,16 @@ fn founder(lineage: &[LineageRecord], id: usize) -> usize {
     id
 }
 
+/// What a picture of a frame reads besides the frame: the scene, the lineage (`None`
+/// without `[division]`), and the cells' tracks up to the frame when they are drawn.
+struct Context<'a> {
+    scene: &'a Scene,
+    lineage: Option<&'a [LineageRecord]>,
+    tracks: Option<Vec<Vec<[f64; 2]>>>,
+}
+
 fn picture(
-    run: &Run,
+    run: &Context<'_>,
     frame: &LoadedFrame,
     ws: &mut Workspace,
     opts: &RenderOptions,
@@ -411,7 +414,9 @@ fn picture(
             let of_cell: Vec<usize> = frame
                 .ids
                 .iter()
-                .map(|&id| lineage_of(run, id).map_or(0, |r| r.generation as usize))
+                .map(|&id| {
+                    record(run.lineage.unwrap_or_default(), id).map_or(0, |r| r.generation as usize)
+                })
                 .collect();
             let top = of_cell.iter().copied().max().unwrap_or(0);
             Fill::Categories {
@@ -423,7 +428,7 @@ fn picture(
             frame
                 .ids
                 .iter()
-                .map(|&id| founder(run.lineage.as_deref().unwrap_or_default(), id))
+                .map(|&id| founder(run.lineage.unwrap_or_default(), id))
                 .collect(),
         ),
         (_, Some((values, label))) => Fill::Values {
@@ -436,7 +441,7 @@ fn picture(
     p.range = opts.range;
     if let Some(f) = &f {
         if opts.director || opts.defects {
-            let side = default_box(&run.scene);
+            let side = default_box(run.scene);
             let smooth = |v: &[f64]| box_smooth(l, v, side).expect("the box fits the lattice");
             let (mut qxx, mut qxy) = (smooth(&f.qxx), smooth(&f.qxy));
             // Only where there is tissue: the director of Q, and its defects, mean nothing in
@@ -479,16 +484,14 @@ fn picture(
             shapes: frame.shapes.clone(),
         });
     }
-    if opts.tracks {
-        p.tracks = Some(run.tracks(frame.step)?);
-    }
+    p.tracks = run.tracks.clone();
     if opts.events {
         let now = frame.tissue.time();
         let since = now - run.scene.file().run.output_every;
         p.events = run
             .lineage
+            .unwrap_or_default()
             .iter()
-            .flatten()
             .filter_map(|r| {
                 let (t, why) = r.death?;
                 (t > since + 1e-9 && t <= now + 1e-9).then_some(EventMark {
@@ -541,18 +544,8 @@ fn render_time(t: f64) -> String {
     }
 }
 
-/// Draws the selected frames of `run_dir` into `out/frame_STEP.png` and, on request, a movie.
-/// `progress(done, total)` is called before the first frame and after each.
-///
-/// # Errors
-/// A run directory that cannot be read, a frame that is missing or damaged, an option that
-/// cannot be used, or a file that cannot be written; files already written stay.
-pub fn render_run(
-    run_dir: &Path,
-    out: &Path,
-    opts: &RenderOptions,
-    progress: &mut dyn FnMut(usize, usize),
-) -> Result<ViewInfo> {
+/// The options of a picture that do not depend on the run: the range and the size.
+fn check_picture_options(opts: &RenderOptions) -> Result<()> {
     if let Some((lo, hi)) = opts.range {
         if !(lo.is_finite() && hi.is_finite() && lo < hi) {
             return Err(ViewError::Options(format!(
@@ -566,6 +559,77 @@ pub fn render_run(
             opts.size.unwrap_or(0)
         )));
     }
+    Ok(())
+}
+
+/// The options that draw from the lineage, refused where there is none (`lacking` says
+/// where it is missing).
+fn check_lineage_options(opts: &RenderOptions, has_lineage: bool, lacking: &str) -> Result<()> {
+    if matches!(opts.colour, Colour::Generation | Colour::Lineage) && !has_lineage {
+        return Err(ViewError::Options(format!(
+            "--colour {}: {lacking} (its scene has no [division], so no cell divided); use --colour id",
+            if opts.colour == Colour::Generation { "generation" } else { "lineage" },
+        )));
+    }
+    if opts.events && !has_lineage {
+        return Err(ViewError::Options(format!(
+            "--events: {lacking} (its scene has no [division], so no cell divided or was extruded); leave --events out"
+        )));
+    }
+    Ok(())
+}
+
+/// One picture of a tissue's current state, drawn as `monolayer render` draws a frame of it,
+/// as PNG bytes, without a run directory: `ws` must hold an observation of this state
+/// (`Simulation::observe`), and `scene` is the tissue's. The same picture, to the byte, as
+/// the render of the frame `rundir::write_frame` would write of the state (with the
+/// lineage beside it). `opts.frames`, the movie and the PNG switch are not read; `tracks`
+/// is refused (a state in memory has no earlier frames to draw them through).
+///
+/// # Errors
+/// An option that cannot be used, or a picture that cannot be drawn.
+pub fn render_state<T: phasefield::Real>(
+    scene: &Scene,
+    tissue: &mechanics::Tissue<T>,
+    ws: &Workspace<T>,
+    opts: &RenderOptions,
+) -> Result<Vec<u8>> {
+    check_picture_options(opts)?;
+    if opts.tracks {
+        return Err(ViewError::Options(
+            "--tracks: a state in memory has no earlier frames to draw the tracks through; render a run directory's frames for them".into(),
+        ));
+    }
+    let lineage: Option<Vec<LineageRecord>> = tissue
+        .proliferation()
+        .map(|clock| clock.lineage().cloned().collect());
+    check_lineage_options(opts, lineage.is_some(), "the simulation has no lineage")?;
+    let frame = LoadedFrame::from_state(tissue, ws)?;
+    let mut ws = Workspace::new(frame.tissue.cells());
+    let context = Context {
+        scene,
+        lineage: lineage.as_deref(),
+        tracks: None,
+    };
+    let pic = picture(&context, &frame, &mut ws, opts)?.draw()?;
+    pic.png_bytes().map_err(|why| {
+        ViewError::Options(format!("the picture could not be encoded as a PNG: {why}"))
+    })
+}
+
+/// Draws the selected frames of `run_dir` into `out/frame_STEP.png` and, on request, a movie.
+/// `progress(done, total)` is called before the first frame and after each.
+///
+/// # Errors
+/// A run directory that cannot be read, a frame that is missing or damaged, an option that
+/// cannot be used, or a file that cannot be written; files already written stay.
+pub fn render_run(
+    run_dir: &Path,
+    out: &Path,
+    opts: &RenderOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<ViewInfo> {
+    check_picture_options(opts)?;
     if !opts.pngs && opts.movie.is_none() {
         return Err(ViewError::Options(
             "nothing to write: without PNGs, give --movie FILE".into(),
@@ -575,19 +639,11 @@ pub fn render_run(
         render::MovieKind::of(m).map_err(ViewError::Options)?;
     }
     let run = Run::open(run_dir, &opts.frames)?;
-    if matches!(opts.colour, Colour::Generation | Colour::Lineage) && run.lineage.is_none() {
-        return Err(ViewError::Options(format!(
-            "--colour {}: {} has no lineage.csv (its scene has no [division], so no cell divided); use --colour id",
-            if opts.colour == Colour::Generation { "generation" } else { "lineage" },
-            run_dir.display()
-        )));
-    }
-    if opts.events && run.lineage.is_none() {
-        return Err(ViewError::Options(format!(
-            "--events: {} has no lineage.csv (its scene has no [division], so no cell divided or was extruded); leave --events out",
-            run_dir.display()
-        )));
-    }
+    check_lineage_options(
+        opts,
+        run.lineage.is_some(),
+        &format!("{} has no lineage.csv", run_dir.display()),
+    )?;
     create_dir(out)?;
     let total = run.frames.len();
     progress(0, total);
@@ -599,7 +655,16 @@ pub fn render_run(
         let ws = ws.get_or_insert_with(|| Workspace::new(frame.tissue.cells()));
         // A run whose cells divide has its own number of cells in each frame.
         ws.fit(frame.tissue.cells());
-        let pic = picture(&run, &frame, ws, opts)?.draw()?;
+        let context = Context {
+            scene: &run.scene,
+            lineage: run.lineage.as_deref(),
+            tracks: if opts.tracks {
+                Some(run.tracks(frame.step)?)
+            } else {
+                None
+            },
+        };
+        let pic = picture(&context, &frame, ws, opts)?.draw()?;
         if let Some(m) = &opts.movie {
             if movie.is_none() {
                 movie = Some(Movie::create(

@@ -1,4 +1,5 @@
 //! Sweeps and damaged frames end to end: one test executable, a module per topic.
 
 mod damaged_frames;
+mod render_state;
 mod sweep;
