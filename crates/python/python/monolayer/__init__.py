@@ -222,7 +222,8 @@ class Simulation:
         """The current state drawn as ``monolayer render`` draws a frame: ``colour`` is one
         of none, velocity, pressure, area, deformation, id, population, generation, lineage;
         ``options`` are ``director``, ``defects``, ``flow``, ``axes``, ``polarity``,
-        ``tracks``, ``events`` (booleans), ``size`` (pixels) and ``range`` (two numbers)."""
+        ``tracks``, ``events`` (booleans), ``size`` (pixels) and ``range`` (two numbers).
+        Drawn in memory; ``tracks`` needs a run's earlier frames (``Run.render``)."""
         return Image(self._sim.render(colour, **options), self.iteration)
 
     def __repr__(self) -> str:
