@@ -66,6 +66,7 @@ mod kernels;
 mod node_terms;
 mod observables;
 mod params;
+pub mod persist;
 mod scatter;
 mod scratch;
 mod simulation;

@@ -32,7 +32,7 @@ use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use mechanics::extensions::Source;
+use mechanics::persist::Source;
 use mechanics::{Controller, Extensions, Tissue};
 use phasefield::{Cells, Real};
 
@@ -304,7 +304,7 @@ pub fn read_checkpoint<T: Real>(path: &Path, scene: &scene::Scene) -> Result<Tis
             _ => return Err(bad("next_id", format!("{v:?} is not one identity"))),
         },
         None => optional("lineage")?.map(|rows| {
-            rows.chunks_exact(mechanics::extensions::LINEAGE_COLUMNS)
+            rows.chunks_exact(mechanics::persist::LINEAGE_COLUMNS)
                 .map(|r| r[0] as usize + 1)
                 .max()
                 .unwrap_or(0)

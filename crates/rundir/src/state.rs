@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mechanics::extensions::Source;
+use mechanics::persist::Source;
 use mechanics::Tissue;
 use phasefield::{Cells, Lattice, PatchShape, Real};
 use scene::{Scene, SceneError, MAX_SIDE};
@@ -94,7 +94,7 @@ const CORE_ARRAYS: [&str; 22] = [
     "lineage",
     // What the terms saw of each cell in the last step (a checkpoint's, for a resume): a new
     // run starts it at zero.
-    mechanics::extensions::TERM_INPUTS,
+    mechanics::persist::TERM_INPUTS,
 ];
 
 /// The extensions' arrays of the saved state `scene` starts from (`init = "frame"`) that the

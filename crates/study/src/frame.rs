@@ -297,7 +297,7 @@ impl LoadedFrame {
         let mut ext = tissue.extensions().clone().with_proliferation(None);
         ext.restore_arrays(
             n,
-            mechanics::extensions::Source::Frame,
+            mechanics::persist::Source::Frame,
             |name| {
                 Ok(arrays.iter().find(|a| a.name == name).map(|a| {
                     let w = a.columns;
@@ -331,7 +331,7 @@ impl LoadedFrame {
     /// each cell's population, the terms' state and what they derive, such as `polarity`).
     /// The ParaView files and the render's arrows are built from this one table, as Python's
     /// cell table is; an array of 2 columns is a vector.
-    pub(crate) fn part_arrays(&self) -> Vec<mechanics::extensions::StateArray> {
+    pub(crate) fn part_arrays(&self) -> Vec<mechanics::persist::StateArray> {
         self.tissue.extensions().frame_arrays()
     }
 
@@ -584,7 +584,7 @@ pub(crate) fn load_frame(
     // The terms act as they did in the run: from the end of the relaxation, with the state
     // the frame holds.
     tissue.set_active(time >= scene.file().run.relax_time * (1.0 - 1e-12));
-    let tissue = rundir::read_extensions(path, tissue, ext, mechanics::extensions::Source::Frame)
+    let tissue = rundir::read_extensions(path, tissue, ext, mechanics::persist::Source::Frame)
         .map_err(|e| input(path, e.to_string()))?;
     // The per-cell arrays must describe the cells of `phi`, in its order: each stored centre
     // must be the centre of mass of its field (to a tenth of a node: f32 storage rounds it by
