@@ -477,3 +477,84 @@ fn a_blow_up_in_the_last_step_on_the_gpu_is_an_error() {
         .collect();
     assert!(rows.iter().all(|&r| r < step), "a row of the bad state");
 }
+
+/// A physics term of a user's, which runs on the host.
+#[derive(Debug)]
+struct HostTerm;
+
+impl mechanics::terms::CellTerm for HostTerm {
+    fn name(&self) -> &str {
+        "host_only"
+    }
+}
+
+/// The GPU declares the settings it implements, not only the parts (issue 48): every setting
+/// of every shipped scene is among them, with the polarity's contact inhibition and a wound
+/// besides; a term of a user's is refused by its table, a value the kernels do not know and a
+/// key no part had when the GPU's list was written are refused by name.
+#[test]
+fn the_gpu_refuses_a_setting_it_has_not_implemented_by_name() {
+    let scenes = std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"));
+    let mut seen = std::collections::BTreeSet::new();
+    for path in scenes {
+        let text = std::fs::read_to_string(&path).unwrap();
+        for set in [&[][..], &["polarity.contact_inhibition=1.0"][..]] {
+            let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+            let Ok(scene) = scene::Scene::parse(&text, &set) else {
+                continue; // a scene without [polarity]
+            };
+            let ext = scene.configured_extensions();
+            let params = scene.model_params(scene.zeta());
+            assert_eq!(
+                gpu::unsupported(&ext, &params),
+                Vec::<String>::new(),
+                "{}",
+                path.display()
+            );
+            seen.extend(ext.settings(&params).into_iter().map(|s| s.key));
+        }
+    }
+    for key in [
+        "[polarity] align",
+        "[polarity] contact_inhibition",
+        "[walls] kind",
+        "[division] extrusion",
+        "[[population]] zeta",
+    ] {
+        assert!(seen.contains(key), "no shipped scene sets {key}: {seen:?}");
+    }
+    // A term of a user's: its table.
+    let mut terms = mechanics::terms::Terms::default();
+    terms.add(std::sync::Arc::new(HostTerm));
+    let ext = mechanics::Extensions::none().with_terms(terms);
+    let params = mechanics::ModelParams::default();
+    let refused = gpu::unsupported(&ext, &params);
+    assert!(
+        refused.len() == 1 && refused[0].starts_with("[terms.host_only] = "),
+        "{refused:?}"
+    );
+    // A value the kernels do not know, and a key they have never heard of.
+    let setting = |key: &str, value: &str| mechanics::Setting {
+        part: mechanics::Part::Terms,
+        key: key.into(),
+        value: value.into(),
+    };
+    let refused = mechanics::backend::unsupported_settings(
+        &[
+            setting("[polarity] align", "velocity"),
+            setting("[polarity] align", "neighbours"),
+            setting("[polarity] chirality", "0.1"),
+        ],
+        gpu::SETTINGS,
+    );
+    assert_eq!(
+        refused,
+        [
+            "[polarity] align = neighbours",
+            "[polarity] chirality = 0.1"
+        ]
+    );
+}

@@ -31,7 +31,7 @@ mod step;
 pub use device::{adapter_info, Device, GpuError};
 pub use step::{
     unsupported, Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Kind, Params, Variant,
-    MAX_KINDS, SUPPORTED,
+    MAX_KINDS, SETTINGS, SUPPORTED,
 };
 
 /// The WGSL source of the step's kernels, with the constants of a patch shape and pressure

@@ -43,29 +43,57 @@ pub fn shader_source(shape: &PatchShape, kind: PressureKind, cap: u32) -> String
     shader_source_split(shape, kind, cap, u32::MAX, Variant::Plain)
 }
 
+/// The settings of the parts the kernels implement, by scene key, with the values they take
+/// (`None`: any value): every key of `[polarity]` (the built-in term; a term of a user's,
+/// `[terms.NAME]`, runs on the host and is not here), adhesion, each population's constants,
+/// the walls' coefficients and a wound, and the division clock's keys (the clock runs on the
+/// host; the device takes its growth factors). A setting added to a part is refused on the GPU
+/// by name until it is implemented there and listed here.
+pub const SETTINGS: &[(&str, Option<&[&str]>)] = &[
+    ("[polarity] alpha", None),
+    ("[polarity] propulsion", Some(&["cell", "density"])),
+    ("[polarity] rotational_diffusion", None),
+    (
+        "[polarity] align",
+        Some(&["none", "velocity", "force", "shape"]),
+    ),
+    ("[polarity] align_rate", None),
+    ("[polarity] angle", None),
+    ("[polarity] contact_inhibition", None),
+    ("[adhesion] omega", None),
+    ("[[population]] gamma", None),
+    ("[[population]] mu", None),
+    ("[[population]] radius", None),
+    ("[[population]] xi", None),
+    ("[[population]] zeta", None),
+    ("[[population]] alpha", None),
+    ("[[population]] rotational_diffusion", None),
+    ("[[population]] align_rate", None),
+    ("[walls] kappa", None),
+    ("[walls] omega", None),
+    ("[walls] kind", None),
+    ("[division] cycle_time", None),
+    ("[division] axis", None),
+    ("[division] max_cells", None),
+    ("[division] pressure_gate", None),
+    ("[division] extrusion", None),
+    ("[division] extrusion_pressure", None),
+    ("[division] death_rate", None),
+    ("[division] growth_time", None),
+];
+
 /// What of the extensions `ext` (with the model's `params`) the GPU backend does not run, each
 /// named: the parts it does not declare ([`SUPPORTED`], with [`mechanics::Part::describe`]),
-/// and of the physics terms every one but the built-in polarity (a `CellTerm` of a user's runs
-/// on the host), or a polarity rule the kernels do not know. Empty: it runs them all. The one
-/// refusal, for a tissue ([`GpuBackend::check`]) and for a scene before anything is written
-/// (the CLI's).
+/// then the settings in effect it does not implement ([`SETTINGS`], by key and value: a
+/// physics term of a user's, a value the kernels do not know). Empty: it runs them all. The
+/// one refusal, for a tissue ([`GpuBackend::check`]) and for a scene before anything is
+/// written (the CLI's).
 pub fn unsupported(ext: &mechanics::Extensions, params: &mechanics::ModelParams) -> Vec<String> {
     let mut out = mechanics::backend::unsupported(ext, params, SUPPORTED);
-    let terms = ext.terms();
-    let polarity = terms.polarity();
-    for (t, term) in terms.iter().enumerate() {
-        if polarity.map(|(k, _)| k) != Some(t) {
-            out.push(format!(
-                "the physics term {:?} (a CellTerm of your own, which runs on the host)",
-                term.name()
-            ));
-        }
-    }
-    if let Some((_, p)) = polarity {
-        if align_code(p.align).is_none() {
-            out.push(format!("polarity aligning to {:?}", p.align));
-        }
-    }
+    out.extend(mechanics::backend::unsupported_settings(
+        &ext.settings(params),
+        SETTINGS,
+    ));
     out
 }
 

@@ -172,6 +172,26 @@ impl<T: phasefield::Real> crate::Workspace<T> {
     }
 }
 
+/// The settings in effect (`settings`, [`Extensions::settings`]) that a backend which
+/// implements `implemented` cannot run, each named as `KEY = VALUE`: a key it does not list,
+/// or a value outside the values it lists for the key (`None`: every value). Empty: it runs
+/// them all. A backend declares its settings, not only its parts, so that a setting added to
+/// a part is refused by name where it has not been implemented.
+pub fn unsupported_settings(
+    settings: &[crate::extensions::Setting],
+    implemented: &[(&str, Option<&[&str]>)],
+) -> Vec<String> {
+    settings
+        .iter()
+        .filter(|s| {
+            !implemented.iter().any(|(key, values)| {
+                *key == s.key && values.is_none_or(|v| v.contains(&s.value.as_str()))
+            })
+        })
+        .map(|s| format!("{} = {}", s.key, s.value))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::{Arc, Mutex};

@@ -163,6 +163,54 @@ impl Proliferation {
         )
     }
 
+    /// Every key of `[division]` in effect, as `(scene key, value)` (the destructuring has
+    /// no `..`: a field added to the clock does not compile until it is listed, so that no
+    /// backend runs a setting it has never heard of). The cycle is given as the clock holds
+    /// it, `T₀` and the rate `k` of its exponential part.
+    pub fn settings_in_effect(&self) -> Vec<(String, String)> {
+        let Proliferation {
+            t0,
+            rate,
+            axis,
+            max_cells,
+            pressure_gate,
+            extrusion,
+            extrusion_pressure,
+            death_rate,
+            growth_time,
+            seed: _,
+            lineage: _,
+        } = self;
+        let mut out = vec![
+            (
+                "[division] cycle_time".to_string(),
+                format!("T0 = {t0}, k = {rate}"),
+            ),
+            (
+                "[division] axis".into(),
+                match axis {
+                    SplitAxis::Long => "long",
+                    SplitAxis::Random => "random",
+                }
+                .into(),
+            ),
+            ("[division] max_cells".into(), max_cells.to_string()),
+        ];
+        let optional = [
+            ("pressure_gate", *pressure_gate),
+            ("extrusion", *extrusion),
+            ("extrusion_pressure", *extrusion_pressure),
+            ("death_rate", (*death_rate > 0.0).then_some(*death_rate)),
+            ("growth_time", (*growth_time > 0.0).then_some(*growth_time)),
+        ];
+        for (key, v) in optional {
+            if let Some(v) = v {
+                out.push((format!("[division] {key}"), v.to_string()));
+            }
+        }
+        out
+    }
+
     /// A clock of cycle `T₀ + Exp(1/k)` with the default options and no cell in its
     /// lineage: what [`Proliferation::starting_at`] and [`Proliferation::restore`] fill.
     pub(crate) fn empty(t0: f64, rate: f64, seed: u64) -> Self {

@@ -94,7 +94,89 @@ pub struct Extensions {
     pub(crate) target_scale: Vec<f64>,
 }
 
+/// One setting of a part in effect: the scene key that sets it and its value, as a scene
+/// writes them. What a backend compares with what it implements
+/// ([`crate::backend::unsupported_settings`]), so that a setting added to a part is refused by
+/// name on a backend that has not implemented it, rather than ignored.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setting {
+    /// The part it belongs to.
+    pub part: Part,
+    /// The scene key, such as `"[polarity] align"`.
+    pub key: String,
+    /// Its value, such as `"velocity"`.
+    pub value: String,
+}
+
 impl Extensions {
+    /// Every setting in effect of every part, in [`Part::ALL`]'s order (with the model's
+    /// `params`, for adhesion). Each part lists its own from a destructuring of its type
+    /// without `..` (the terms through [`crate::terms::CellTerm::settings`]), so a field added
+    /// to a part does not compile until it is listed.
+    pub fn settings(&self, params: &ModelParams) -> Vec<Setting> {
+        let mut out = Vec::new();
+        let mut add = |part: Part, key: String, value: String| {
+            out.push(Setting { part, key, value });
+        };
+        for part in Part::ALL {
+            match part {
+                Part::Terms => {
+                    for term in self.terms.iter() {
+                        for (key, value) in term.settings() {
+                            add(part, key, value);
+                        }
+                    }
+                }
+                Part::Adhesion => {
+                    if params.omega != 0.0 {
+                        add(part, "[adhesion] omega".into(), params.omega.to_string());
+                    }
+                }
+                Part::Populations => {
+                    for (k, kind) in self.populations.kinds().iter().enumerate() {
+                        let crate::terms::Population {
+                            gamma,
+                            mu,
+                            radius,
+                            xi,
+                            zeta,
+                        } = kind;
+                        for (key, v) in [
+                            ("gamma", gamma),
+                            ("mu", mu),
+                            ("radius", radius),
+                            ("xi", xi),
+                            ("zeta", zeta),
+                        ] {
+                            if let Some(v) = v {
+                                add(
+                                    part,
+                                    format!("[[population]] {key}"),
+                                    format!("{v} (population {k})"),
+                                );
+                            }
+                        }
+                    }
+                }
+                Part::Walls => {
+                    if let Some(w) = &self.walls {
+                        for (key, value) in w.settings() {
+                            add(part, key, value);
+                        }
+                    }
+                }
+                Part::Division => {
+                    if let Some(clock) = &self.proliferation {
+                        for (key, value) in clock.settings_in_effect() {
+                            add(part, key, value);
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// No extension: the paper's model.
     pub fn none() -> Self {
         Self::default()

@@ -95,6 +95,18 @@ pub trait CellTerm: Send + Sync + fmt::Debug + std::any::Any {
         Vec::new()
     }
 
+    /// The settings of this term in effect, each as `(scene key, value)`, for a backend to
+    /// compare with what it implements ([`crate::Extensions::settings`]): by default the
+    /// term's table `[terms.NAME]` as one setting, which no device implements (a term of a
+    /// user's runs on the host). A built-in term lists each key, so that a backend refuses
+    /// one it lacks by name.
+    fn settings(&self) -> Vec<(String, String)> {
+        vec![(
+            format!("[terms.{}]", self.name()),
+            "a physics term whose code runs on the host".into(),
+        )]
+    }
+
     /// Tissue-level observables the term defines from its state, over the cells whose
     /// identities are `ids` (`x` holds `state_names().len()` values per identity), each as
     /// `(name, value)`: the polar order `|⟨p_i⟩|` of [`Polarity`], for example. The analysis

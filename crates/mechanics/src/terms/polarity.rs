@@ -242,6 +242,68 @@ impl CellTerm for Polarity {
         )]
     }
 
+    /// Every key of `[polarity]` in effect (the destructuring has no `..`: a field added to
+    /// [`Polarity`] does not compile until it is listed here, so that no backend runs a
+    /// setting it has never heard of).
+    fn settings(&self) -> Vec<(String, String)> {
+        let Polarity {
+            alpha,
+            propulsion,
+            rotational_diffusion,
+            align,
+            align_rate,
+            initial_angle,
+            contact_inhibition,
+            by_population,
+        } = self;
+        let mut out = vec![
+            ("[polarity] alpha".to_string(), alpha.to_string()),
+            (
+                "[polarity] propulsion".into(),
+                match propulsion {
+                    Propulsion::Cell => "cell",
+                    Propulsion::Density => "density",
+                }
+                .into(),
+            ),
+            (
+                "[polarity] rotational_diffusion".into(),
+                rotational_diffusion.to_string(),
+            ),
+            (
+                "[polarity] align".into(),
+                match align {
+                    Align::None => "none",
+                    Align::Velocity => "velocity",
+                    Align::Force => "force",
+                    Align::Shape => "shape",
+                }
+                .into(),
+            ),
+            ("[polarity] align_rate".into(), align_rate.to_string()),
+        ];
+        if let Some(theta) = initial_angle {
+            out.push(("[polarity] angle".into(), theta.to_string()));
+        }
+        if *contact_inhibition != 0.0 {
+            out.push((
+                "[polarity] contact_inhibition".into(),
+                contact_inhibition.to_string(),
+            ));
+        }
+        for (k, [a, d, j]) in by_population.iter().enumerate() {
+            for (key, v) in [("alpha", a), ("rotational_diffusion", d), ("align_rate", j)] {
+                if let Some(v) = v {
+                    out.push((
+                        format!("[[population]] {key}"),
+                        format!("{v} (population {k})"),
+                    ));
+                }
+            }
+        }
+        out
+    }
+
     /// `polar_order`: `|⟨p_i⟩|`, the length of the mean unit polarity (1 when all point the
     /// same way, about `1/√N` for random angles; NaN for no cell).
     fn observables(&self, x: &[f64], ids: &[usize]) -> Vec<(&'static str, f64)> {

@@ -64,6 +64,29 @@ impl Walls {
         }
     }
 
+    /// Every setting of `[walls]` in effect, as `(scene key, value)` (the destructuring has
+    /// no `..`: a field added here does not compile until it is listed): the coefficients,
+    /// and whether the field changes when the activity starts (a wound that opens).
+    pub fn settings(&self) -> Vec<(String, String)> {
+        let Walls {
+            kappa,
+            omega,
+            relaxation: _,
+            active: _,
+        } = self;
+        let mut out = vec![("[walls] kappa".to_string(), kappa.to_string())];
+        if *omega != 0.0 {
+            out.push(("[walls] omega".into(), omega.to_string()));
+        }
+        if self.open_when_active() {
+            out.push((
+                "[walls] kind".into(),
+                "walls that change when the activity starts (a wound)".into(),
+            ));
+        }
+        out
+    }
+
     /// Whether `other` is the same walls: the same coefficients and the same fields before
     /// and after the activity switch (compared by value, so a wall rebuilt from the scene
     /// equals the one it was built from before).
