@@ -296,85 +296,47 @@ pub(crate) fn evaluate<T: Real>(
                 *p = pressure(kind, &coef, s1, s2, u);
             }
         };
-        // One scatter for each pressure form, and one with adhesion's single-cell part
-        // `c φ ∇²φ` added to `U`: the choice is made once per evaluation, and each node loop
-        // is compiled alone (without adhesion the loops are what they were).
+        // One scatter (`scatter_sums`) with the single-cell part of the pressure that each
+        // node adds to `U` for each pressure form, and with adhesion's `c φ ∇²φ` added: the
+        // choice is made once per evaluation, and each node loop is compiled alone with its
+        // form (without adhesion the loops are what they were).
+        // The scatter, written once; each form of `U` a node gets is a closure of its own, so
+        // that each node loop is compiled with its form alone.
         match (kind, c_adh != 0.0) {
-            (PressureKind::Paper, false) => scatter::<N_SUMS, T, _, _, _>(
+            (PressureKind::Paper, false) => scatter_sums(
                 cells,
                 phi,
                 global,
-                |i| {
-                    let (coef, area_factor, sh) = per_cell(i);
-                    move |run: &StencilRun<'_, T>,
-                          [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
-                        run.add_to(
-                            [],
-                            move |s, []| {
-                                let p = s.c;
-                                let u = pressure_cell_part(
-                                    PressureKind::Paper,
-                                    &coef,
-                                    p,
-                                    s.laplacian(),
-                                    area_factor,
-                                );
-                                node(p, u, sh)
-                            },
-                            [s1, s2, u, qxx, qxy],
-                        )
-                    }
+                &per_cell,
+                node,
+                &finish,
+                move |coef, s, a| {
+                    pressure_cell_part(PressureKind::Paper, coef, s.c, s.laplacian(), a)
                 },
-                finish,
             ),
-            (PressureKind::Interaction, false) => scatter::<N_SUMS, T, _, _, _>(
+            (PressureKind::Interaction, false) => scatter_sums(
                 cells,
                 phi,
                 global,
-                |i| {
-                    let (coef, _, sh) = per_cell(i);
-                    move |run: &StencilRun<'_, T>,
-                          [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
-                        run.add_to(
-                            [],
-                            move |s, []| {
-                                let p = s.c;
-                                let u = pressure_cell_part(
-                                    PressureKind::Interaction,
-                                    &coef,
-                                    p,
-                                    0.0,
-                                    0.0,
-                                );
-                                node(p, u, sh)
-                            },
-                            [s1, s2, u, qxx, qxy],
-                        )
-                    }
+                &per_cell,
+                node,
+                &finish,
+                move |coef, s, _| {
+                    pressure_cell_part(PressureKind::Interaction, coef, s.c, 0.0, 0.0)
                 },
-                finish,
             ),
-            (kind, true) => scatter::<N_SUMS, T, _, _, _>(
+            (kind, true) => scatter_sums(
                 cells,
                 phi,
                 global,
-                |i| {
-                    let (coef, area_factor, sh) = per_cell(i);
-                    move |run: &StencilRun<'_, T>,
-                          [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
-                        run.add_to(
-                            [],
-                            move |s, []| {
-                                let (p, lap) = (s.c, s.laplacian());
-                                let u = pressure_cell_part(kind, &coef, p, lap, area_factor)
-                                    + adhesion_pressure_cell_part(c_adh, p, lap);
-                                node(p, u, sh)
-                            },
-                            [s1, s2, u, qxx, qxy],
-                        )
-                    }
+                &per_cell,
+                node,
+                &finish,
+                move |coef, s, a| {
+                    let (p, lap) = (s.c, s.laplacian());
+                    pressure_cell_part(kind, coef, p, lap, a)
+                        + adhesion_pressure_cell_part(c_adh, p, lap)
                 },
-                finish,
             ),
         }
     }
@@ -495,6 +457,46 @@ pub(crate) fn evaluate<T: Real>(
                 });
         }
     }
+}
+
+/// Pass 2: every cell's `s1, s2, U, Q_xx, Q_xy` scattered onto the lattice (`scatter`), then
+/// `finish` stripe by stripe (the pressure). `per_cell(i)` is what the scatter needs of cell
+/// `i` (energy coefficients, area factor, ζ-weighted `S_i`), `node` its sums at one node, and
+/// `cell_u(coef, stencil, area_factor)` the single-cell part of the pressure a node adds to
+/// `U`: the one thing the pressure forms and adhesion change, each a closure of its own, so
+/// that each node loop is compiled with its form alone.
+#[inline(always)]
+fn scatter_sums<T, C, N, F, U>(
+    cells: &Cells<T>,
+    phi: &[T],
+    global: &mut LatticeSums<N_SUMS>,
+    per_cell: &C,
+    node: N,
+    finish: &F,
+    cell_u: U,
+) where
+    T: Real,
+    C: Fn(usize) -> (EnergyCoefficients, f64, [f64; 2]) + Sync,
+    N: Fn(f64, f64, [f64; 2]) -> [f64; 5] + Copy + Sync,
+    F: Fn([&mut [f64]; N_SUMS]) + Sync,
+    U: Fn(&EnergyCoefficients, &Stencil, f64) -> f64 + Copy + Sync,
+{
+    scatter::<N_SUMS, T, _, _, _>(
+        cells,
+        phi,
+        global,
+        |i| {
+            let (coef, area_factor, sh) = per_cell(i);
+            move |run: &StencilRun<'_, T>, [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
+                run.add_to(
+                    [],
+                    move |s, []| node(s.c, cell_u(&coef, &s, area_factor), sh),
+                    [s1, s2, u, qxx, qxy],
+                )
+            }
+        },
+        finish,
+    );
 }
 
 /// What the force pass reads besides the cell: the lattice sums, the patch shape, the lattice
