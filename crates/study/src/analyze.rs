@@ -178,8 +178,10 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         path: out.clone(),
         source,
     })?;
+    // The rows first: the columns the terms add (`CellTerm::observables`, beyond the
+    // documented `polar_order`) are known once a frame is read.
     let mut obs = String::new();
-    row!(obs, "{}", rundir::OBSERVABLES_HEADER);
+    let mut term_columns: Option<Vec<&'static str>> = None;
     let mut defects_csv = String::new();
     // Axes and angle conventions are in the README: a comment line here would be taken for
     // the header by pandas and numpy.
@@ -240,7 +242,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         if let Some(lineage) = &lineage {
             check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
         }
-        let (demix, polar) = mixing_and_order(&frame, &shape);
+        let (demix, polar, term_obs) = mixing_and_order(&frame, &shape);
+        let columns = term_columns.get_or_insert_with(|| term_obs.iter().map(|o| o.0).collect());
         // Each cell's shape index P/√A, averaged; and the centres for the MSD.
         let cells_n = frame.centres.len();
         let patch = shape.nx * shape.ny;
@@ -348,8 +351,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             Some(p) if time > p => creations as f64 / ((time - p) * area),
             _ => f64::NAN,
         };
-        row!(
-            obs,
+        let mut line = format!(
             "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
@@ -368,12 +370,27 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             f.vx.iter().sum::<f64>() / area,
             f.vy.iter().sum::<f64>() / area
         );
+        for name in columns.iter() {
+            let v = term_obs
+                .iter()
+                .find(|o| o.0 == *name)
+                .map_or(f64::NAN, |o| o.1);
+            line += &format!(",{v:e}");
+        }
+        row!(obs, "{line}");
         prev_time = Some(time);
         info.frames += 1;
         info.defects += found.len();
         info.events += tracks.events.len();
     }
-    write_file(&out.join("observables.csv"), obs.as_bytes())?;
+    let mut header = rundir::OBSERVABLES_HEADER.to_string();
+    for name in term_columns.iter().flatten() {
+        header += &format!(",{name}");
+    }
+    write_file(
+        &out.join("observables.csv"),
+        format!("{header}\n{obs}").as_bytes(),
+    )?;
     let mut msd_csv = String::new();
     row!(msd_csv, "{}", rundir::MSD_HEADER);
     for p in analysis::motion::msd(&positions, [lattice.lx as f64, lattice.ly as f64]) {
@@ -520,9 +537,13 @@ fn write_cell_events(
 }
 
 /// The demixing parameter of the frame's populations over the cells that touch
-/// (`analysis::mixing`; NaN without populations), and the polar order `|⟨p_i⟩|` of the
-/// cells' polarities (NaN without `[polarity]`).
-fn mixing_and_order(frame: &LoadedFrame, shape: &PatchShape) -> (f64, f64) {
+/// (`analysis::mixing`; NaN without populations), the polar order `|⟨p_i⟩|` of the cells'
+/// polarities (NaN without `[polarity]`), and every other observable the terms define, by
+/// name (columns of their own at the end of `observables.csv`).
+fn mixing_and_order(
+    frame: &LoadedFrame,
+    shape: &PatchShape,
+) -> (f64, f64, Vec<(&'static str, f64)>) {
     let tissue = &frame.tissue;
     let pops = tissue.populations();
     let demix = if pops.is_empty() {
@@ -537,13 +558,12 @@ fn mixing_and_order(frame: &LoadedFrame, shape: &PatchShape) -> (f64, f64) {
     };
     // The terms' own observables (`CellTerm::observables`) over the frame's cells.
     let ids: Vec<usize> = (0..tissue.n_cells()).collect();
-    let polar = tissue
+    let (polar, others): (Vec<_>, Vec<_>) = tissue
         .terms()
         .observables(&ids)
         .into_iter()
-        .find(|(name, _)| *name == "polar_order")
-        .map_or(f64::NAN, |(_, v)| v);
-    (demix, polar)
+        .partition(|(name, _)| *name == "polar_order");
+    (demix, polar.first().map_or(f64::NAN, |o| o.1), others)
 }
 
 fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {

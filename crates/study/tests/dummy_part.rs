@@ -2,8 +2,8 @@
 //! 48): a dummy term, `[terms.spin]`, with a per-cell angle that turns at a rate ω, the unit
 //! vector of that angle as a derived per-cell vector, and an observable of its own, goes
 //! through frames, checkpoints and a resume, `init = "frame"`, the ParaView cells file, the
-//! render's arrows, the observables hook and a backend's refusal by name, with nothing of it
-//! written anywhere but here.
+//! render's arrows, the observables hook (a column of `observables.csv`) and a backend's
+//! refusal by name, with nothing of it written anywhere but here.
 
 use std::sync::Arc;
 
@@ -133,6 +133,19 @@ fn a_new_part_reaches_every_consumer() {
         obs.len() == 1 && obs[0].0 == "spin_order" && (0.0..=1.0).contains(&obs[0].1),
         "{obs:?}"
     );
+
+    // ...and the analysis writes it as a column of its own, after the documented ones.
+    study::analyze::analyze(&full, &study::analyze::AnalyzeOptions::default()).unwrap();
+    let table = std::fs::read_to_string(full.join("analysis/observables.csv")).unwrap();
+    let mut lines = table.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        format!("{},spin_order", rundir::OBSERVABLES_HEADER)
+    );
+    for line in lines {
+        let v: f64 = line.rsplit(',').next().unwrap().parse().unwrap();
+        assert!((0.0..=1.0).contains(&v), "{line}");
+    }
 
     // ParaView: the cells file carries the state and the vector (3 components).
     let vtk = tmp.path().join("vtk");
