@@ -397,7 +397,7 @@ impl Proliferation {
     }
 
     /// Records the end of the cell `id` at `time`, at `place`, for `why` (call it with the
-    /// identity [`Tissue::remove`] returns).
+    /// identity [`crate::Tissue::remove`] returns).
     pub fn removed(&mut self, id: usize, time: f64, place: [f64; 2], why: Ending) {
         if let Some(r) = self.lineage.get_mut(id).filter(|r| r.id == id) {
             r.death = Some((time, why));

@@ -9,8 +9,8 @@ use crate::geometry::TracelessTensor;
 /// Fields of the lattice-wide sums of one evaluation.
 pub(crate) const N_SUMS: usize = 6;
 
-/// A lattice-wide sum left in the [`Workspace`] by an evaluation (read it with
-/// [`Workspace::sum`] or [`Workspace::sum_field`]).
+/// A lattice-wide sum left in the [`crate::Workspace`] by an evaluation (read it with
+/// [`crate::Workspace::sum`] or [`crate::Workspace::sum_field`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum SumField {

@@ -52,7 +52,7 @@ pub enum Source {
     Frame,
 }
 
-/// The name of the array of what the terms see of each cell ([`Terms::last_evaluation`]):
+/// The name of the array of what the terms see of each cell ([`crate::terms::Terms::last_evaluation`]):
 /// not of the form `term.variable`, so that no term's state can take it.
 pub const TERM_INPUTS: &str = "term_inputs";
 
