@@ -56,56 +56,7 @@ enum Command {
     /// Run a scene over a grid of values and seeds: each point an ordinary run directory under
     /// OUT/runs/, and OUT/summary.csv with one row per run. A second call with the same
     /// arguments redoes only the runs that did not finish.
-    Sweep {
-        /// The scene file (TOML); with `--collect` it may be left out, and the sweep recorded in
-        /// OUT is read.
-        #[arg(required_unless_present = "collect")]
-        scene: Option<PathBuf>,
-        /// An axis of the grid, e.g. `--vary model.zeta=0.004,0.006` (repeatable; the last
-        /// varies fastest).
-        #[arg(long = "vary", value_name = "SECTION.KEY=V1,V2,...")]
-        vary: Vec<String>,
-        /// Seeds of each point, `A-B` or `A` (default: the scene's `[run] seed`).
-        #[arg(long)]
-        seeds: Option<String>,
-        /// Override a scene value for every point (repeatable).
-        #[arg(long = "set", value_name = "SECTION.KEY=VALUE")]
-        set: Vec<String>,
-        /// The sweep directory (created if missing).
-        #[arg(long)]
-        out: PathBuf,
-        /// Runs at a time; each gets cores / jobs threads. Results do not depend on it.
-        #[arg(long, default_value_t = 1)]
-        jobs: usize,
-        /// No progress output.
-        #[arg(long, short)]
-        quiet: bool,
-        /// Where the runs happen: `local` (here, the default) or `slurm` (writes
-        /// OUT/slurm/sweep.sbatch, a job array of one task per run that is not complete).
-        #[arg(long, default_value = "local", value_parser = ["local", "slurm"])]
-        backend: String,
-        /// With `--backend slurm`: submit the job array with `sbatch`.
-        #[arg(long)]
-        submit: bool,
-        /// Only build OUT/summary.csv from the finished runs (after a SLURM sweep).
-        #[arg(long, conflicts_with = "submit")]
-        collect: bool,
-        /// Threads of each run (default: cores / jobs; with `--backend slurm`, the CPUs of each
-        /// task, default 1).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Analyse every run (as `monolayer analyze`) and add the three correlation lengths,
-        /// the defect density and the creation rate to the summary.
-        #[arg(long)]
-        analyze: bool,
-        /// With `--analyze`: the options of `monolayer analyze`.
-        #[command(flatten)]
-        analysis: AnalysisArgs,
-        /// Refuse a local sweep whose largest point, times --jobs, has a memory estimate above
-        /// this, e.g. `8G` (default: the memory available on this machine).
-        #[arg(long, value_name = "BYTES")]
-        max_memory: Option<String>,
-    },
+    Sweep(SweepCmd),
     /// The activity threshold of a sweep: for every combination of its other axes, the
     /// activity where the late growth rate of ln v_rms first exceeds that of zeta = 0 from the
     /// same seeds (linear interpolation, with its bracket); writes DIR/threshold.csv.
@@ -140,67 +91,7 @@ enum Command {
     /// Draw the frames of a run directory: one PNG per frame (each cell's contour φ_i = 1/2,
     /// filled by a quantity with a colour bar; on request the director, the ±1/2 defects, the
     /// flow and the deformation axes), and optionally a movie.
-    Render {
-        /// A directory written by `monolayer run`.
-        run_dir: PathBuf,
-        /// The directory of the PNGs (created if missing; not needed with --no-pngs).
-        #[arg(long, required_unless_present = "no_pngs")]
-        out: Option<PathBuf>,
-        /// `all`, or steps such as `0,500,1000` (the numbers in frames/frame_STEP.npz).
-        #[arg(long, default_value = "all")]
-        frames: String,
-        /// What fills the cells: none, velocity (|v_i|), pressure (the cell's mean P), area,
-        /// deformation (|S_i|), id (a colour per cell), population ([[population]], a colour
-        /// each, named in a legend), generation and lineage (with [division]: a colour per
-        /// generation, named in a legend, or per founder).
-        #[arg(long, default_value = "none")]
-        colour: String,
-        /// The director of the smoothed Q, as short segments.
-        #[arg(long)]
-        director: bool,
-        /// The ±1/2 defects of the smoothed Q: a comet for +1/2 (tail along its orientation),
-        /// three arms for -1/2.
-        #[arg(long)]
-        defects: bool,
-        /// Arrows of the velocity field.
-        #[arg(long)]
-        flow: bool,
-        /// Each cell's principal deformation axis (with --colour none: the paper's Fig. 1b).
-        #[arg(long)]
-        axes: bool,
-        /// Each cell's polarity as an arrow (scenes with [polarity]).
-        #[arg(long)]
-        polarity: bool,
-        /// Each cell's track: its centre through every frame of the run up to the one drawn.
-        #[arg(long)]
-        tracks: bool,
-        /// The divisions (rings), extrusions (black ×) and deaths (grey ×) since the frame
-        /// before, from lineage.csv (scenes with [division]).
-        #[arg(long)]
-        events: bool,
-        /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
-        #[arg(long)]
-        size: Option<u32>,
-        /// The colour bar's range `LOW,HIGH` (default: each frame's own; fix it for movies).
-        #[arg(long, value_name = "LOW,HIGH")]
-        range: Option<String>,
-        /// Also a movie of the frames: FILE.gif or FILE.apng (pure Rust) or FILE.mp4 (needs
-        /// ffmpeg on the PATH).
-        #[arg(long)]
-        movie: Option<PathBuf>,
-        /// Frames per second of the movie.
-        #[arg(long, default_value_t = 5.0)]
-        fps: f64,
-        /// With --movie: no PNG per frame.
-        #[arg(long, requires = "movie")]
-        no_pngs: bool,
-        /// Worker threads (default: all cores).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// No progress output.
-        #[arg(long, short)]
-        quiet: bool,
-    },
+    Render(RenderCmd),
     /// Write a run directory as files other programs open.
     Export {
         #[command(subcommand)]
@@ -342,6 +233,284 @@ fn finished(info: &run::RunInfo, dir: &std::path::Path, quiet: bool) -> ExitCode
     ExitCode::SUCCESS
 }
 
+#[derive(clap::Args)]
+struct SweepCmd {
+    /// The scene file (TOML); with `--collect` it may be left out, and the sweep recorded in
+    /// OUT is read.
+    #[arg(required_unless_present = "collect")]
+    scene: Option<PathBuf>,
+    /// An axis of the grid, e.g. `--vary model.zeta=0.004,0.006` (repeatable; the last
+    /// varies fastest).
+    #[arg(long = "vary", value_name = "SECTION.KEY=V1,V2,...")]
+    vary: Vec<String>,
+    /// Seeds of each point, `A-B` or `A` (default: the scene's `[run] seed`).
+    #[arg(long)]
+    seeds: Option<String>,
+    /// Override a scene value for every point (repeatable).
+    #[arg(long = "set", value_name = "SECTION.KEY=VALUE")]
+    set: Vec<String>,
+    /// The sweep directory (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Runs at a time; each gets cores / jobs threads. Results do not depend on it.
+    #[arg(long, default_value_t = 1)]
+    jobs: usize,
+    /// No progress output.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Where the runs happen: `local` (here, the default) or `slurm` (writes
+    /// OUT/slurm/sweep.sbatch, a job array of one task per run that is not complete).
+    #[arg(long, default_value = "local", value_parser = ["local", "slurm"])]
+    backend: String,
+    /// With `--backend slurm`: submit the job array with `sbatch`.
+    #[arg(long)]
+    submit: bool,
+    /// Only build OUT/summary.csv from the finished runs (after a SLURM sweep).
+    #[arg(long, conflicts_with = "submit")]
+    collect: bool,
+    /// Threads of each run (default: cores / jobs; with `--backend slurm`, the CPUs of each
+    /// task, default 1).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Analyse every run (as `monolayer analyze`) and add the three correlation lengths,
+    /// the defect density and the creation rate to the summary.
+    #[arg(long)]
+    analyze: bool,
+    /// With `--analyze`: the options of `monolayer analyze`.
+    #[command(flatten)]
+    analysis: AnalysisArgs,
+    /// Refuse a local sweep whose largest point, times --jobs, has a memory estimate above
+    /// this, e.g. `8G` (default: the memory available on this machine).
+    #[arg(long, value_name = "BYTES")]
+    max_memory: Option<String>,
+}
+
+#[derive(clap::Args)]
+struct RenderCmd {
+    /// A directory written by `monolayer run`.
+    run_dir: PathBuf,
+    /// The directory of the PNGs (created if missing; not needed with --no-pngs).
+    #[arg(long, required_unless_present = "no_pngs")]
+    out: Option<PathBuf>,
+    /// `all`, or steps such as `0,500,1000` (the numbers in frames/frame_STEP.npz).
+    #[arg(long, default_value = "all")]
+    frames: String,
+    /// What fills the cells: none, velocity (|v_i|), pressure (the cell's mean P), area,
+    /// deformation (|S_i|), id (a colour per cell), population ([[population]], a colour
+    /// each, named in a legend), generation and lineage (with [division]: a colour per
+    /// generation, named in a legend, or per founder).
+    #[arg(long, default_value = "none")]
+    colour: String,
+    /// The director of the smoothed Q, as short segments.
+    #[arg(long)]
+    director: bool,
+    /// The ±1/2 defects of the smoothed Q: a comet for +1/2 (tail along its orientation),
+    /// three arms for -1/2.
+    #[arg(long)]
+    defects: bool,
+    /// Arrows of the velocity field.
+    #[arg(long)]
+    flow: bool,
+    /// Each cell's principal deformation axis (with --colour none: the paper's Fig. 1b).
+    #[arg(long)]
+    axes: bool,
+    /// Each cell's polarity as an arrow (scenes with [polarity]).
+    #[arg(long)]
+    polarity: bool,
+    /// Each cell's track: its centre through every frame of the run up to the one drawn.
+    #[arg(long)]
+    tracks: bool,
+    /// The divisions (rings), extrusions (black ×) and deaths (grey ×) since the frame
+    /// before, from lineage.csv (scenes with [division]).
+    #[arg(long)]
+    events: bool,
+    /// The picture's width in pixels (default: 4 per node, from 400 to 1000).
+    #[arg(long)]
+    size: Option<u32>,
+    /// The colour bar's range `LOW,HIGH` (default: each frame's own; fix it for movies).
+    #[arg(long, value_name = "LOW,HIGH")]
+    range: Option<String>,
+    /// Also a movie of the frames: FILE.gif or FILE.apng (pure Rust) or FILE.mp4 (needs
+    /// ffmpeg on the PATH).
+    #[arg(long)]
+    movie: Option<PathBuf>,
+    /// Frames per second of the movie.
+    #[arg(long, default_value_t = 5.0)]
+    fps: f64,
+    /// With --movie: no PNG per frame.
+    #[arg(long, requires = "movie")]
+    no_pngs: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress output.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+/// `monolayer sweep`.
+fn sweep_command(cmd: SweepCmd) -> Result<ExitCode> {
+    let SweepCmd {
+        scene,
+        vary,
+        seeds,
+        set,
+        out,
+        jobs,
+        quiet,
+        backend,
+        submit,
+        collect,
+        threads,
+        analyze,
+        analysis,
+        max_memory,
+    } = cmd;
+    anyhow::ensure!(
+        analyze || !analysis.given(),
+        "--from, --box, --crop, --max-link, --max-pair and --s-rms-baseline are options of the analysis: add --analyze"
+    );
+    anyhow::ensure!(
+        !(analyze && backend == "slurm" && !collect),
+        "--analyze runs after the runs: give it with --collect once the SLURM tasks are done"
+    );
+    anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
+    anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
+    anyhow::ensure!(
+        !submit || backend == "slurm",
+        "--submit needs --backend slurm"
+    );
+    let action = if collect {
+        SweepAction::Collect
+    } else if backend == "slurm" {
+        SweepAction::Slurm { submit }
+    } else {
+        SweepAction::Local
+    };
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let default_threads = match action {
+        SweepAction::Slurm { .. } => 1,
+        _ => (cores / jobs).max(1),
+    };
+    let args = monolayer_cli::sweep::SweepArgs {
+        scene: scene.as_deref(),
+        vary: &vary,
+        seeds: seeds.as_deref(),
+        set: &set,
+        out: &out,
+        jobs,
+        threads: threads.unwrap_or(default_threads),
+        quiet,
+        action,
+        max_memory: max_memory.as_deref(),
+        analyze: analyze.then(|| analysis.options()),
+    };
+    match monolayer_cli::sweep::sweep(&args)? {
+        SweepOutcome::Ran(info, n) if !quiet => say!(
+            "done: {} of {n} runs taken ({} steps), {} already complete; summary in {}",
+            info.ran,
+            info.steps,
+            info.skipped,
+            out.join("summary.csv").display()
+        ),
+        SweepOutcome::JobArray(job, submitted) if !quiet => match (job.tasks, submitted) {
+            (0, _) => say!("every run is complete; build the summary with --collect"),
+            (n, Some(s)) => say!(
+                "{s}: {n} array tasks from {}; when they are done, run monolayer sweep --collect --out {}",
+                job.script.display(),
+                out.display()
+            ),
+            (n, None) => say!(
+                "wrote {} ({n} array tasks); submit it with sbatch, then run monolayer sweep --collect --out {}",
+                job.script.display(),
+                out.display()
+            ),
+        },
+        SweepOutcome::Collected(n) if !quiet => {
+            say!("summary of {n} runs in {}", out.join("summary.csv").display())
+        }
+        _ => {}
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `monolayer render`.
+fn render_command(cmd: RenderCmd) -> Result<ExitCode> {
+    let RenderCmd {
+        run_dir,
+        out,
+        frames,
+        colour,
+        director,
+        defects,
+        flow,
+        axes,
+        polarity,
+        tracks,
+        events,
+        size,
+        range,
+        movie,
+        fps,
+        no_pngs,
+        threads,
+        quiet,
+    } = cmd;
+    let range = range
+        .map(|r| {
+            let v: Vec<f64> = r.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            match v[..] {
+                [lo, hi] => Ok((lo, hi)),
+                _ => Err(anyhow::anyhow!(
+                    "--range {r}: give two numbers LOW,HIGH, e.g. --range 0,0.01"
+                )),
+            }
+        })
+        .transpose()?;
+    let opts = RenderOptions {
+        frames: frames.parse().map_err(anyhow::Error::msg)?,
+        colour: colour.parse().map_err(anyhow::Error::msg)?,
+        director,
+        defects,
+        flow,
+        axes,
+        polarity,
+        tracks,
+        events,
+        size,
+        range,
+        movie,
+        fps,
+        pngs: !no_pngs,
+    };
+    // With --no-pngs only the movie is written, beside which nothing else goes.
+    let out = out.unwrap_or_else(|| {
+        let m = opts.movie.as_deref().unwrap_or(std::path::Path::new("."));
+        m.parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."))
+            .to_path_buf()
+    });
+    let mut progress = monolayer_cli::view::frames_progress("drawn", quiet);
+    let info = pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
+    if !quiet {
+        note_skipped(&info.notes, &run_dir);
+        match &opts.movie {
+            Some(m) if no_pngs => {
+                say!("drew {} frames into {}", info.frames, m.display())
+            }
+            Some(m) => say!(
+                "drew {} frames into {} and {}",
+                info.frames,
+                out.display(),
+                m.display()
+            ),
+            None => say!("drew {} frames into {}", info.frames, out.display()),
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 fn real_main() -> Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
@@ -378,89 +547,7 @@ fn real_main() -> Result<ExitCode> {
             let info = pool.install(|| run::run(&parsed, new, &out, overwrite, quiet))?;
             Ok(finished(&info, &out, quiet))
         }
-        Command::Sweep {
-            scene,
-            vary,
-            seeds,
-            set,
-            out,
-            jobs,
-            quiet,
-            backend,
-            submit,
-            collect,
-            threads,
-            analyze,
-            analysis,
-            max_memory,
-        } => {
-            anyhow::ensure!(
-                analyze || !analysis.given(),
-                "--from, --box, --crop, --max-link, --max-pair and --s-rms-baseline are options of the analysis: add --analyze"
-            );
-            anyhow::ensure!(
-                !(analyze && backend == "slurm" && !collect),
-                "--analyze runs after the runs: give it with --collect once the SLURM tasks are done"
-            );
-            anyhow::ensure!(jobs >= 1, "--jobs must be at least 1");
-            anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
-            anyhow::ensure!(
-                !submit || backend == "slurm",
-                "--submit needs --backend slurm"
-            );
-            let action = if collect {
-                SweepAction::Collect
-            } else if backend == "slurm" {
-                SweepAction::Slurm { submit }
-            } else {
-                SweepAction::Local
-            };
-            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-            let default_threads = match action {
-                SweepAction::Slurm { .. } => 1,
-                _ => (cores / jobs).max(1),
-            };
-            let args = monolayer_cli::sweep::SweepArgs {
-                scene: scene.as_deref(),
-                vary: &vary,
-                seeds: seeds.as_deref(),
-                set: &set,
-                out: &out,
-                jobs,
-                threads: threads.unwrap_or(default_threads),
-                quiet,
-                action,
-                max_memory: max_memory.as_deref(),
-                analyze: analyze.then(|| analysis.options()),
-            };
-            match monolayer_cli::sweep::sweep(&args)? {
-                SweepOutcome::Ran(info, n) if !quiet => say!(
-                    "done: {} of {n} runs taken ({} steps), {} already complete; summary in {}",
-                    info.ran,
-                    info.steps,
-                    info.skipped,
-                    out.join("summary.csv").display()
-                ),
-                SweepOutcome::JobArray(job, submitted) if !quiet => match (job.tasks, submitted) {
-                    (0, _) => say!("every run is complete; build the summary with --collect"),
-                    (n, Some(s)) => say!(
-                        "{s}: {n} array tasks from {}; when they are done, run monolayer sweep --collect --out {}",
-                        job.script.display(),
-                        out.display()
-                    ),
-                    (n, None) => say!(
-                        "wrote {} ({n} array tasks); submit it with sbatch, then run monolayer sweep --collect --out {}",
-                        job.script.display(),
-                        out.display()
-                    ),
-                },
-                SweepOutcome::Collected(n) if !quiet => {
-                    say!("summary of {n} runs in {}", out.join("summary.csv").display())
-                }
-                _ => {}
-            }
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Sweep(cmd) => sweep_command(cmd),
         Command::Reproduce {
             figure,
             out,
@@ -500,81 +587,7 @@ fn real_main() -> Result<ExitCode> {
             say!("written to {}", out.display());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Render {
-            run_dir,
-            out,
-            frames,
-            colour,
-            director,
-            defects,
-            flow,
-            axes,
-            polarity,
-            tracks,
-            events,
-            size,
-            range,
-            movie,
-            fps,
-            no_pngs,
-            threads,
-            quiet,
-        } => {
-            let range = range
-                .map(|r| {
-                    let v: Vec<f64> = r.split(',').filter_map(|x| x.trim().parse().ok()).collect();
-                    match v[..] {
-                        [lo, hi] => Ok((lo, hi)),
-                        _ => Err(anyhow::anyhow!(
-                            "--range {r}: give two numbers LOW,HIGH, e.g. --range 0,0.01"
-                        )),
-                    }
-                })
-                .transpose()?;
-            let opts = RenderOptions {
-                frames: frames.parse().map_err(anyhow::Error::msg)?,
-                colour: colour.parse().map_err(anyhow::Error::msg)?,
-                director,
-                defects,
-                flow,
-                axes,
-                polarity,
-                tracks,
-                events,
-                size,
-                range,
-                movie,
-                fps,
-                pngs: !no_pngs,
-            };
-            // With --no-pngs only the movie is written, beside which nothing else goes.
-            let out = out.unwrap_or_else(|| {
-                let m = opts.movie.as_deref().unwrap_or(std::path::Path::new("."));
-                m.parent()
-                    .filter(|p| !p.as_os_str().is_empty())
-                    .unwrap_or(std::path::Path::new("."))
-                    .to_path_buf()
-            });
-            let mut progress = monolayer_cli::view::frames_progress("drawn", quiet);
-            let info =
-                pool(threads)?.install(|| render_run(&run_dir, &out, &opts, &mut progress))?;
-            if !quiet {
-                note_skipped(&info.notes, &run_dir);
-                match &opts.movie {
-                    Some(m) if no_pngs => {
-                        say!("drew {} frames into {}", info.frames, m.display())
-                    }
-                    Some(m) => say!(
-                        "drew {} frames into {} and {}",
-                        info.frames,
-                        out.display(),
-                        m.display()
-                    ),
-                    None => say!("drew {} frames into {}", info.frames, out.display()),
-                }
-            }
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Render(cmd) => render_command(cmd),
         Command::Export {
             format:
                 ExportFormat::Vtk {
