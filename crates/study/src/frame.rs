@@ -443,6 +443,61 @@ pub(crate) fn check_lineage(
     Ok(())
 }
 
+/// The per-cell arrays of the frame at `path` checked for its `n` cells on `lattice`: each of
+/// the right length and finite (`phi` too), every patch origin a node of the lattice. Returns
+/// the origins.
+fn checked_cells(
+    path: &Path,
+    n: usize,
+    lattice: Lattice,
+    [origin, shape_tensor, centre, velocity, area, phi]: [&Array; 6],
+) -> Result<Vec<[usize; 2]>> {
+    for (name, a, len) in [
+        ("origin", origin, 2 * n),
+        ("shape_tensor", shape_tensor, 2 * n),
+        ("centre", centre, 2 * n),
+        ("velocity", velocity, 2 * n),
+        ("area", area, n),
+    ] {
+        if a.data.len() != len {
+            return Err(input(
+                path,
+                format!("{name} has {} values for {n} cells", a.data.len()),
+            ));
+        }
+    }
+    for (name, a) in [
+        ("phi", &phi.data),
+        ("shape_tensor", &shape_tensor.data),
+        ("centre", &centre.data),
+        ("velocity", &velocity.data),
+        ("area", &area.data),
+    ] {
+        let bad = a.iter().filter(|v| !v.is_finite()).count();
+        if bad > 0 {
+            return Err(input(
+                path,
+                format!("array '{name}' holds {bad} non-finite values (NaN or infinite): the state is not one the model can have; analyse the frames before it with --from or rerun with a smaller dt"),
+            ));
+        }
+    }
+    let mut origins: Vec<[usize; 2]> = Vec::with_capacity(n);
+    for (i, o) in origin.data.chunks_exact(2).enumerate() {
+        let ok = |v: f64, l: usize| v >= 0.0 && v.fract() == 0.0 && v < l as f64;
+        if !(ok(o[0], lattice.lx) && ok(o[1], lattice.ly)) {
+            return Err(input(
+                path,
+                format!(
+                    "array 'origin' puts patch {i} at {:?}, off the {}×{} lattice",
+                    o, lattice.lx, lattice.ly
+                ),
+            ));
+        }
+        origins.push([o[0] as usize, o[1] as usize]);
+    }
+    Ok(origins)
+}
+
 /// One frame's state, rebuilt as a tissue.
 pub(crate) fn load_frame(
     path: &Path,
@@ -516,54 +571,17 @@ pub(crate) fn load_frame(
         ));
     }
     let ids = frame_ids(path, n)?;
-    for (name, a, len) in [
-        ("origin", &origin, 2 * n),
-        ("shape_tensor", &shape_tensor, 2 * n),
-        ("centre", &centre, 2 * n),
-        ("velocity", &velocity, 2 * n),
-        ("area", &area, n),
-    ] {
-        if a.data.len() != len {
-            return Err(input(
-                path,
-                format!("{name} has {} values for {n} cells", a.data.len()),
-            ));
-        }
-    }
-    for (name, a) in [
-        ("phi", &phi.data),
-        ("shape_tensor", &shape_tensor.data),
-        ("centre", &centre.data),
-        ("velocity", &velocity.data),
-        ("area", &area.data),
-    ] {
-        let bad = a.iter().filter(|v| !v.is_finite()).count();
-        if bad > 0 {
-            return Err(input(
-                path,
-                format!("array '{name}' holds {bad} non-finite values (NaN or infinite): the state is not one the model can have; analyse the frames before it with --from or rerun with a smaller dt"),
-            ));
-        }
-    }
+    let origins = checked_cells(
+        path,
+        n,
+        lattice,
+        [&origin, &shape_tensor, &centre, &velocity, &area, &phi],
+    )?;
     if !(time.is_finite() && zeta.is_finite()) {
         return Err(input(
             path,
             format!("time {time} or zeta {zeta} is not finite"),
         ));
-    }
-    let mut origins: Vec<[usize; 2]> = Vec::with_capacity(n);
-    for (i, o) in origin.data.chunks_exact(2).enumerate() {
-        let ok = |v: f64, l: usize| v >= 0.0 && v.fract() == 0.0 && v < l as f64;
-        if !(ok(o[0], lattice.lx) && ok(o[1], lattice.ly)) {
-            return Err(input(
-                path,
-                format!(
-                    "array 'origin' puts patch {i} at {:?}, off the {}×{} lattice",
-                    o, lattice.lx, lattice.ly
-                ),
-            ));
-        }
-        origins.push([o[0] as usize, o[1] as usize]);
     }
     let cells = Cells::from_unrolled(lattice, shape.clone(), &origins, &phi.data);
     // The scene's parts, their state then read from the frame as `init = "frame"` reads it

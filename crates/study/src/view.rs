@@ -343,31 +343,13 @@ struct Context<'a> {
     tracks: Option<Vec<Vec<[f64; 2]>>>,
 }
 
-fn picture(
-    run: &Context<'_>,
-    frame: &LoadedFrame,
-    ws: &mut Workspace,
-    opts: &RenderOptions,
-) -> Result<TissuePicture> {
-    let l = run.scene.lattice();
+/// What fills the cells of a picture for `colour`: a value per cell with its label (the
+/// pressure from the evaluated fields `f`), a category per cell with the legend's names
+/// (populations, generations), a colour per key (identities, founders), or nothing.
+fn fill(run: &Context<'_>, frame: &LoadedFrame, f: Option<&TissueFields>, colour: Colour) -> Fill {
     let shape = run.scene.patch_shape();
-    let radius = run.scene.file().cells.radius;
-    let size = opts
-        .size
-        .unwrap_or_else(|| (4 * l.lx).clamp(400, 1000) as u32);
-    let mut p = TissuePicture::new(l.lx, l.ly, size);
-    p.patches = Patches {
-        nx: shape.nx,
-        ny: shape.ny,
-        origins: frame.origins.clone(),
-        phi: frame.phi.clone(),
-    };
-    p.mark = radius;
-    p.walls = frame.tissue.wall_field().map(|w| w.w().to_vec());
-    let need_fields = opts.director || opts.defects || opts.flow || opts.colour == Colour::Pressure;
-    let f: Option<TissueFields> = need_fields.then(|| frame.tissue.fields(ws));
-    let signed = opts.colour == Colour::Pressure;
-    let values: Option<(Vec<f64>, &str)> = match opts.colour {
+    let signed = colour == Colour::Pressure;
+    let values: Option<(Vec<f64>, &str)> = match colour {
         Colour::None | Colour::Id | Colour::Lineage | Colour::Generation | Colour::Population => {
             None
         }
@@ -381,16 +363,11 @@ fn picture(
             "|S|",
         )),
         Colour::Pressure => Some((
-            cell_means(
-                frame,
-                shape.nx,
-                shape.ny,
-                &f.as_ref().expect("evaluated").pressure,
-            ),
+            cell_means(frame, shape.nx, shape.ny, &f.expect("evaluated").pressure),
             "pressure P",
         )),
     };
-    p.fill = match (opts.colour, values) {
+    match (colour, values) {
         (Colour::Id, _) => Fill::Keys(frame.ids.clone()),
         // Categories, in a legend: each population by its name, each generation by number.
         (Colour::Population, _) => {
@@ -437,7 +414,33 @@ fn picture(
             signed,
         },
         _ => Fill::Plain,
+    }
+}
+
+fn picture(
+    run: &Context<'_>,
+    frame: &LoadedFrame,
+    ws: &mut Workspace,
+    opts: &RenderOptions,
+) -> Result<TissuePicture> {
+    let l = run.scene.lattice();
+    let shape = run.scene.patch_shape();
+    let radius = run.scene.file().cells.radius;
+    let size = opts
+        .size
+        .unwrap_or_else(|| (4 * l.lx).clamp(400, 1000) as u32);
+    let mut p = TissuePicture::new(l.lx, l.ly, size);
+    p.patches = Patches {
+        nx: shape.nx,
+        ny: shape.ny,
+        origins: frame.origins.clone(),
+        phi: frame.phi.clone(),
     };
+    p.mark = radius;
+    p.walls = frame.tissue.wall_field().map(|w| w.w().to_vec());
+    let need_fields = opts.director || opts.defects || opts.flow || opts.colour == Colour::Pressure;
+    let f: Option<TissueFields> = need_fields.then(|| frame.tissue.fields(ws));
+    p.fill = fill(run, frame, f.as_ref(), opts.colour);
     p.range = opts.range;
     if let Some(f) = &f {
         if opts.director || opts.defects {
