@@ -13,14 +13,8 @@ type Graph = BTreeMap<String, BTreeSet<String>>;
 
 /// The crates whose modules still form a cycle, each with the modules on it: the test fails
 /// when another crate has one, and when one of these no longer has it (then remove it here).
-const KNOWN_CYCLES: &[(&str, &[&str])] = &[
-    // The scene's file, its validation and checks, and its parts' tables.
-    (
-        "scene",
-        &["check", "division", "file", "registry", "validate", "walls"],
-    ),
-    ("stability", &["map", "rest"]),
-];
+/// None today (issue 48 untied mechanics', scene's and stability's).
+const KNOWN_CYCLES: &[(&str, &[&str])] = &[];
 
 /// What `lib.rs` re-exports at the crate root: the name, and the module it comes from.
 fn root_exports(lib: &str) -> BTreeMap<String, String> {

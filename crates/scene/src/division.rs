@@ -5,8 +5,8 @@ use mechanics::division::{Proliferation, SplitAxis};
 use mechanics::Tissue;
 use phasefield::Real;
 
+use crate::error::{invalid, sig3, SceneError};
 use crate::file::{DivisionAxis, DivisionSpec, InitKind, SceneFile};
-use crate::validate::{invalid, sig3, SceneError};
 
 /// The most cells `[division] max_cells` may allow without being asked: twice as many as fill
 /// the lattice at the target area, `2 lx ly / (πR²)`.

@@ -8,7 +8,7 @@ use phasefield::PatchShape;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-use crate::validate::SceneError;
+use crate::error::SceneError;
 
 /// `[domain]`: the periodic lattice.
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -35,19 +35,20 @@
 
 mod check;
 mod division;
+mod error;
 mod file;
 mod paths;
 mod registry;
 mod validate;
 mod walls;
 
+pub use error::{SceneError, MAX_SIDE, MAX_STEPS};
 pub use file::{
     AdhesionSpec, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain, InitKind,
     Integrator, Model, PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
 };
 pub use paths::absolute_paths;
 pub use registry::{register_term, registered_terms, TermBuilder, TermError};
-pub use validate::{SceneError, MAX_SIDE, MAX_STEPS};
 
 use mechanics::{
     AdaptiveParams, Controller, ModelParams, Precision, Schedule, Simulation, StepParams, Tissue,
@@ -220,8 +221,7 @@ impl Scene {
             return None;
         }
         let dt_max = it.dt_max.unwrap_or_else(|| self.file.stability_estimate());
-        let mut p =
-            AdaptiveParams::new(it.tolerance.unwrap_or(validate::DEFAULT_TOLERANCE), dt_max);
+        let mut p = AdaptiveParams::new(it.tolerance.unwrap_or(error::DEFAULT_TOLERANCE), dt_max);
         let r = &self.file.run;
         p.dt_min = ((r.relax_time + r.time) / MAX_STEPS).max(1e-9).min(dt_max);
         Some(p)
@@ -270,7 +270,7 @@ impl Scene {
                 };
                 format!(
                     "[integrator] {key} = {v} is above the stability estimate {}; the run stops if it blows up",
-                    validate::sig3(dt_max)
+                    error::sig3(dt_max)
                 )
             })
             .into_iter()

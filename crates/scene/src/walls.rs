@@ -6,8 +6,8 @@ use std::path::Path;
 use mechanics::walls::Walls;
 use phasefield::{Lattice, WallField, WallShape};
 
+use crate::error::{invalid, SceneError};
 use crate::file::{WallKind, WallsSpec};
-use crate::validate::{invalid, SceneError};
 
 /// The walls of `[walls]`: their field during the relaxation and after it (none once a wound
 /// has opened), with κ_w and ω_w. `reach` is how far from the solid the distances must be

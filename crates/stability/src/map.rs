@@ -65,6 +65,14 @@ pub fn max_change(a: &Cells<f64>, b: &Cells<f64>) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The largest cell speed of the last evaluation in `ws`.
+pub(crate) fn v_max(ws: &Workspace<f64>) -> f64 {
+    ws.cell_states()
+        .iter()
+        .map(|c| c.velocity.norm())
+        .fold(0.0, f64::max)
+}
+
 /// Euclidean norm.
 pub fn norm(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
@@ -157,7 +165,7 @@ impl StepMap {
         .map_err(StabilityError::Step)?;
         let mut ws = Workspace::new(base.cells());
         base.refresh(&mut ws);
-        let residual_speed = crate::rest::v_max(&ws);
+        let residual_speed = v_max(&ws);
         let translations = translation_modes(base.cells());
         let steps = steps.max(1);
         let mut image = base.clone();

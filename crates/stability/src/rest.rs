@@ -148,14 +148,6 @@ impl Default for Relaxation {
     }
 }
 
-/// The largest cell speed of the last evaluation in `ws`.
-pub(crate) fn v_max(ws: &Workspace<f64>) -> f64 {
-    ws.cell_states()
-        .iter()
-        .map(|c| c.velocity.norm())
-        .fold(0.0, f64::max)
-}
-
 /// Builds the packing of `hex` as discs and relaxes it at ζ = 0 (whatever `params.zeta`), until
 /// its fields change by less than `relax.phi_rate` per unit time, or `relax.max_time`.
 ///
@@ -184,7 +176,7 @@ pub fn rest_state(
         let phi_rate = crate::map::max_change(before.cells(), tissue.cells()) / (t - before.time());
         if t >= relax.max_time || (t >= relax.min_time && phi_rate < relax.phi_rate) {
             tissue.refresh(&mut ws);
-            let v = v_max(&ws);
+            let v = crate::map::v_max(&ws);
             let s_rms = tissue.observe(&mut ws).s_rms;
             return Ok(RestState {
                 tissue,

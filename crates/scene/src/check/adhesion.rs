@@ -1,7 +1,7 @@
 //! The check of `[adhesion]`.
 
+use crate::error::{invalid, SceneError};
 use crate::file::SceneFile;
-use crate::validate::{invalid, SceneError};
 
 /// `[adhesion]`: ω in range, below γ.
 pub(crate) fn adhesion(file: &SceneFile) -> Result<(), SceneError> {

@@ -1,7 +1,7 @@
 //! The check of `[cells]`.
 
+use crate::error::{invalid, SceneError};
 use crate::file::{InitKind, SceneFile};
-use crate::validate::{invalid, SceneError};
 use phasefield::Lattice;
 
 /// The cells: count, radius, initial radius, and the layout's keys (`positions`, `from`).

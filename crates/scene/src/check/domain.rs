@@ -1,7 +1,7 @@
 //! The check of `[domain]`.
 
+use crate::error::{invalid, SceneError, MAX_SIDE};
 use crate::file::SceneFile;
-use crate::validate::{invalid, SceneError, MAX_SIDE};
 
 /// The lattice: each side at least 8 nodes and at most [`MAX_SIDE`].
 pub(crate) fn domain(file: &SceneFile) -> Result<(), SceneError> {

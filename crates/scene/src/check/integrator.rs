@@ -1,7 +1,7 @@
 //! The check of `[integrator]` (and of the settings the GPU backend refuses).
 
+use crate::error::{invalid, readable, sig3, SceneError, DEFAULT_TOLERANCE, MAX_STEPS};
 use crate::file::{ComputeBackend, SceneFile};
-use crate::validate::{invalid, readable, sig3, SceneError, DEFAULT_TOLERANCE, MAX_STEPS};
 use phasefield::{Lattice, PatchShape};
 
 /// The integrator: dt against the stability estimate, the adaptive step's keys, the correctors, the margin against every radius, the GPU's refusals, and the patch against the lattice.

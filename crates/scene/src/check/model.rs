@@ -1,7 +1,7 @@
 //! The check of `[model]`.
 
+use crate::error::{invalid, SceneError};
 use crate::file::SceneFile;
-use crate::validate::{invalid, SceneError};
 
 /// The model's parameters.
 pub(crate) fn model(file: &SceneFile) -> Result<(), SceneError> {

@@ -1,7 +1,7 @@
 //! The check of `[polarity]`.
 
+use crate::error::{invalid, SceneError};
 use crate::file::{AlignKind, SceneFile};
-use crate::validate::{invalid, SceneError};
 
 /// `[polarity]`: each key in range.
 pub(crate) fn polarity(file: &SceneFile) -> Result<(), SceneError> {

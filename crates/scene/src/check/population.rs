@@ -1,7 +1,7 @@
 //! The check of the `[[population]]` tables.
 
+use crate::error::{invalid, SceneError};
 use crate::file::SceneFile;
-use crate::validate::{invalid, SceneError};
 
 /// The `[[population]]` tables: counts that add up, each override in range, polarity keys only with `[polarity]`.
 pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {

@@ -1,7 +1,7 @@
 //! The check of `[run]`.
 
+use crate::error::{invalid, sig3, SceneError, MAX_STEPS};
 use crate::file::SceneFile;
-use crate::validate::{invalid, sig3, SceneError, MAX_STEPS};
 
 /// The run's times and output intervals (against `dt`, and the step bound).
 pub(crate) fn run(file: &SceneFile) -> Result<(), SceneError> {

@@ -1,7 +1,7 @@
 //! The check of `[walls]`.
 
+use crate::error::{invalid, SceneError};
 use crate::file::SceneFile;
-use crate::validate::{invalid, SceneError};
 
 /// A wound needs a relaxation to open after (the geometry is checked when the walls are built, `crate::walls::walls_of`).
 pub(crate) fn walls(file: &SceneFile) -> Result<(), SceneError> {
