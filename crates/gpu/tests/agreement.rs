@@ -929,7 +929,8 @@ fn a_term_of_your_own_is_refused_by_name() {
     let tissue = paper_tissue(0.0).with_terms(Terms::new(1).with(Polarity::new(0.01)).with(Push));
     let err = GpuBackend::check(&tissue, &sp).unwrap_err().to_string();
     assert!(
-        err.contains("\"push\"")
+        err.contains("[terms.push]")
+            && err.contains("runs on the host")
             && err.contains("backend = \"cpu\"")
             && !err.contains("polarity ("),
         "{err}"
