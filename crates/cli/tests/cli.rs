@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use crate::common::{bin, check_rejected, resume_matches, run_files, scene_path, stderr};
+use crate::common::{
+    bin, check_rejected, python_has, resume_matches, run_files, run_python, scene_path, stderr,
+};
 
 fn run(scene: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut c = bin();
@@ -71,17 +73,7 @@ fn a_run_writes_scene_series_and_frames() {
 /// says so and passes only if NumPy is missing *and* we are not in CI.
 #[test]
 fn frames_load_in_numpy_without_custom_code() {
-    let have_numpy = Command::new("python3")
-        .args(["-c", "import numpy"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false);
-    if !have_numpy {
-        assert!(
-            std::env::var("CI").is_err(),
-            "CI must install numpy (see .ci/run)"
-        );
-        eprintln!("numpy not installed: skipping the NumPy check");
+    if !python_has("numpy", "numpy") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
@@ -113,15 +105,7 @@ print("ok")
 "#,
         dir.path().display()
     );
-    let py = Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(
-        py.status.success(),
-        "{}",
-        String::from_utf8_lossy(&py.stderr)
-    );
+    run_python(&script);
 }
 
 #[test]
@@ -643,16 +627,7 @@ fn analyze_after_run_writes_consistent_files() {
 /// columns `run.json` lists and one row per data line. CI installs pandas (`.ci/run`);
 /// elsewhere the check is skipped when pandas is missing.
 fn pandas_reads_every_table(run_dir: &Path) {
-    let have = Command::new("python3")
-        .args(["-c", "import pandas"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !have {
-        assert!(
-            std::env::var("CI").is_err(),
-            "CI must install pandas (see .ci/run)"
-        );
-        eprintln!("pandas not installed: skipping the pandas check");
+    if !python_has("pandas", "pandas") {
         return;
     }
     let script = format!(
@@ -670,15 +645,7 @@ print("ok")
 "#,
         run_dir.display()
     );
-    let py = Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(
-        py.status.success(),
-        "{}",
-        String::from_utf8_lossy(&py.stderr)
-    );
+    run_python(&script);
 }
 
 /// A missing, partial or foreign run directory gets a message that says what is wrong.

@@ -2,7 +2,7 @@
 //! scene: the files exist, decode, hold every frame, and carry the frame's values, checked
 //! by our own reader and by VTK's.
 
-use crate::common::{bin, stderr};
+use crate::common::{bin, python_has, run_python, stderr};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -213,16 +213,7 @@ fn export_vtk_round_trips_through_our_reader_and_vtks() {
     assert_eq!(vti.arrays[1].2, owner);
     assert!(owner.iter().any(|&o| o < 0.0) && owner.iter().any(|&o| o >= 59.0));
 
-    let have = Command::new("python3")
-        .args(["-c", "import vtkmodules.vtkIOXML, numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !have {
-        assert!(
-            std::env::var("CI").is_err(),
-            "CI must install vtk (see .ci/run)"
-        );
-        eprintln!("the vtk Python package is not installed: skipping VTK's reader");
+    if !python_has("vtkmodules.vtkIOXML, numpy", "vtk") {
         return;
     }
     let script = format!(
@@ -281,16 +272,7 @@ print("ok")
         run = run.display(),
         out = out.display()
     );
-    let py = Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(
-        py.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&py.stdout),
-        String::from_utf8_lossy(&py.stderr)
-    );
+    run_python(&script);
 }
 
 /// The cells' ParaView file holds every per-cell array the frame has for the scene's parts,
@@ -327,16 +309,7 @@ fn the_cells_file_holds_every_part_array_of_the_frame() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
-    let have = Command::new("python3")
-        .args(["-c", "import vtkmodules.vtkIOXML, numpy"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !have {
-        assert!(
-            std::env::var("CI").is_err(),
-            "CI must install vtk (see .ci/run)"
-        );
-        eprintln!("the vtk Python package is not installed: skipping VTK's reader");
+    if !python_has("vtkmodules.vtkIOXML, numpy", "vtk") {
         return;
     }
     let script = format!(
@@ -367,14 +340,5 @@ print("ok")
 "#,
         run = run.display()
     );
-    let py = Command::new("python3")
-        .args(["-c", &script])
-        .output()
-        .unwrap();
-    assert!(
-        py.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&py.stdout),
-        String::from_utf8_lossy(&py.stderr)
-    );
+    run_python(&script);
 }

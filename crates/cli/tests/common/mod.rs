@@ -129,3 +129,35 @@ pub fn check_rejected(base: &Path, out: &Path, overrides: &[&str], expect: &[&st
         out.display()
     );
 }
+
+/// Whether Python can `import MODULES` (such as `"vtkmodules.vtkIOXML, numpy"`) for a check by
+/// `package`'s own reader. CI must have it (`.ci/run` installs it); elsewhere the caller skips
+/// the check, and this says so.
+pub fn python_has(modules: &str, package: &str) -> bool {
+    let have = Command::new("python3")
+        .args(["-c", &format!("import {modules}")])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have {
+        assert!(
+            std::env::var("CI").is_err(),
+            "CI must install {package} (see .ci/run)"
+        );
+        eprintln!("the {package} Python package is not installed: skipping its check");
+    }
+    have
+}
+
+/// Runs `script` with `python3 -c`, which must succeed (its output is the failure's message).
+pub fn run_python(script: &str) {
+    let py = Command::new("python3")
+        .args(["-c", script])
+        .output()
+        .unwrap();
+    assert!(
+        py.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&py.stdout),
+        String::from_utf8_lossy(&py.stderr)
+    );
+}
