@@ -5,10 +5,11 @@
 use phasefield::kernel::StencilRun;
 use phasefield::Real;
 
+use crate::evaluation::{CellState, SumField};
 use crate::geometry::TracelessTensor;
 use crate::scatter::scatter;
 use crate::tissue::Tissue;
-use crate::workspace::{CellState, SumField, Workspace};
+use crate::workspace::Workspace;
 
 /// Lattice fields, each `lx * ly` long with index `x * ly + y`.
 #[derive(Debug, Clone, PartialEq, Default)]

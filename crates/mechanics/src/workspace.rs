@@ -3,8 +3,7 @@
 
 use phasefield::{Cells, ComTable, Real};
 
-use crate::evaluation::N_SUMS;
-pub use crate::evaluation::{CellState, SumField};
+use crate::evaluation::{CellState, SumField, N_SUMS};
 use crate::scatter::LatticeSums;
 
 /// Scratch memory for [`crate::Tissue::step`] and the observations: built once, reused,
