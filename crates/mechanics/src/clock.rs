@@ -143,24 +143,10 @@ impl Proliferation {
         Ok(())
     }
 
-    /// Every setting of the clock (not its lineage), for comparisons: the cycle, the axis,
-    /// the cap, the gate, the extrusion rule, the death rate, the growth time and the seed.
+    /// Every setting of the clock (not its lineage), for comparisons: those in effect
+    /// ([`Proliferation::settings_in_effect`], which lists every field) and the seed.
     pub fn settings(&self) -> String {
-        format!(
-            "{:?}",
-            (
-                self.t0,
-                self.rate,
-                self.axis,
-                self.max_cells,
-                self.pressure_gate,
-                self.extrusion,
-                self.extrusion_pressure,
-                self.death_rate,
-                self.growth_time,
-                self.seed,
-            )
-        )
+        format!("{:?}", (self.settings_in_effect(), self.seed))
     }
 
     /// Every key of `[division]` in effect, as `(scene key, value)` (the destructuring has
