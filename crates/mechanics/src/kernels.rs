@@ -26,7 +26,7 @@ use crate::equations::{
 };
 use crate::evaluation::{CellState, SumField, N_SUMS};
 use crate::geometry::TracelessTensor;
-use crate::node_terms::NodeTerm;
+use crate::node_terms::{NodeTerm, PopulationSums};
 use crate::params::{ModelParams, PressureKind};
 use crate::scatter::{scatter, LatticeSums};
 use crate::terms::{CellConstants, Populations};
@@ -142,10 +142,16 @@ pub(crate) struct EvalInput<'a, T: Real> {
 pub(crate) struct EvalScratch<'a> {
     pub sums: &'a mut LatticeSums<N_SUMS>,
     pub cell_state: &'a mut [CellState],
-    /// One lattice field for the node terms ([`NodeTerm::add_pressure`]).
+    /// The node terms' lattice fields of scratch, one after the other in the order of the
+    /// terms ([`NodeTerm::scratch_fields`] each).
     pub node_scratch: &'a mut [f64],
-    /// Two lattice fields, the node terms' `a` and `b`.
+    /// The node terms' `a_p` and `b_p`, two lattice fields for each coefficient class (one
+    /// class, or one per population when a term's coefficients depend on it).
     pub node_coefficients: &'a mut [f64],
+    /// The node terms' `[k_p, c_p]` of each class.
+    pub node_constants: &'a mut Vec<[f64; 2]>,
+    /// Each population's `s1_p`, filled when a node term reads them.
+    pub population_sums: &'a mut PopulationSums,
     pub kind_constants: &'a mut Vec<CellConstants>,
 }
 
@@ -230,6 +236,8 @@ pub(crate) fn evaluate<T: Real>(
         cell_state,
         node_scratch,
         node_coefficients: node_buf,
+        node_constants,
+        population_sums,
         kind_constants,
     } = scratch;
     let shape = cells.shape();
@@ -265,24 +273,50 @@ pub(crate) fn evaluate<T: Real>(
             }
         });
 
+    // The node terms' coefficient classes (`crate::node_terms`): one, or one per population
+    // when a term's coefficients depend on it; each class's summed `[k_p, c_p]`.
+    let per_population = terms.iter().flatten().any(|t| t.per_population());
+    let classes = if per_population {
+        pops.kinds().len().max(1)
+    } else {
+        1
+    };
+    let class = |i: usize| {
+        if per_population {
+            pops.population(ids[i])
+        } else {
+            0
+        }
+    };
+    node_constants.clear();
+    node_constants.extend((0..classes).map(|p| {
+        let asked = |t: &&dyn NodeTerm| if t.per_population() { p } else { 0 };
+        let sum = |f: fn(&dyn NodeTerm, usize) -> f64| {
+            terms.iter().flatten().map(|t| f(*t, asked(t))).sum::<f64>()
+        };
+        [
+            sum(|t, p| t.cell_pressure_coefficient(p)),
+            sum(|t, p| t.laplacian_coefficient(p)),
+        ]
+    }));
+    let node_constants: &[[f64; 2]] = node_constants;
+
     // 2. Lattice sums.
     let coef = energy.coefficients();
     let kind = params.pressure;
-    // The node terms' single-cell pressure `k φ ∇²φ` (adhesion's), summed.
-    let c_adh: f64 = terms
-        .iter()
-        .flatten()
-        .map(|t| t.cell_pressure_coefficient())
-        .sum();
+    // Whether a node term has a single-cell pressure `k_p φ ∇²φ` (adhesion's).
+    let cell_part = node_constants.iter().any(|k| k[0] != 0.0);
     {
         let cs: &[CellState] = cell_state;
         // What the scatter needs of cell `i`, once per cell and stripe: its energy
-        // coefficients, its area factor and its deformation tensor weighted by its ζ.
+        // coefficients, its area factor, its deformation tensor weighted by its ζ and the
+        // node terms' `k_p` of its class.
         let per_cell = |i: usize| {
             let k = constants(i);
             let [sxx, sxy] = cs[i].shape.components();
             let sh = [k.zeta_weight * sxx, k.zeta_weight * sxy];
-            (k.coef, k.coef.area_factor(cs[i].area), sh)
+            let k_node = node_constants[class(i)][0];
+            (k.coef, k.coef.area_factor(cs[i].area), sh, k_node)
         };
         let node = move |p: f64, u: f64, sh: [f64; 2]| {
             let [q_xx, q_xy] = nematic_density(p, sh);
@@ -297,12 +331,10 @@ pub(crate) fn evaluate<T: Real>(
             }
         };
         // One scatter (`scatter_sums`) with the single-cell part of the pressure that each
-        // node adds to `U` for each pressure form, and with adhesion's `c φ ∇²φ` added: the
-        // choice is made once per evaluation, and each node loop is compiled alone with its
-        // form (without adhesion the loops are what they were).
-        // The scatter, written once; each form of `U` a node gets is a closure of its own, so
-        // that each node loop is compiled with its form alone.
-        match (kind, c_adh != 0.0) {
+        // node adds to `U` for each pressure form, and with the node terms' `k_p φ ∇²φ` added:
+        // the choice is made once per evaluation, and each node loop is compiled alone with
+        // its form (without adhesion the loops are what they were).
+        match (kind, cell_part) {
             (PressureKind::Paper, false) => scatter_sums(
                 cells,
                 phi,
@@ -310,7 +342,7 @@ pub(crate) fn evaluate<T: Real>(
                 &per_cell,
                 node,
                 &finish,
-                move |coef, s, a| {
+                move |coef, s, a, _| {
                     pressure_cell_part(PressureKind::Paper, coef, s.c, s.laplacian(), a)
                 },
             ),
@@ -321,7 +353,7 @@ pub(crate) fn evaluate<T: Real>(
                 &per_cell,
                 node,
                 &finish,
-                move |coef, s, _| {
+                move |coef, s, _, _| {
                     pressure_cell_part(PressureKind::Interaction, coef, s.c, 0.0, 0.0)
                 },
             ),
@@ -332,31 +364,36 @@ pub(crate) fn evaluate<T: Real>(
                 &per_cell,
                 node,
                 &finish,
-                move |coef, s, a| {
+                move |coef, s, a, k_node| {
                     let (p, lap) = (s.c, s.laplacian());
                     pressure_cell_part(kind, coef, p, lap, a)
-                        + adhesion_pressure_cell_part(c_adh, p, lap)
+                        + adhesion_pressure_cell_part(k_node, p, lap)
                 },
             ),
         }
     }
 
-    // The node terms' lattice parts of the pressure, then their coefficients, gathered by
-    // the force pass.
-    for t in terms.iter().flatten() {
-        t.add_pressure(global, node_scratch);
+    // Each population's `s1_p`, for the node terms that read them; then the terms' lattice
+    // parts of the pressure, then their coefficients, gathered by the force pass.
+    if terms.iter().flatten().any(|t| t.needs_population_sums()) {
+        let n = pops.kinds().len().max(1);
+        population_sums.fill(cells, phi, n, |i| pops.population(ids[i]));
+    }
+    let nodes = cells.lattice().len();
+    {
+        let mut rest: &mut [f64] = node_scratch;
+        for t in terms.iter().flatten() {
+            let (mine, after) = std::mem::take(&mut rest).split_at_mut(t.scratch_fields() * nodes);
+            t.add_pressure(global, population_sums, mine);
+            rest = after;
+        }
     }
     let node_terms = terms.iter().any(Option::is_some).then(|| {
-        fill_node_terms(terms, node_scratch, node_buf);
-        let (a, b) = node_buf.split_at(node_buf.len() / 2);
-        NodeTerms {
-            a,
-            b,
-            c_lap: terms
-                .iter()
-                .flatten()
-                .map(|t| t.laplacian_coefficient())
-                .sum(),
+        fill_node_terms(terms, node_scratch, nodes, node_buf);
+        ClassCoefficients {
+            fields: node_buf,
+            constants: node_constants,
+            nodes,
         }
     });
 
@@ -370,13 +407,13 @@ pub(crate) fn evaluate<T: Real>(
         ly,
         zeta,
         cell_force,
-        node_terms,
     };
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
         let CellConstants { coef, xi, .. } = constants(i);
         let c_self = pressure_self_coefficient(kind, &coef);
-        force_and_rhs(&force_input, i, xs, coef, xi, c_self, cell, st, out);
+        let node = node_terms.as_ref().map(|n| n.of_class(class(i)));
+        force_and_rhs(&force_input, i, xs, coef, xi, c_self, node, cell, st, out);
         // The Heun update of this cell, while its fields are in cache.
         let out: &[T] = out;
         match post {
@@ -461,10 +498,10 @@ pub(crate) fn evaluate<T: Real>(
 
 /// Pass 2: every cell's `s1, s2, U, Q_xx, Q_xy` scattered onto the lattice (`scatter`), then
 /// `finish` stripe by stripe (the pressure). `per_cell(i)` is what the scatter needs of cell
-/// `i` (energy coefficients, area factor, ζ-weighted `S_i`), `node` its sums at one node, and
-/// `cell_u(coef, stencil, area_factor)` the single-cell part of the pressure a node adds to
-/// `U`: the one thing the pressure forms and adhesion change, each a closure of its own, so
-/// that each node loop is compiled with its form alone.
+/// `i` (energy coefficients, area factor, ζ-weighted `S_i`, the node terms' `k_p`), `node` its
+/// sums at one node, and `cell_u(coef, stencil, area_factor, k_p)` the single-cell part of the
+/// pressure a node adds to `U`: the one thing the pressure forms and the node terms change,
+/// each a closure of its own, so that each node loop is compiled with its form alone.
 #[inline(always)]
 fn scatter_sums<T, C, N, F, U>(
     cells: &Cells<T>,
@@ -476,21 +513,21 @@ fn scatter_sums<T, C, N, F, U>(
     cell_u: U,
 ) where
     T: Real,
-    C: Fn(usize) -> (EnergyCoefficients, f64, [f64; 2]) + Sync,
+    C: Fn(usize) -> (EnergyCoefficients, f64, [f64; 2], f64) + Sync,
     N: Fn(f64, f64, [f64; 2]) -> [f64; 5] + Copy + Sync,
     F: Fn([&mut [f64]; N_SUMS]) + Sync,
-    U: Fn(&EnergyCoefficients, &Stencil, f64) -> f64 + Copy + Sync,
+    U: Fn(&EnergyCoefficients, &Stencil, f64, f64) -> f64 + Copy + Sync,
 {
     scatter::<N_SUMS, T, _, _, _>(
         cells,
         phi,
         global,
         |i| {
-            let (coef, area_factor, sh) = per_cell(i);
+            let (coef, area_factor, sh, k_node) = per_cell(i);
             move |run: &StencilRun<'_, T>, [s1, s2, u, qxx, qxy, _]: [&mut [f64]; N_SUMS]| {
                 run.add_to(
                     [],
-                    move |s, []| node(s.c, cell_u(&coef, &s, area_factor), sh),
+                    move |s, []| node(s.c, cell_u(&coef, &s, area_factor, k_node), sh),
                     [s1, s2, u, qxx, qxy],
                 )
             }
@@ -500,18 +537,18 @@ fn scatter_sums<T, C, N, F, U>(
 }
 
 /// What the force pass reads besides the cell: the lattice sums, the patch shape, the lattice
-/// height, ζ (1 when the sums are ζ-weighted), the terms' whole-cell forces and the node terms.
+/// height, ζ (1 when the sums are ζ-weighted) and the terms' whole-cell forces.
 struct ForceInput<'a> {
     global: &'a LatticeSums<N_SUMS>,
     shape: &'a PatchShape,
     ly: usize,
     zeta: f64,
     cell_force: Option<&'a [[f64; 2]]>,
-    node_terms: Option<NodeTerms<'a>>,
 }
 
 /// Pass 3 for cell `i`, on its patch in the thread's padded scratch: the force `F_i`, the
-/// velocity `v_i` (into `st`), then the right-hand side `R_i` into `out`. A function of its
+/// velocity `v_i` (into `st`), then the right-hand side `R_i` into `out`, with the node terms'
+/// coefficients of its class `node_terms`. A function of its
 /// own, never inlined, so that its two chunk loops are compiled with this cell's values alone
 /// in the registers, whatever `evaluate` around it grows into (issue 38: inlined there, the
 /// loops took 4–20 % more instructions depending on the rest of `evaluate`).
@@ -524,6 +561,7 @@ fn force_and_rhs<T: Real>(
     coef: EnergyCoefficients,
     xi: f64,
     c_self: f64,
+    node_terms: Option<NodeTerms<'_>>,
     cell: &[T],
     st: &mut CellState,
     out: &mut [T],
@@ -534,7 +572,6 @@ fn force_and_rhs<T: Real>(
         ly,
         zeta,
         cell_force,
-        node_terms,
     } = *input;
     PADDED.with_borrow_mut(|padded| {
         padded.fill(cell, shape);
@@ -612,7 +649,7 @@ fn force_and_rhs<T: Real>(
     });
 }
 
-/// The node terms' coefficients of an evaluation, summed over its terms
+/// The node terms' coefficients for one class of cells, summed over its terms
 /// ([`crate::node_terms`]): `δF_node/δφ_i = a φ_i + b + c ∇²φ_i`, with the lattice fields `a`
 /// and `b` (index `x * ly + y`) and the constant `c`.
 #[derive(Debug, Clone, Copy)]
@@ -622,21 +659,55 @@ struct NodeTerms<'a> {
     c_lap: f64,
 }
 
-/// The terms' `a` and `b` into the two halves of `out` (two lattice fields), each term adding
-/// its own in the order of `terms`.
-fn fill_node_terms(terms: &[Option<&dyn NodeTerm>], scratch: &[f64], out: &mut [f64]) {
-    let (a, b) = out.split_at_mut(out.len() / 2);
+/// The node terms' coefficients of every class: `a_p`, `b_p` at fields `2p`, `2p + 1` of
+/// `fields` (`nodes` values each) and `[k_p, c_p]` in `constants`.
+struct ClassCoefficients<'a> {
+    fields: &'a [f64],
+    constants: &'a [[f64; 2]],
+    nodes: usize,
+}
+
+impl ClassCoefficients<'_> {
+    /// The coefficients of class `p`.
+    fn of_class(&self, p: usize) -> NodeTerms<'_> {
+        let n = self.nodes;
+        NodeTerms {
+            a: &self.fields[2 * p * n..(2 * p + 1) * n],
+            b: &self.fields[(2 * p + 1) * n..(2 * p + 2) * n],
+            c_lap: self.constants[p][1],
+        }
+    }
+}
+
+/// The terms' `a_p` and `b_p` of every class into `out` (two lattice fields of `nodes` values
+/// per class, as [`ClassCoefficients`] reads them), each term adding its own in the order of
+/// `terms`, reading its part of `scratch` ([`NodeTerm::scratch_fields`]). A term whose
+/// coefficients are the same for every class is asked for population 0.
+fn fill_node_terms(
+    terms: &[Option<&dyn NodeTerm>],
+    scratch: &[f64],
+    nodes: usize,
+    out: &mut [f64],
+) {
     const CHUNK: usize = 4096;
-    a.par_chunks_mut(CHUNK)
-        .zip(b.par_chunks_mut(CHUNK))
-        .enumerate()
-        .for_each(|(c, (a, b))| {
-            a.fill(0.0);
-            b.fill(0.0);
-            for t in terms.iter().flatten() {
-                t.add_coefficients(scratch, c * CHUNK, a, b);
-            }
-        });
+    for (p, class) in out.chunks_exact_mut(2 * nodes).enumerate() {
+        let (a, b) = class.split_at_mut(nodes);
+        a.par_chunks_mut(CHUNK)
+            .zip(b.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (a, b))| {
+                a.fill(0.0);
+                b.fill(0.0);
+                // Each term with its part of the scratch, in order.
+                let mut start = 0;
+                for t in terms.iter().flatten() {
+                    let len = t.scratch_fields() * nodes;
+                    let asked = if t.per_population() { p } else { 0 };
+                    t.add_coefficients(asked, &scratch[start..start + len], c * CHUNK, a, b);
+                    start += len;
+                }
+            });
+    }
 }
 
 /// The node terms' derivative at a node, `a φ + b + c ∇²φ` ([`NodeTerms`]; the Laplacian

@@ -564,8 +564,10 @@ impl<T: Real> Tissue<T> {
     ) -> Result<(), usize> {
         let TermScratch {
             cell_force,
-            lap_s1,
+            node_scratch,
             node_terms: node_terms_buf,
+            node_constants,
+            population_sums,
             kind_constants,
         } = scratch;
         // The node terms of this evaluation, in a fixed order (adhesion, then walls: the
@@ -580,17 +582,23 @@ impl<T: Real> Tissue<T> {
         ];
         // Their lattice scratch, made on its first use (the one allocation of a run with
         // adhesion).
-        let n = if node_terms.iter().flatten().any(|t| t.needs_scratch()) {
-            self.lattice().len()
-        } else {
-            0
-        };
-        if lap_s1.len() != n {
-            lap_s1.resize(n, 0.0);
+        let nodes = self.lattice().len();
+        let n: usize = node_terms
+            .iter()
+            .flatten()
+            .map(|t| t.scratch_fields() * nodes)
+            .sum();
+        if node_scratch.len() != n {
+            node_scratch.resize(n, 0.0);
         }
-        // Their coefficients (made on first use too).
+        // Their coefficients, two fields per class (made on first use too).
+        let classes = if node_terms.iter().flatten().any(|t| t.per_population()) {
+            self.ext.populations.kinds().len().max(1)
+        } else {
+            1
+        };
         let m = if node_terms.iter().any(Option::is_some) {
-            2 * self.lattice().len()
+            2 * classes * nodes
         } else {
             0
         };
@@ -640,8 +648,10 @@ impl<T: Real> Tissue<T> {
         let scratch = EvalScratch {
             sums,
             cell_state,
-            node_scratch: lap_s1,
+            node_scratch,
             node_coefficients: node_terms_buf,
+            node_constants,
+            population_sums,
             kind_constants,
         };
         evaluate(&input, out, scratch, post);

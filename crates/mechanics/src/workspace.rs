@@ -37,11 +37,16 @@ pub struct Workspace<T: Real = f64> {
 pub(crate) struct TermScratch {
     /// The whole-cell forces of the terms for the next evaluation, by slot.
     pub(crate) cell_force: Vec<[f64; 2]>,
-    /// The lattice Laplacian of `s1`, with adhesion only (empty otherwise).
-    pub(crate) lap_s1: Vec<f64>,
-    /// The node terms' two lattice fields of coefficients, with adhesion or walls only
-    /// (empty otherwise).
+    /// The node terms' lattice fields of scratch (adhesion: the Laplacian of `s1`), empty
+    /// without such a term (`crate::node_terms::NodeTerm::scratch_fields`).
+    pub(crate) node_scratch: Vec<f64>,
+    /// The node terms' lattice fields of coefficients, two for each coefficient class, with
+    /// adhesion or walls only (empty otherwise).
     pub(crate) node_terms: Vec<f64>,
+    /// The node terms' constants `[k_p, c_p]` of each class.
+    pub(crate) node_constants: Vec<[f64; 2]>,
+    /// Each population's `s1_p`, for a node term that reads them (empty otherwise).
+    pub(crate) population_sums: crate::node_terms::PopulationSums,
     /// Each population's constants in the current evaluation (one entry without populations).
     pub(crate) kind_constants: Vec<crate::terms::CellConstants>,
 }
@@ -50,7 +55,10 @@ impl TermScratch {
     /// Bytes of heap memory held.
     fn heap_bytes(&self) -> usize {
         self.cell_force.capacity() * std::mem::size_of::<[f64; 2]>()
-            + (self.lap_s1.capacity() + self.node_terms.capacity()) * std::mem::size_of::<f64>()
+            + (self.node_scratch.capacity() + self.node_terms.capacity())
+                * std::mem::size_of::<f64>()
+            + self.node_constants.capacity() * std::mem::size_of::<[f64; 2]>()
+            + self.population_sums.heap_bytes()
             + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
     }
 }
@@ -92,8 +100,10 @@ impl<T: Real> Workspace<T> {
             com: ComTable::new(lattice),
             term_scratch: TermScratch {
                 cell_force: vec![[0.0; 2]; cells.n_cells()],
-                lap_s1: Vec::new(),
+                node_scratch: Vec::new(),
                 node_terms: Vec::new(),
+                node_constants: Vec::with_capacity(4),
+                population_sums: Default::default(),
                 kind_constants: Vec::with_capacity(4),
             },
         }

@@ -3,9 +3,7 @@
 //! (`equations::adhesion_derivative`, `c = 2ωλ`): `b = −c ∇²s1` and the Laplacian coefficient
 //! `c`; its pressure is `c φ_i ∇²φ_i` per cell in the scatter and `−c s1 ∇²s1` on the lattice.
 
-use rayon::prelude::*;
-
-use super::NodeTerm;
+use super::{laplacian_into, NodeTerm, PopulationSums};
 use crate::equations::{adhesion_derivative, adhesion_pressure};
 use crate::evaluation::{SumField, N_SUMS};
 use crate::scatter::LatticeSums;
@@ -17,46 +15,35 @@ pub(crate) struct Adhesion {
 }
 
 impl NodeTerm for Adhesion {
-    fn cell_pressure_coefficient(&self) -> f64 {
+    fn cell_pressure_coefficient(&self, _population: usize) -> f64 {
         self.c
     }
 
-    fn laplacian_coefficient(&self) -> f64 {
+    fn laplacian_coefficient(&self, _population: usize) -> f64 {
         self.c
     }
 
-    fn needs_scratch(&self) -> bool {
-        true
+    fn scratch_fields(&self) -> usize {
+        1
     }
 
     /// The lattice Laplacian of `s1` into `scratch` (index `x * ly + y`), and the cross term
     /// `−c s1 ∇²s1` ([`adhesion_pressure`]) added to the pressure.
-    fn add_pressure(&self, sums: &mut LatticeSums<N_SUMS>, lap_s1: &mut [f64]) {
+    fn add_pressure(
+        &self,
+        sums: &mut LatticeSums<N_SUMS>,
+        _populations: &PopulationSums,
+        lap_s1: &mut [f64],
+    ) {
         const I_S1: usize = SumField::S1.index();
         const I_P: usize = SumField::P.index();
         let lattice = sums.lattice();
-        let (lx, ly) = (lattice.lx, lattice.ly);
-        assert_eq!(
-            lap_s1.len(),
-            lx * ly,
-            "the Laplacian buffer holds the lattice"
-        );
-        lap_s1.par_chunks_mut(ly).enumerate().for_each(|(x, out)| {
-            let (xm, xp) = ((x + lx - 1) % lx, (x + 1) % lx);
-            let (c0, cm, cp) = (
-                sums.column(I_S1, x),
-                sums.column(I_S1, xm),
-                sums.column(I_S1, xp),
-            );
-            for y in 0..ly {
-                let (ym, yp) = (
-                    if y == 0 { ly - 1 } else { y - 1 },
-                    if y + 1 == ly { 0 } else { y + 1 },
-                );
-                out[y] = cm[y] + cp[y] + c0[ym] + c0[yp] - 4.0 * c0[y];
-            }
-        });
-        for x in 0..lx {
+        {
+            let sums: &LatticeSums<N_SUMS> = sums;
+            laplacian_into(lattice, |x| sums.column(I_S1, x), lap_s1);
+        }
+        let ly = lattice.ly;
+        for x in 0..lattice.lx {
             let ([s1], p) = sums.columns_read_write([I_S1], I_P, x);
             for ((p, &s1), &lap) in p.iter_mut().zip(s1).zip(&lap_s1[x * ly..(x + 1) * ly]) {
                 *p += adhesion_pressure(self.c, s1, lap);
@@ -64,7 +51,14 @@ impl NodeTerm for Adhesion {
         }
     }
 
-    fn add_coefficients(&self, lap_s1: &[f64], k0: usize, _a: &mut [f64], b: &mut [f64]) {
+    fn add_coefficients(
+        &self,
+        _population: usize,
+        lap_s1: &[f64],
+        k0: usize,
+        _a: &mut [f64],
+        b: &mut [f64],
+    ) {
         for (b, &lap) in b.iter_mut().zip(&lap_s1[k0..]) {
             *b += adhesion_derivative(self.c, lap, 0.0);
         }

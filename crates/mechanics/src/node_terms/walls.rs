@@ -6,7 +6,7 @@
 
 use phasefield::WallField;
 
-use super::NodeTerm;
+use super::{NodeTerm, PopulationSums};
 use crate::equations::{wall_derivative, wall_pressure};
 use crate::evaluation::{SumField, N_SUMS};
 use crate::scatter::LatticeSums;
@@ -21,7 +21,12 @@ pub(crate) struct WallTerm<'a> {
 
 impl NodeTerm for WallTerm<'_> {
     /// [`wall_pressure`] added node by node once the scatter has completed the sums.
-    fn add_pressure(&self, sums: &mut LatticeSums<N_SUMS>, _scratch: &mut [f64]) {
+    fn add_pressure(
+        &self,
+        sums: &mut LatticeSums<N_SUMS>,
+        _populations: &PopulationSums,
+        _scratch: &mut [f64],
+    ) {
         const I_S1: usize = SumField::S1.index();
         const I_S2: usize = SumField::S2.index();
         const I_P: usize = SumField::P.index();
@@ -42,7 +47,14 @@ impl NodeTerm for WallTerm<'_> {
         }
     }
 
-    fn add_coefficients(&self, _scratch: &[f64], k0: usize, a: &mut [f64], b: &mut [f64]) {
+    fn add_coefficients(
+        &self,
+        _population: usize,
+        _scratch: &[f64],
+        k0: usize,
+        a: &mut [f64],
+        b: &mut [f64],
+    ) {
         let (w, lap_w) = (&self.field.w()[k0..], &self.field.laplacian()[k0..]);
         for (k, (a, b)) in a.iter_mut().zip(b.iter_mut()).enumerate() {
             *a += wall_derivative(self.coefficients, 1.0, w[k], 0.0);
