@@ -1,15 +1,11 @@
 //! `reproduce contractile`: the supplementary figure of ζ = −0.0018, which stays at rest,
 //! against ζ = 0 and an extensile ζ = 0.005 from the same relaxed states.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 
 use super::column_stats;
-use super::{
-    drawn, g, mean_se, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob,
-    Verdict,
-};
+use super::pipeline::{cell, point, sci, Csv, Made, PointRuns};
+use super::{g, mean_se, mean_std, pm, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict};
 use study::SweepError;
 
 const ZETAS: [&str; 3] = ["-0.0018", "0", "0.005"];
@@ -70,7 +66,7 @@ pub(crate) fn rule(rate: (f64, f64), extensile: (f64, f64)) -> (Verdict, String)
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 1000.0,
         Scale::Paper => 2000.0,
@@ -92,14 +88,23 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         },
     )?;
     p.reporter.stage("contractile: tables and plots");
-    let recs = res.records(None)?;
+    let points = res.points(None)?;
     let mut claims = Vec::new();
-    let mut csv = String::from("pressure,zeta,time,v_rms,v_rms_std,s_rms,s_rms_std\n");
+    let mut plots = Vec::new();
+    let mut csv = Csv::new(&[
+        "pressure",
+        "zeta",
+        "time",
+        "v_rms",
+        "v_rms_std",
+        "s_rms",
+        "s_rms_std",
+    ]);
     for pressure in ["paper", "interaction"] {
-        let of = |z: &str| -> Vec<&Rec> {
-            recs.iter()
-                .filter(|r| r.values[0] == pressure && r.values[1] == z)
-                .collect()
+        let of = |z: &str| -> Result<&PointRuns, SweepError> {
+            point(&points, &[pressure, z]).ok_or_else(|| SweepError::Reproduce {
+                why: format!("the sweep has no point {pressure}, ζ = {z}"),
+            })
         };
         let mut v = Plot::new(
             format!("v_rms in time: contractile, passive, extensile ({pressure} pressure)"),
@@ -113,12 +118,23 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             "S_rms (mean ± std over seeds)",
         );
         for z in ZETAS {
-            let st = column_stats(&of(z), "series.csv", "time", &["v_rms", "s_rms"], 10)?;
+            let st = column_stats(
+                &of(z)?.refs(),
+                "series.csv",
+                "time",
+                &["v_rms", "s_rms"],
+                10,
+            )?;
             for (time, c) in &st {
-                csv += &format!(
-                    "{pressure},{z},{time},{:e},{:e},{:e},{:e}\n",
-                    c[0].0, c[0].1, c[1].0, c[1].1
-                );
+                csv.row([
+                    cell(pressure),
+                    cell(z),
+                    cell(time),
+                    sci(c[0].0),
+                    sci(c[0].1),
+                    sci(c[1].0),
+                    sci(c[1].1),
+                ]);
             }
             let time: Vec<f64> = st.iter().map(|x| x.0).collect();
             let pick = |i: usize, j: bool| -> Vec<f64> {
@@ -145,38 +161,26 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     .line_only(),
             );
         }
-        drawn(v.save_png(&dir.join(format!("contractile_v_rms_{pressure}.png"))))?;
-        drawn(s.save_png(&dir.join(format!("contractile_s_rms_{pressure}.png"))))?;
+        plots.push((format!("contractile_v_rms_{pressure}.png"), v));
+        plots.push((format!("contractile_s_rms_{pressure}.png"), s));
 
         // The verdict: the contractile flow decays at least as the passive one, paired by seed.
         // `f(run, its ζ = 0 twin)` for every run of activity z with a twin of the same seed.
-        let paired = |z: &str, f: fn(&Rec, &Rec) -> f64| -> Vec<f64> {
-            of(z)
-                .iter()
-                .filter_map(|r| {
-                    of("0")
-                        .into_iter()
-                        .find(|b| b.seed == r.seed)
-                        .map(|b| f(r, b))
-                })
-                .collect()
-        };
+        let rest = of("0")?;
+        let (contractile, extensile) = (of("-0.0018")?, of("0.005")?);
         let rate_excess = |r: &Rec, b: &Rec| r.summary.growth_rate - b.summary.growth_rate;
         let v_rms_ratio = |r: &Rec, b: &Rec| r.summary.v_rms / b.summary.v_rms;
-        let d_rate = mean_std(&paired("-0.0018", rate_excess));
-        let d_s = mean_std(&paired("-0.0018", |r, b| r.summary.s_rms - b.summary.s_rms));
-        let v_ratio = mean_std(&paired("-0.0018", v_rms_ratio));
-        let e_ratio = mean_std(&paired("0.005", v_rms_ratio));
-        let e_rate = mean_std(&paired("0.005", rate_excess));
+        let d_rate = mean_std(&contractile.paired(rest, rate_excess));
+        let d_s = mean_std(&contractile.paired(rest, |r, b| r.summary.s_rms - b.summary.s_rms));
+        let v_ratio = mean_std(&contractile.paired(rest, v_rms_ratio));
+        let e_ratio = mean_std(&extensile.paired(rest, v_rms_ratio));
+        let e_rate = mean_std(&extensile.paired(rest, rate_excess));
         // Stable: its flow decays, ⟨r⟩ < 0 beyond its error, the threshold protocol's "below
         // ζ_cr".
-        let rate = mean_se(
-            &of("-0.0018")
-                .iter()
-                .map(|r| r.summary.growth_rate)
-                .collect::<Vec<_>>(),
-        );
-        let e_ratio_se = mean_se(&paired("0.005", v_rms_ratio));
+        let rate = contractile
+            .measure(|r| Ok(r.summary.growth_rate))?
+            .mean_se();
+        let e_ratio_se = mean_se(&extensile.paired(rest, v_rms_ratio));
         let (verdict, reason) = rule(rate, e_ratio_se);
         claims.push(Claim::new(
             format!("9.3 ({pressure} pressure): contractile activity (ζ = −0.0018) stays stable"),
@@ -193,7 +197,6 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             reason,
         ));
     }
-    write_text(&dir.join("contractile_series.csv"), &csv)?;
     let settings = format!(
         "- Paper scene (docs/model.md §8): 60 cells, L = 100, γ = 0.01, both pressure forms; ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation at ζ = 0, then {t} TU; integrator {}; f32 storage.\n\
@@ -202,7 +205,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.seeds(),
         p.scale.integrator_name()
     );
-    Ok((claims, settings))
+    let mut made = Made::new(claims, settings).table("contractile_series.csv", csv);
+    for (name, plot) in plots {
+        made = made.plot(name, plot);
+    }
+    Ok(made)
 }
 
 #[cfg(test)]

@@ -12,12 +12,11 @@
 //! statistic of a run is the mean over its extrusions of `d₊ − d₊,random` (and of
 //! `d₋ − d₋,random`); of a rule, the mean and standard error over seeds.
 
-use std::path::Path;
-
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
-use super::{g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made};
+use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 
 /// The paper's tissue at ζ = 0.01 (active turbulence) with a cell-cycle clock of 300 TU and a
 /// growth phase of 50 TU; the figure adds an extrusion rule.
@@ -94,14 +93,21 @@ pub(crate) fn verdict(per_seed: &[f64]) -> (Verdict, String) {
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 1000.0,
         Scale::Paper => 2000.0,
     };
     let mut claims = Vec::new();
-    let mut csv =
-        String::from("rule,seed,extrusions,divisions,d_plus_excess,d_minus_excess,cells_end\n");
+    let mut csv = Csv::new(&[
+        "rule",
+        "seed",
+        "extrusions",
+        "divisions",
+        "d_plus_excess",
+        "d_minus_excess",
+        "cells_end",
+    ]);
     for (rule, key) in RULES {
         let mut sets = vec![key.to_string(), format!("run.time={t}")];
         sets.extend(p.scale.own_dt_set());
@@ -141,10 +147,15 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             };
             let series = super::Table::read(&r.run.join("series.csv"))?;
             let cells_end = series.f64s("cells")?.last().copied().unwrap_or(f64::NAN);
-            csv += &format!(
-                "{rule},{},{n_ext},{n_div},{dp:e},{dm:e},{cells_end}\n",
-                r.seed
-            );
+            csv.row([
+                cell(rule),
+                cell(r.seed),
+                cell(n_ext),
+                cell(n_div),
+                sci(dp),
+                sci(dm),
+                cell(cells_end),
+            ]);
             plus.push(dp);
             minus.push(dm);
             counts.push(n_ext as f64);
@@ -165,7 +176,6 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             wm.clone(),
         ));
     }
-    write_text(&dir.join("extrusion.csv"), &csv)?;
     let settings = format!(
         "- The paper's tissue (60 cells, R = 8, periodic 100², γ = 0.01, paper form) at ζ = 0.01 (active turbulence), with `[division] cycle_time = 300`, `growth_time = 50` and an extrusion rule: the stress-based rule `extrusion_pressure = 0.04` (a cell whose pressure p_i = Σφ_i P/Σφ_i, the isotropic stress at the cell, rises above it; the relaxed tissue's pressures are 0.005–0.013) or the area rule `extrusion = 0.3` (a cell below 30 % of its target area); seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; dt = {}; frames every 10 TU, analysed; at these settings the cell count holds at about 53 (pressure rule) and 86 (area rule) instead of growing to the cap.\n\
@@ -174,7 +184,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         seeds(p.scale),
         p.scale.own_dt(),
     );
-    Ok((claims, settings))
+    Ok(Made::new(claims, settings).table("extrusion.csv", csv))
 }
 
 #[cfg(test)]

@@ -10,13 +10,12 @@
 //! and standard error over seeds. The critical noise `D_c` is where the seed mean crosses ½
 //! (linear in `ln D_r`), its error the jackknife over seeds.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
-use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made, PerSeed};
+use super::{g, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict};
 
 /// `scenes/polar.toml`'s tissue: 80 polar cells in a periodic 120² box, aligning with their
 /// own velocity; the figure sets `D_r` and the run length.
@@ -149,7 +148,7 @@ pub(crate) fn verdict(stats: &[(f64, f64)], dc: Option<f64>, dc_err: f64) -> (Ve
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (noises, t) = settings(p.scale);
     let relax = 100.0;
     let from = relax + t / 2.0;
@@ -169,48 +168,42 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             seeds: None,
         },
     )?;
-    let recs = res.records(None)?;
+    let points = res.points(None)?;
     p.reporter.stage("flocking: tables and plots");
-    let mut seeds: Vec<u64> = recs.iter().map(|r| r.seed).collect();
-    seeds.sort_unstable();
-    seeds.dedup();
     let d: Vec<f64> = noises
         .iter()
         .map(|v| v.parse().expect("a number"))
         .collect();
-    // order[seed][noise], and each run's series for the plot in time.
-    let mut order = vec![vec![f64::NAN; noises.len()]; seeds.len()];
-    let mut runs_csv = String::from("rotational_diffusion,seed,polar_order_mean\n");
-    let mut in_time: Vec<(String, Vec<f64>, Vec<f64>)> = Vec::new();
-    for r in &recs {
-        let k = noises
-            .iter()
-            .position(|v| *v == r.values[0])
-            .expect("a noise of the sweep");
-        let s = seeds.binary_search(&r.seed).expect("a seed of the sweep");
-        let obs = r.run.join("analysis/observables.csv");
-        order[s][k] = super::late_mean(&obs, "polar_order", from, |v| v)?;
-        runs_csv += &format!("{},{},{:e}\n", r.values[0], r.seed, order[s][k]);
-        if s == 0 {
-            let tab = super::Table::read(&obs)?;
-            in_time.push((
-                format!("D_r = {}", r.values[0]),
-                tab.f64s("time")?,
-                tab.f64s("polar_order")?,
-            ));
+    // Each run's late polar order, by noise.
+    let late = |r: &Rec| {
+        super::late_mean(
+            &r.run.join("analysis/observables.csv"),
+            "polar_order",
+            from,
+            |v| v,
+        )
+    };
+    let by_noise: Vec<PerSeed> = points
+        .iter()
+        .map(|pt| pt.measure(late))
+        .collect::<Result<_, _>>()?;
+    let mut runs_csv = Csv::new(&["rotational_diffusion", "seed", "polar_order_mean"]);
+    for (pt, m) in points.iter().zip(&by_noise) {
+        for (seed, v) in m.seeds.iter().zip(&m.values) {
+            runs_csv.row([cell(&pt.values[0]), cell(seed), sci(*v)]);
         }
     }
-    let stats: Vec<(f64, f64)> = (0..d.len())
-        .map(|k| mean_se(&order.iter().map(|o| o[k]).collect::<Vec<_>>()))
+    // order[seed][noise].
+    let order: Vec<Vec<f64>> = (0..by_noise.first().map_or(0, |m| m.values.len()))
+        .map(|s| by_noise.iter().map(|m| m.values[s]).collect())
         .collect();
+    let stats: Vec<(f64, f64)> = by_noise.iter().map(PerSeed::mean_se).collect();
     let (dc, dc_err) = critical_noise(&d, &order);
     let null = (std::f64::consts::PI / (4.0 * CELLS)).sqrt();
-    let mut points_csv = String::from("rotational_diffusion,polar_order_mean,polar_order_se\n");
+    let mut points_csv = Csv::new(&["rotational_diffusion", "polar_order_mean", "polar_order_se"]);
     for (v, s) in noises.iter().zip(&stats) {
-        points_csv += &format!("{v},{:e},{:e}\n", s.0, s.1);
+        points_csv.row([cell(v), sci(s.0), sci(s.1)]);
     }
-    write_text(&dir.join("flocking_runs.csv"), &runs_csv)?;
-    write_text(&dir.join("flocking.csv"), &points_csv)?;
     let mut plot = Plot::new(
         "Flocking against rotational noise",
         "rotational diffusion D_r (1/TU)",
@@ -230,25 +223,27 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             &stats.iter().map(|s| s.1).collect::<Vec<_>>(),
         ),
     );
-    drawn(plot.save_png(&dir.join("flocking.png")))?;
+    let first_seed = by_noise
+        .first()
+        .and_then(|m| m.seeds.first().copied())
+        .unwrap_or(1);
     let mut tplot = Plot::new(
-        format!(
-            "Polar order in time, seed {}",
-            seeds.first().copied().unwrap_or(1)
-        ),
+        format!("Polar order in time, seed {first_seed}"),
         "time (TU)",
         "|⟨p⟩|",
     );
     tplot.zero_y = true;
     tplot.legend = render::LegendAt::UpperRight;
-    for (label, times, pol) in &in_time {
+    for pt in &points {
+        let Some(r) = pt.runs.first() else { continue };
+        let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
+        let (times, pol) = (tab.f64s("time")?, tab.f64s("polar_order")?);
         tplot.series.push(
-            Series::new(label.clone())
-                .with_points(times, pol, &vec![0.0; times.len()])
+            Series::new(format!("D_r = {}", pt.values[0]))
+                .with_points(&times, &pol, &vec![0.0; times.len()])
                 .line_only(),
         );
     }
-    drawn(tplot.save_png(&dir.join("flocking_in_time.png")))?;
     let (v, why) = verdict(&stats, dc, dc_err);
     // The alignment rate of a cell at its free speed, J α/ξ (ξ = 2).
     let align_rate = 1.0 * 0.04 / 2.0;
@@ -291,12 +286,17 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.own_dt(),
         g(null),
     );
-    Ok((claims, settings))
+    Ok(Made::new(claims, settings)
+        .table("flocking_runs.csv", runs_csv)
+        .table("flocking.csv", points_csv)
+        .plot("flocking.png", plot)
+        .plot("flocking_in_time.png", tplot))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mean_se;
 
     /// A synthetic order `1/(1 + (D/D_c)²)` per seed, with a seed's scatter of `D_c`.
     fn synthetic(dc: f64, scatter: f64) -> (Vec<f64>, Vec<Vec<f64>>) {

@@ -19,6 +19,7 @@ mod extrusion;
 mod flocking;
 mod jamming;
 mod lengths;
+mod pipeline;
 mod rotation;
 mod rules;
 mod run_length;
@@ -460,28 +461,30 @@ pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, S
 pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, SweepError> {
     let start = Instant::now();
     let dir = p.figure_dir(figure)?;
-    let (claims, settings) = match figure {
-        Figure::Threshold => threshold::make(p, &dir)?,
-        Figure::Lengths => lengths::make(p, &dir)?,
-        Figure::Defects => defects::make(p, &dir)?,
-        Figure::DefectFields => defect_fields::make(p, &dir)?,
-        Figure::Contractile => contractile::make(p, &dir)?,
-        Figure::Scaling => scaling::make(p, &dir)?,
-        Figure::Stability => stability::make(p, &dir)?,
-        Figure::RunLength => run_length::make(p, &dir)?,
-        Figure::Channel => channel::make(p, &dir)?,
-        Figure::Rotation => rotation::make(p, &dir)?,
-        Figure::Flocking => flocking::make(p, &dir)?,
-        Figure::Sorting => sorting::make(p, &dir)?,
-        Figure::Jamming => jamming::make(p, &dir)?,
-        Figure::Extrusion => extrusion::make(p, &dir)?,
+    use pipeline::Made;
+    let made = match figure {
+        Figure::Threshold => Made::written(threshold::make(p, &dir)?),
+        Figure::Lengths => Made::written(lengths::make(p, &dir)?),
+        Figure::Defects => Made::written(defects::make(p, &dir)?),
+        Figure::DefectFields => Made::written(defect_fields::make(p, &dir)?),
+        Figure::Contractile => contractile::make(p)?,
+        Figure::Scaling => Made::written(scaling::make(p, &dir)?),
+        Figure::Stability => Made::written(stability::make(p, &dir)?),
+        Figure::RunLength => Made::written(run_length::make(p, &dir)?),
+        Figure::Channel => Made::written(channel::make(p, &dir)?),
+        Figure::Rotation => Made::written(rotation::make(p, &dir)?),
+        Figure::Flocking => flocking::make(p)?,
+        Figure::Sorting => sorting::make(p)?,
+        Figure::Jamming => Made::written(jamming::make(p, &dir)?),
+        Figure::Extrusion => extrusion::make(p)?,
     };
+    made.write_files(&dir)?;
     let wall_s = start.elapsed().as_secs_f64();
-    write_verdict(&dir, figure, p.scale, &settings, &claims, wall_s)?;
+    write_verdict(&dir, figure, p.scale, &made.settings, &made.claims, wall_s)?;
     Ok(FigureReport {
         figure,
         dir,
-        claims,
+        claims: made.claims,
         wall_s,
     })
 }

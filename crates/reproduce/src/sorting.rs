@@ -13,13 +13,12 @@
 //! second half of the active phase; of a point, the mean and standard error over seeds.
 //! [`classify`] says whether it sorts.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
-use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made, PerSeed};
+use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 
 /// Two populations of 59 cells of radius 8 in a periodic 140² box (the paper's density); the
 /// figure sets their ζ and γ.
@@ -168,14 +167,14 @@ const SPECS: [Spec; 7] = [
     },
 ];
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 2000.0,
         Scale::Paper => 5000.0,
     };
     let from = 100.0 + t / 2.0;
     // Each point's late demixing by seed, and its mean series in time.
-    let mut late: Vec<Vec<f64>> = Vec::new();
+    let mut late: Vec<PerSeed> = Vec::new();
     let mut in_time: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
     for spec in &SPECS {
         let [za, zb, ga, gb] = spec.values;
@@ -198,48 +197,50 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 seeds: Some(seeds(p.scale)),
             },
         )?;
-        let mut per_seed = Vec::new();
-        let mut series: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
-        for r in res.records(None)? {
-            let obs = r.run.join("analysis/observables.csv");
-            per_seed.push(super::late_mean(&obs, "demixing", from, |v| v)?);
-            let tab = super::Table::read(&obs)?;
-            series.push((tab.f64s("time")?, tab.f64s("demixing")?));
+        // A sweep without axes: one point.
+        for pt in res.points(None)? {
+            late.push(pt.measure(|r| {
+                let obs = r.run.join("analysis/observables.csv");
+                super::late_mean(&obs, "demixing", from, |v| v)
+            })?);
+            in_time.push(pt.mean_series("analysis/observables.csv", "time", "demixing")?);
         }
-        let rows = series.iter().map(|s| s.0.len()).min().unwrap_or(0);
-        let mean: Vec<f64> = (0..rows)
-            .map(|k| series.iter().map(|s| s.1[k]).sum::<f64>() / series.len() as f64)
-            .collect();
-        in_time.push((
-            series.first().map_or(Vec::new(), |s| s.0[..rows].to_vec()),
-            mean,
-        ));
-        late.push(per_seed);
     }
     p.reporter.stage("sorting: tables and plots");
-    let control = late[0].clone();
-    let mut csv = String::from(
-        "point,axis,zeta_a,zeta_b,gamma_a,gamma_b,seed_values,demixing_mean,demixing_se,state\n",
-    );
+    let control = late[0].values.clone();
+    let mut csv = Csv::new(&[
+        "point",
+        "axis",
+        "zeta_a",
+        "zeta_b",
+        "gamma_a",
+        "gamma_b",
+        "seed_values",
+        "demixing_mean",
+        "demixing_se",
+        "state",
+    ]);
     let mut states_by_axis: Vec<(&str, State)> = Vec::new();
     let mut measured: Vec<String> = Vec::new();
     for (spec, vals) in SPECS.iter().zip(&late) {
-        let (state, d, e) = classify(vals);
+        let (state, d, e) = classify(&vals.values);
         let [za, zb, ga, gb] = spec.values;
-        csv += &format!(
-            "{},{},{za},{zb},{ga},{gb},{},{d:e},{e:e},{}\n",
-            spec.name,
-            spec.axis,
-            vals.iter()
-                .map(|v| format!("{v:.4}"))
-                .collect::<Vec<_>>()
-                .join(" "),
-            if spec.axis == "control" {
+        csv.row([
+            cell(spec.name),
+            cell(spec.axis),
+            cell(za),
+            cell(zb),
+            cell(ga),
+            cell(gb),
+            vals.joined(4),
+            sci(d),
+            sci(e),
+            cell(if spec.axis == "control" {
                 "control"
             } else {
                 state.name()
-            }
-        );
+            }),
+        ]);
         if spec.axis != "control" {
             states_by_axis.push((spec.axis, state));
             measured.push(format!(
@@ -251,7 +252,6 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             ));
         }
     }
-    write_text(&dir.join("sorting.csv"), &csv)?;
     let mut plot = Plot::new(
         "Demixing of two populations in time",
         "time (TU)",
@@ -268,7 +268,6 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .line_only(),
         );
     }
-    drawn(plot.save_png(&dir.join("sorting_in_time.png")))?;
     let axis_states = |axis: &str| -> Vec<State> {
         states_by_axis
             .iter()
@@ -317,7 +316,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         seeds(p.scale),
         p.scale.own_dt(),
     );
-    Ok((claims, settings))
+    Ok(Made::new(claims, settings)
+        .table("sorting.csv", csv)
+        .plot("sorting_in_time.png", plot))
 }
 
 #[cfg(test)]

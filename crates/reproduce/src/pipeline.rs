@@ -1,0 +1,261 @@
+//! The pipeline every figure goes through, in one place: a figure's sweeps give runs, grouped
+//! here by point and seed ([`PointRuns`]); a per-run measure gives each point its values by
+//! seed ([`PerSeed`]) and their statistics; the figure turns those into tables ([`Csv`]),
+//! plots and claims, and returns them as one [`Made`], which [`crate::reproduce`] writes: the
+//! CSV files, the PNG plots and `verdict.md` with the settings.
+//!
+//! A figure that is not on the pipeline yet writes its own files and returns
+//! [`Made::written`].
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use render::Plot;
+use study::SweepError;
+
+use crate::{drawn, mean_se, write_text, Claim, Rec, Stat, SweepResult, Table};
+
+/// What a figure made: its claims and settings for `verdict.md`, and the tables and plots
+/// that the pipeline writes into the figure's directory under the names given.
+pub(crate) struct Made {
+    pub claims: Vec<Claim>,
+    pub settings: String,
+    pub tables: Vec<(String, Csv)>,
+    pub plots: Vec<(String, Plot)>,
+}
+
+impl Made {
+    /// Claims and settings, the files to come ([`Made::table`], [`Made::plot`]).
+    pub(crate) fn new(claims: Vec<Claim>, settings: String) -> Self {
+        Self {
+            claims,
+            settings,
+            tables: Vec::new(),
+            plots: Vec::new(),
+        }
+    }
+
+    /// A figure that wrote its own files.
+    pub(crate) fn written((claims, settings): (Vec<Claim>, String)) -> Self {
+        Self::new(claims, settings)
+    }
+
+    /// With the table `csv` written as `name`.
+    pub(crate) fn table(mut self, name: impl Into<String>, csv: Csv) -> Self {
+        self.tables.push((name.into(), csv));
+        self
+    }
+
+    /// With the plot `plot` drawn as `name`.
+    pub(crate) fn plot(mut self, name: impl Into<String>, plot: Plot) -> Self {
+        self.plots.push((name.into(), plot));
+        self
+    }
+
+    /// Writes the tables and draws the plots into `dir`.
+    pub(crate) fn write_files(&self, dir: &Path) -> Result<(), SweepError> {
+        for (name, csv) in &self.tables {
+            write_text(&dir.join(name), &csv.text())?;
+        }
+        for (name, plot) in &self.plots {
+            drawn(plot.save_png(&dir.join(name)))?;
+        }
+        Ok(())
+    }
+}
+
+/// A table to be written as CSV: its header, then rows of cells that the figure formatted
+/// ([`sci`] for measured values, so that they keep every digit).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Csv {
+    columns: Vec<&'static str>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Csv {
+    /// An empty table with these columns.
+    pub(crate) fn new(columns: &[&'static str]) -> Self {
+        Self {
+            columns: columns.to_vec(),
+            rows: Vec::new(),
+        }
+    }
+
+    /// Adds a row. Panics unless it has a cell for every column (a figure's bug).
+    pub(crate) fn row(&mut self, cells: impl IntoIterator<Item = String>) {
+        let row: Vec<String> = cells.into_iter().collect();
+        assert_eq!(
+            row.len(),
+            self.columns.len(),
+            "a cell for each of the columns {:?}",
+            self.columns
+        );
+        self.rows.push(row);
+    }
+
+    /// The CSV text: the header and the rows, one a line.
+    pub(crate) fn text(&self) -> String {
+        let mut s = self.columns.join(",");
+        s.push('\n');
+        for r in &self.rows {
+            s += &r.join(",");
+            s.push('\n');
+        }
+        s
+    }
+}
+
+/// A measured value as a CSV cell, to every digit (`{:e}`).
+pub(crate) fn sci(v: f64) -> String {
+    format!("{v:e}")
+}
+
+/// Any value as a CSV cell, as `Display` writes it (a setting, a name).
+pub(crate) fn cell(v: impl std::fmt::Display) -> String {
+    v.to_string()
+}
+
+/// The runs of one point of a figure (its values on the sweep's axes), in seed order.
+pub(crate) struct PointRuns {
+    pub values: Vec<String>,
+    pub runs: Vec<Rec>,
+}
+
+impl SweepResult {
+    /// Every point's runs, summarised as [`SweepResult::records`] does (over `time` TU of the
+    /// active phase), in the order of the sweep's points, each point's runs in seed order.
+    pub(crate) fn points(&self, time: Option<f64>) -> Result<Vec<PointRuns>, SweepError> {
+        let mut order: Vec<Vec<String>> = Vec::new();
+        let mut by: BTreeMap<Vec<String>, Vec<Rec>> = BTreeMap::new();
+        for r in self.records(time)? {
+            if !by.contains_key(&r.values) {
+                order.push(r.values.clone());
+            }
+            by.entry(r.values.clone()).or_default().push(r);
+        }
+        Ok(order
+            .into_iter()
+            .map(|values| {
+                let mut runs = by.remove(&values).expect("each point listed once");
+                runs.sort_by_key(|r| r.seed);
+                PointRuns { values, runs }
+            })
+            .collect())
+    }
+}
+
+/// The point whose values are `values`, if the sweep has it.
+pub(crate) fn point<'a>(points: &'a [PointRuns], values: &[&str]) -> Option<&'a PointRuns> {
+    points.iter().find(|p| p.values.iter().eq(values.iter()))
+}
+
+impl PointRuns {
+    /// Its runs by reference (for the helpers that take a list of runs).
+    pub(crate) fn refs(&self) -> Vec<&Rec> {
+        self.runs.iter().collect()
+    }
+
+    /// `f(run, twin)` for each of its runs that `other` has a run of the same seed for: a
+    /// measure paired by seed.
+    pub(crate) fn paired(&self, other: &PointRuns, f: impl Fn(&Rec, &Rec) -> f64) -> Vec<f64> {
+        self.runs
+            .iter()
+            .filter_map(|r| {
+                other
+                    .runs
+                    .iter()
+                    .find(|b| b.seed == r.seed)
+                    .map(|b| f(r, b))
+            })
+            .collect()
+    }
+
+    /// `f` of each run: the point's values by seed.
+    pub(crate) fn measure(
+        &self,
+        f: impl Fn(&Rec) -> Result<f64, SweepError>,
+    ) -> Result<PerSeed, SweepError> {
+        Ok(PerSeed {
+            seeds: self.runs.iter().map(|r| r.seed).collect(),
+            values: self.runs.iter().map(f).collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// The column `column` of every run's table `file` against its column `index`, averaged
+    /// over the runs row by row, over the rows they all have: `(index of the first run, mean)`.
+    pub(crate) fn mean_series(
+        &self,
+        file: &str,
+        index: &str,
+        column: &str,
+    ) -> Result<(Vec<f64>, Vec<f64>), SweepError> {
+        let series: Vec<(Vec<f64>, Vec<f64>)> = self
+            .runs
+            .iter()
+            .map(|r| {
+                let t = Table::read(&r.run.join(file))?;
+                Ok((t.f64s(index)?, t.f64s(column)?))
+            })
+            .collect::<Result<_, SweepError>>()?;
+        let rows = series.iter().map(|s| s.0.len()).min().unwrap_or(0);
+        let mean = (0..rows)
+            .map(|k| series.iter().map(|s| s.1[k]).sum::<f64>() / series.len() as f64)
+            .collect();
+        let index = series.first().map_or(Vec::new(), |s| s.0[..rows].to_vec());
+        Ok((index, mean))
+    }
+}
+
+/// One quantity of a point, a value for each seed's run.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct PerSeed {
+    pub seeds: Vec<u64>,
+    pub values: Vec<f64>,
+}
+
+impl PerSeed {
+    /// The mean and standard error over seeds ([`mean_se`]).
+    pub(crate) fn mean_se(&self) -> Stat {
+        mean_se(&self.values)
+    }
+
+    /// The values with `digits` decimals, separated by spaces (a CSV cell).
+    pub(crate) fn joined(&self, digits: usize) -> String {
+        self.values
+            .iter()
+            .map(|v| format!("{v:.digits$}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The CSV text is the header and the rows as written, and a row with a cell missing is
+    /// refused.
+    #[test]
+    fn a_csv_is_its_header_and_rows() {
+        let mut t = Csv::new(&["a", "b"]);
+        t.row([cell("x"), sci(0.25)]);
+        t.row([cell(3), sci(f64::NAN)]);
+        assert_eq!(t.text(), "a,b\nx,2.5e-1\n3,NaN\n");
+        let short = std::panic::catch_unwind(move || t.clone().row([cell(1)]));
+        assert!(short.is_err(), "a row without every cell");
+    }
+
+    /// Seed statistics are those of the values: the mean and standard error of 1, 2, 3 are 2
+    /// and 1/√3.
+    #[test]
+    fn seed_statistics() {
+        let p = PerSeed {
+            seeds: vec![1, 2, 3],
+            values: vec![1.0, 2.0, 3.0],
+        };
+        let (m, se) = p.mean_se();
+        assert_eq!(m, 2.0);
+        assert!((se - 1.0 / 3f64.sqrt()).abs() < 1e-15);
+        assert_eq!(p.joined(2), "1.00 2.00 3.00");
+    }
+}
