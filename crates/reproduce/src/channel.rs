@@ -17,11 +17,10 @@
 //! is the least-squares slope of `ln W_c` against `ln ζ`, its error from the jackknife over
 //! seeds.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 
-use super::{drawn, g, mean_se, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made, PerSeed};
+use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 use study::SweepError;
 
 /// The activities; ζ = 0 is the baseline.
@@ -170,7 +169,7 @@ pub(crate) fn verdict(b: f64, se: f64, onsets: &[Onset]) -> (Verdict, String) {
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 600.0,
         Scale::Paper => 1500.0,
@@ -181,8 +180,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .iter()
         .map(|z| z.parse().expect("a number"))
         .collect();
-    // Each width's runs with their net flow Φ.
-    let mut recs: Vec<(usize, Vec<(Rec, f64)>)> = Vec::new();
+    // Each width's activities, each with its runs' net flow Φ and v_rms by seed.
+    let mut flows: Vec<(usize, Vec<Flow>)> = Vec::new();
     for &w in &ws {
         let ly = w + 2;
         let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
@@ -212,54 +211,59 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 seeds: None,
             },
         )?;
-        let mut with_flow = Vec::new();
-        for r in res.records(None)? {
-            let phi = super::late_mean(
-                &r.run.join("analysis/observables.csv"),
-                "v_mean_x",
-                200.0 + t / 2.0,
-                f64::abs,
-            )?;
-            with_flow.push((r, phi));
-        }
-        recs.push((w, with_flow));
+        let by_zeta = res
+            .points(None)?
+            .iter()
+            .map(|pt| {
+                Ok(Flow {
+                    zeta: pt.values[0].clone(),
+                    net: pt.measure(|r| {
+                        super::late_mean(
+                            &r.run.join("analysis/observables.csv"),
+                            "v_mean_x",
+                            200.0 + t / 2.0,
+                            f64::abs,
+                        )
+                    })?,
+                    v_rms: pt.measure(|r| Ok(r.summary.v_rms))?,
+                })
+            })
+            .collect::<Result<_, SweepError>>()?;
+        flows.push((w, by_zeta));
     }
     p.reporter.stage("channel: tables and plots");
-    let seeds: Vec<u64> = {
-        let mut s: Vec<u64> = recs[0].1.iter().map(|r| r.0.seed).collect();
-        s.sort_unstable();
-        s.dedup();
-        s
-    };
-    // ratio[seed][zeta][width] of the net flow Φ; v_rms beside it.
-    let run_of = |w: usize, z: &str, seed: u64| {
-        recs.iter()
+    let flow = |w: usize, z: &str| -> Result<&Flow, SweepError> {
+        flows
+            .iter()
             .find(|(ww, _)| *ww == w)
-            .and_then(|(_, rs)| rs.iter().find(|r| r.0.values[0] == z && r.0.seed == seed))
+            .and_then(|(_, f)| f.iter().find(|f| f.zeta == z))
+            .ok_or_else(|| SweepError::Reproduce {
+                why: format!("the channel sweep of width {w} has no ζ = {z}"),
+            })
     };
-    let v_of =
-        |w: usize, z: &str, seed: u64| -> f64 { run_of(w, z, seed).map_or(f64::NAN, |r| r.1) };
-    let vrms_of = |w: usize, z: &str, seed: u64| -> f64 {
-        run_of(w, z, seed).map_or(f64::NAN, |r| r.0.summary.v_rms)
-    };
-    let ratio: Vec<Vec<Vec<f64>>> = seeds
-        .iter()
-        .map(|&s| {
-            ZETAS[1..]
-                .iter()
-                .map(|z| {
-                    ws.iter()
-                        .map(|&w| v_of(w, z, s) / vrms_of(w, z, s))
-                        .collect()
-                })
-                .collect()
-        })
-        .collect();
+    let n_seeds = flows[0].1[0].net.values.len();
+    // ratio[seed][zeta][width] of the net flow Φ to v_rms.
+    let mut ratio = vec![vec![vec![f64::NAN; ws.len()]; ZETAS.len() - 1]; n_seeds];
+    for (zi, z) in ZETAS[1..].iter().enumerate() {
+        for (wi, &w) in ws.iter().enumerate() {
+            for (s, c) in flow(w, z)?.coherence().into_iter().enumerate() {
+                ratio[s][zi][wi] = c;
+            }
+        }
+    }
     let wf: Vec<f64> = ws.iter().map(|&w| w as f64).collect();
     let (b, se, wc) = exponent(&wf, &zetas, &ratio);
 
-    let mut csv =
-        String::from("width,zeta,net_flow,net_flow_se,coherence,coherence_se,v_rms,v_rms_se\n");
+    let mut csv = Csv::new(&[
+        "width",
+        "zeta",
+        "net_flow",
+        "net_flow_se",
+        "coherence",
+        "coherence_se",
+        "v_rms",
+        "v_rms_se",
+    ]);
     let mut plot = Plot::new(
         "Coherence of the flow along a channel against its width",
         "channel width W (nodes)",
@@ -272,11 +276,12 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let mut es = Vec::new();
         for (wi, &w) in ws.iter().enumerate() {
             let r = mean_se(&ratio.iter().map(|s| s[zi][wi]).collect::<Vec<_>>());
-            let v = mean_se(&seeds.iter().map(|&s| v_of(w, z, s)).collect::<Vec<_>>());
-            let u = mean_se(&seeds.iter().map(|&s| vrms_of(w, z, s)).collect::<Vec<_>>());
-            csv += &format!(
-                "{w},{z},{:e},{:e},{:e},{:e},{:e},{:e}\n",
-                v.0, v.1, r.0, r.1, u.0, u.1
+            let f = flow(w, z)?;
+            let (v, u) = (f.net.mean_se(), f.v_rms.mean_se());
+            csv.row(
+                [w.to_string(), cell(z)]
+                    .into_iter()
+                    .chain([v.0, v.1, r.0, r.1, u.0, u.1].map(sci)),
             );
             ys.push(r.0);
             es.push(if r.1.is_finite() { r.1 } else { 0.0 });
@@ -297,27 +302,18 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             .with_points(&wf, &random, &vec![0.0; wf.len()])
             .line_only(),
     );
-    for (w, _) in &recs {
-        let v = mean_se(&seeds.iter().map(|&s| v_of(*w, "0", s)).collect::<Vec<_>>());
-        let u = mean_se(
-            &seeds
-                .iter()
-                .map(|&s| vrms_of(*w, "0", s))
-                .collect::<Vec<_>>(),
-        );
-        let c = mean_se(
-            &seeds
-                .iter()
-                .map(|&s| v_of(*w, "0", s) / vrms_of(*w, "0", s))
-                .collect::<Vec<_>>(),
-        );
-        csv += &format!(
-            "{w},0,{:e},{:e},{:e},{:e},{:e},{:e}\n",
-            v.0, v.1, c.0, c.1, u.0, u.1
+    for &w in &ws {
+        let f = flow(w, "0")?;
+        let (v, u, c) = (f.net.mean_se(), f.v_rms.mean_se(), mean_se(&f.coherence()));
+        csv.row(
+            [w.to_string(), cell(0)]
+                .into_iter()
+                .chain([v.0, v.1, c.0, c.1, u.0, u.1].map(sci)),
         );
     }
-    write_text(&dir.join("channel_flow.csv"), &csv)?;
-    drawn(plot.save_png(&dir.join("channel_flow.png")))?;
+    let mut made = Made::new(Vec::new(), String::new())
+        .table("channel_flow.csv", csv)
+        .plot("channel_flow.png", plot);
     let (x, y): (Vec<f64>, Vec<f64>) = zetas
         .iter()
         .zip(&wc)
@@ -342,7 +338,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 .with_points(&x, &line, &vec![0.0; x.len()])
                 .line_only(),
         );
-        drawn(wplot.save_png(&dir.join("channel_critical_width.png")))?;
+        made = made.plot("channel_critical_width.png", wplot);
     }
     let (v, reason) = verdict(b, se, &wc);
     let wc_text: Vec<String> = ZETAS[1..]
@@ -380,7 +376,28 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.seeds(),
         p.scale.integrator_name()
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
+}
+
+/// One activity of one width: its runs' net flow `Φ` and `v_rms`, by seed.
+struct Flow {
+    zeta: String,
+    net: PerSeed,
+    v_rms: PerSeed,
+}
+
+impl Flow {
+    /// The coherence `Φ/v_rms` of each seed's run.
+    fn coherence(&self) -> Vec<f64> {
+        self.net
+            .values
+            .iter()
+            .zip(&self.v_rms.values)
+            .map(|(v, u)| v / u)
+            .collect()
+    }
 }
 
 #[cfg(test)]

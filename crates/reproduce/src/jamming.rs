@@ -13,13 +13,12 @@
 //! `ln MSD(τ_L) + 2 se < ln R²`. The transition α_c(γ) is where the seed mean crosses `ln R²`,
 //! linear in `ln α`, its error the jackknife over seeds.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
-use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made};
+use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 
 /// The paper's tissue (60 cells of radius 8 in a periodic 100² box) with persistent random
 /// propulsion: `D_r = 0.01` (a persistence time of 100 TU), no alignment, ζ = 0.
@@ -237,7 +236,7 @@ pub(crate) fn verdict_shape(q: &[(f64, f64)]) -> (Verdict, String) {
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 2000.0,
         Scale::Paper => 5000.0,
@@ -259,10 +258,8 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         },
     )?;
     p.reporter.stage("jamming: tables and plots");
-    let recs = res.records(None)?;
-    let mut seeds: Vec<u64> = recs.iter().map(|r| r.seed).collect();
-    seeds.sort_unstable();
-    seeds.dedup();
+    let points = res.points(None)?;
+    let n_seeds = points.first().map_or(0, |pt| pt.runs.len());
     let alphas: Vec<f64> = ALPHAS
         .iter()
         .map(|a| a.parse().expect("a number"))
@@ -272,21 +269,31 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .map(|a| a.parse().expect("a number"))
         .collect();
     // [γ][seed][α]: ln MSD(τ_L) and the shape index; τ_L per run.
-    let mut ln_msd = vec![vec![vec![f64::NAN; ALPHAS.len()]; seeds.len()]; GAMMAS.len()];
+    let mut ln_msd = vec![vec![vec![f64::NAN; ALPHAS.len()]; n_seeds]; GAMMAS.len()];
     let mut q = ln_msd.clone();
     let mut lag_l = f64::NAN;
-    let mut runs_csv = String::from("gamma,alpha,seed,lag,msd,d_eff,shape_index\n");
+    let mut runs_csv = Csv::new(&[
+        "gamma",
+        "alpha",
+        "seed",
+        "lag",
+        "msd",
+        "d_eff",
+        "shape_index",
+    ]);
     let from = 200.0 + t / 2.0;
-    for r in &recs {
+    for (pt, (si, r)) in points
+        .iter()
+        .flat_map(|pt| pt.runs.iter().enumerate().map(move |r| (pt, r)))
+    {
         let gi = GAMMAS
             .iter()
-            .position(|v| *v == r.values[0])
+            .position(|v| *v == pt.values[0])
             .expect("a γ of the sweep");
         let ai = ALPHAS
             .iter()
-            .position(|v| *v == r.values[1])
+            .position(|v| *v == pt.values[1])
             .expect("an α of the sweep");
-        let si = seeds.binary_search(&r.seed).expect("a seed of the sweep");
         let m = super::Table::read(&r.run.join("analysis/msd.csv"))?;
         let (lags, msd) = (m.f64s("lag")?, m.f64s("msd")?);
         let (lag, v) = (
@@ -302,17 +309,26 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         )?;
         ln_msd[gi][si][ai] = v.ln();
         q[gi][si][ai] = qm;
-        runs_csv += &format!(
-            "{},{},{},{lag},{v:e},{:e},{qm}\n",
-            r.values[0],
-            r.values[1],
-            r.seed,
-            v / (4.0 * lag)
-        );
+        runs_csv.row([
+            cell(&pt.values[0]),
+            cell(&pt.values[1]),
+            cell(r.seed),
+            cell(lag),
+            sci(v),
+            sci(v / (4.0 * lag)),
+            cell(qm),
+        ]);
     }
-    let mut points_csv = String::from(
-        "gamma,alpha,ln_msd_mean,ln_msd_se,msd_geometric_mean,shape_index_mean,shape_index_se,phase\n",
-    );
+    let mut points_csv = Csv::new(&[
+        "gamma",
+        "alpha",
+        "ln_msd_mean",
+        "ln_msd_se",
+        "msd_geometric_mean",
+        "shape_index_mean",
+        "shape_index_se",
+        "phase",
+    ]);
     let mut rows: Vec<(Vec<Phase>, Option<f64>, f64)> = Vec::new();
     let mut ac_pts: Vec<(f64, f64)> = Vec::new();
     let mut q_at: Vec<(f64, f64)> = Vec::new();
@@ -340,15 +356,16 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             .collect();
         let phases: Vec<Phase> = stats.iter().map(|s| phase(*s)).collect();
         for (ai, alpha) in ALPHAS.iter().enumerate() {
-            points_csv += &format!(
-                "{gamma},{alpha},{:e},{:e},{:e},{},{:e},{}\n",
-                stats[ai].0,
-                stats[ai].1,
-                stats[ai].0.exp(),
-                qstats[ai].0,
-                qstats[ai].1,
-                phases[ai].name()
-            );
+            points_csv.row([
+                cell(gamma),
+                cell(alpha),
+                sci(stats[ai].0),
+                sci(stats[ai].1),
+                sci(stats[ai].0.exp()),
+                cell(qstats[ai].0),
+                sci(qstats[ai].1),
+                cell(phases[ai].name()),
+            ]);
         }
         let (ac, err) = critical_alpha(&alphas, &ln_msd[gi]);
         // q at α_c, interpolated as α_c is, with the larger spread of the two points.
@@ -393,10 +410,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 &qstats.iter().map(|s| s.1).collect::<Vec<_>>(),
             ));
     }
-    write_text(&dir.join("jamming_runs.csv"), &runs_csv)?;
-    write_text(&dir.join("jamming.csv"), &points_csv)?;
-    drawn(plot.save_png(&dir.join("jamming_msd.png")))?;
-    drawn(qplot.save_png(&dir.join("jamming_shape_index.png")))?;
+    let mut made = Made::new(Vec::new(), String::new())
+        .table("jamming_runs.csv", runs_csv)
+        .table("jamming.csv", points_csv)
+        .plot("jamming_msd.png", plot)
+        .plot("jamming_shape_index.png", qplot);
     let (x, y): (Vec<f64>, Vec<f64>) = gammas
         .iter()
         .zip(&ac_pts)
@@ -419,7 +437,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         lplot
             .series
             .push(Series::new("α_c").with_points(&x, &y, &e));
-        drawn(lplot.save_png(&dir.join("jamming_line.png")))?;
+        made = made.plot("jamming_line.png", lplot);
     }
     let (v1, w1) = verdict_line(&rows);
     let (v2, w2) = verdict_deformability(&gammas, &ac_pts);
@@ -457,7 +475,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.own_dt(),
         g(lag_l),
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
 }
 
 #[cfg(test)]

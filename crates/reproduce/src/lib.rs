@@ -471,11 +471,11 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Scaling => Made::written(scaling::make(p, &dir)?),
         Figure::Stability => Made::written(stability::make(p, &dir)?),
         Figure::RunLength => Made::written(run_length::make(p, &dir)?),
-        Figure::Channel => Made::written(channel::make(p, &dir)?),
+        Figure::Channel => channel::make(p)?,
         Figure::Rotation => Made::written(rotation::make(p, &dir)?),
         Figure::Flocking => flocking::make(p)?,
         Figure::Sorting => sorting::make(p)?,
-        Figure::Jamming => Made::written(jamming::make(p, &dir)?),
+        Figure::Jamming => jamming::make(p)?,
         Figure::Extrusion => extrusion::make(p)?,
     };
     made.write_files(&dir)?;
