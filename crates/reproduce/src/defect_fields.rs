@@ -4,11 +4,10 @@
 use std::path::Path;
 
 use analysis::crop::COMPONENTS;
-use render::{save_heatmaps, Heatmap};
+use render::Heatmap;
 
-use super::{
-    drawn, g, mean_se, mean_std, pm, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict,
-};
+use super::pipeline::{cell, point, sci, Csv, Made, Picture};
+use super::{g, mean_se, mean_std, pm, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
@@ -86,7 +85,7 @@ fn ring_modes(vu: &[f64], vv: &[f64], r: f64) -> [f64; 5] {
     c.map(|(a, b)| a.hypot(b))
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 400.0,
         Scale::Paper => 1000.0,
@@ -118,17 +117,19 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         },
     )?;
     p.reporter.stage("defect-fields: averages and pictures");
-    let recs = res.records(None)?;
+    let points = res.points(None)?;
     let mut claims = Vec::new();
-    let mut csv = String::from("pressure,charge,u,v");
-    for c in COMPONENTS {
-        csv += &format!(",{c}");
-    }
-    csv += ",defects\n";
+    let mut made = Made::new(Vec::new(), String::new());
+    let columns: Vec<&str> = ["pressure", "charge", "u", "v"]
+        .into_iter()
+        .chain(COMPONENTS)
+        .chain(["defects"])
+        .collect();
+    let mut csv = Csv::new(&columns);
     for pressure in ["paper", "interaction"] {
-        let runs: Vec<Crops> = recs
+        let runs: Vec<Crops> = point(&points, &[pressure])
+            .map_or(&[][..], |pt| &pt.runs)
             .iter()
-            .filter(|r| r.values[0] == pressure)
             .map(|r| read_crops(&r.run.join("analysis/defect_averages.npz")))
             .collect::<Result<_, _>>()?;
         // Averages over every defect of every run (weighted by the defects of each run).
@@ -153,15 +154,17 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let h = (CROP / 2) as f64;
         for (charge, n, f) in [("+1/2", np, &plus), ("-1/2", nm, &minus)] {
             for k in 0..CROP * CROP {
-                csv += &format!(
-                    "{pressure},{charge},{},{}",
-                    (k / CROP) as f64 - h,
-                    (k % CROP) as f64 - h
+                csv.row(
+                    [
+                        cell(pressure),
+                        cell(charge),
+                        cell((k / CROP) as f64 - h),
+                        cell((k % CROP) as f64 - h),
+                    ]
+                    .into_iter()
+                    .chain(f.iter().map(|c| sci(c[k])))
+                    .chain([cell(n)]),
                 );
-                for c in f {
-                    csv += &format!(",{:e}", c[k]);
-                }
-                csv += &format!(",{n}\n");
             }
         }
         // The isotropic parts carry the mean pressure of the tissue: show their variation.
@@ -203,13 +206,15 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             if n == 0.0 {
                 continue;
             }
-            drawn(save_heatmaps(
-                &dir.join(format!("{file}_{pressure}.png")),
-                &format!("Fig. 4: averages around {n} {title} defects (ζ = 0.005, γ = 0.014, {pressure} pressure; u along the defect axis)"),
-                &panels(f, pressure, u),
-                3,
-                380,
-            ))?;
+            made = made.plot(
+                format!("{file}_{pressure}.png"),
+                Picture::Heatmaps {
+                    title: format!("Fig. 4: averages around {n} {title} defects (ζ = 0.005, γ = 0.014, {pressure} pressure; u along the defect axis)"),
+                    panels: panels(f, pressure, u),
+                    cols: 3,
+                    panel_px: 380,
+                },
+            );
         }
 
         // Per-run core velocities, for the seed spread.
@@ -337,7 +342,6 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             "holds when m = 3 leads in every run (at least three), does not hold when it leads in fewer than half, inconclusive between",
         ));
     }
-    write_text(&dir.join("defect_fields.csv"), &csv)?;
     let settings = format!(
         "- Paper scene on L = 200 (240 cells), ζ = 0.005, γ = 0.014, both pressure forms; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {}; a frame every 10 TU, analysed from t = {from}.\n\
@@ -347,7 +351,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.seeds(),
         p.scale.integrator_name()
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made.table("defect_fields.csv", csv))
 }
 
 /// The verdict on "a +½ defect self-propels along its axis, towards its head" from each run's

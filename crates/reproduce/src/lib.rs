@@ -466,7 +466,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Threshold => Made::written(threshold::make(p, &dir)?),
         Figure::Lengths => Made::written(lengths::make(p, &dir)?),
         Figure::Defects => Made::written(defects::make(p, &dir)?),
-        Figure::DefectFields => Made::written(defect_fields::make(p, &dir)?),
+        Figure::DefectFields => defect_fields::make(p)?,
         Figure::Contractile => contractile::make(p)?,
         Figure::Scaling => Made::written(scaling::make(p, &dir)?),
         Figure::Stability => Made::written(stability::make(p, &dir)?),

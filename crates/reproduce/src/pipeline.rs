@@ -10,7 +10,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use render::Plot;
+use render::{Heatmap, Plot};
 use study::SweepError;
 
 use crate::{drawn, mean_se, write_text, Claim, Rec, Stat, SweepResult, Table};
@@ -21,7 +21,40 @@ pub(crate) struct Made {
     pub claims: Vec<Claim>,
     pub settings: String,
     pub tables: Vec<(String, Csv)>,
-    pub plots: Vec<(String, Plot)>,
+    pub plots: Vec<(String, Picture)>,
+}
+
+/// A picture of a figure, drawn by the `render` crate.
+pub(crate) enum Picture {
+    /// A plot of series.
+    Plot(Plot),
+    /// Panels of heat maps in `cols` columns, `panel_px` pixels each, under a title.
+    Heatmaps {
+        title: String,
+        panels: Vec<Heatmap>,
+        cols: usize,
+        panel_px: u32,
+    },
+}
+
+impl From<Plot> for Picture {
+    fn from(p: Plot) -> Self {
+        Self::Plot(p)
+    }
+}
+
+impl Picture {
+    fn save_png(&self, path: &Path) -> Result<(), render::RenderError> {
+        match self {
+            Self::Plot(p) => p.save_png(path),
+            Self::Heatmaps {
+                title,
+                panels,
+                cols,
+                panel_px,
+            } => render::save_heatmaps(path, title, panels, *cols, *panel_px),
+        }
+    }
 }
 
 impl Made {
@@ -46,9 +79,9 @@ impl Made {
         self
     }
 
-    /// With the plot `plot` drawn as `name`.
-    pub(crate) fn plot(mut self, name: impl Into<String>, plot: Plot) -> Self {
-        self.plots.push((name.into(), plot));
+    /// With the picture `plot` drawn as `name`.
+    pub(crate) fn plot(mut self, name: impl Into<String>, plot: impl Into<Picture>) -> Self {
+        self.plots.push((name.into(), plot.into()));
         self
     }
 
@@ -68,15 +101,15 @@ impl Made {
 /// ([`sci`] for measured values, so that they keep every digit).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Csv {
-    columns: Vec<&'static str>,
+    columns: Vec<String>,
     rows: Vec<Vec<String>>,
 }
 
 impl Csv {
     /// An empty table with these columns.
-    pub(crate) fn new(columns: &[&'static str]) -> Self {
+    pub(crate) fn new(columns: &[&str]) -> Self {
         Self {
-            columns: columns.to_vec(),
+            columns: columns.iter().map(|c| c.to_string()).collect(),
             rows: Vec::new(),
         }
     }
