@@ -1,14 +1,12 @@
 //! `reproduce defects`: the supplementary defect figure. Defect density and creation rate
 //! against ζ; total density and net charge over time; where pairs are created.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 
 use super::lengths::{by_value, times, trend, turbulence, PRESSURES, ZETAS};
+use super::pipeline::{cell, sci, Csv, Made, PointRuns};
 use super::{
-    drawn, g, mean_se, mean_std, write_text, AtValue, Claim, Rec, ReproduceParams, SweepResult,
-    Table, Verdict,
+    g, mean_se, mean_std, AtValue, Claim, Rec, ReproduceParams, SweepResult, Table, Verdict,
 };
 use study::SweepError;
 
@@ -180,27 +178,37 @@ fn pairs_at_random_places(f: &[f64], q: &[f64], r: &[f64]) -> (Verdict, String) 
 /// The figure's tables, plots and claims for one pressure form.
 fn one_form(
     p: &ReproduceParams,
-    dir: &Path,
+    made: &mut Made,
     zeta: &SweepResult,
+    points: &[PointRuns],
     pressure: &str,
 ) -> Result<Vec<Claim>, SweepError> {
-    let recs: Vec<Rec> = zeta
-        .records(None)?
-        .into_iter()
-        .filter(|r| r.values[0] == pressure)
+    let recs: Vec<&Rec> = points
+        .iter()
+        .filter(|pt| pt.values[0] == pressure)
+        .flat_map(|pt| &pt.runs)
         .collect();
     let density = by_value(zeta, pressure, &ZETAS, "defect_density")?;
     let rate = by_value(zeta, pressure, &ZETAS, "creation_rate")?;
-    let mut csv = String::from(
-        "zeta,defect_density,defect_density_std,creation_rate,creation_rate_std,seeds\n",
-    );
+    let mut csv = Csv::new(&[
+        "zeta",
+        "defect_density",
+        "defect_density_std",
+        "creation_rate",
+        "creation_rate_std",
+        "seeds",
+    ]);
     for (d, r) in density.iter().zip(&rate) {
-        csv += &format!(
-            "{},{:e},{:e},{:e},{:e},{}\n",
-            d.0, d.1 .0, d.1 .1, r.1 .0, r.1 .1, d.2
-        );
+        csv.row([
+            cell(d.0),
+            sci(d.1 .0),
+            sci(d.1 .1),
+            sci(r.1 .0),
+            sci(r.1 .1),
+            cell(d.2),
+        ]);
     }
-    write_text(&dir.join(format!("defects_vs_zeta_{pressure}.csv")), &csv)?;
+    made.add_table(format!("defects_vs_zeta_{pressure}.csv"), csv);
     let series = |pts: &[AtValue], label: &str| {
         let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
         let m: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
@@ -213,17 +221,25 @@ fn one_form(
         "±1/2 defects per node",
     );
     pd.series.push(series(&density, "defect density"));
-    drawn(pd.save_png(&dir.join(format!("defect_density_vs_zeta_{pressure}.png"))))?;
+    made.add_plot(format!("defect_density_vs_zeta_{pressure}.png"), pd);
     let mut pr = Plot::new(
         format!("Creation rate of defect pairs against ζ ({pressure} pressure)"),
         "activity ζ",
         "pair creations per node per TU",
     );
     pr.series.push(series(&rate, "creation rate"));
-    drawn(pr.save_png(&dir.join(format!("creation_rate_vs_zeta_{pressure}.png"))))?;
+    made.add_plot(format!("creation_rate_vs_zeta_{pressure}.png"), pr);
 
     // Over time, and the charge of every frame.
-    let mut time_csv = String::from("zeta,seed,time,n_plus,n_minus,defect_density,net_charge\n");
+    let mut time_csv = Csv::new(&[
+        "zeta",
+        "seed",
+        "time",
+        "n_plus",
+        "n_minus",
+        "defect_density",
+        "net_charge",
+    ]);
     let mut pt = Plot::new(
         format!("Defect density in time (seed 1, {pressure} pressure)"),
         "time (TU)",
@@ -240,7 +256,7 @@ fn one_form(
     let (mut fractions, mut nulls, mut maps) = (Vec::new(), Vec::new(), Vec::new());
     // The same for deaths: paired fraction of deaths (annihilations) and its null.
     let (mut d_fractions, mut d_nulls, mut annihilations) = (Vec::new(), Vec::new(), 0usize);
-    for r in &recs {
+    for &r in &recs {
         let t = Table::read(&r.run.join("analysis/observables.csv"))?;
         let (time, np, nm, dens, net, un) = (
             t.f64s("time")?,
@@ -251,10 +267,15 @@ fn one_form(
             t.f64s("unpaired")?,
         );
         for k in 0..time.len() {
-            time_csv += &format!(
-                "{},{},{},{},{},{:e},{}\n",
-                r.values[1], r.seed, time[k], np[k], nm[k], dens[k], net[k]
-            );
+            time_csv.row([
+                cell(&r.values[1]),
+                cell(r.seed),
+                cell(time[k]),
+                cell(np[k]),
+                cell(nm[k]),
+                sci(dens[k]),
+                cell(net[k]),
+            ]);
             frames += 1;
             if net[k] != 0.0 {
                 charged += 1;
@@ -283,19 +304,19 @@ fn one_form(
             let ev = Table::read(&r.run.join("analysis/defect_events.csv"))?;
             let (kind, x, y) = (ev.strs("kind")?, ev.f64s("x")?, ev.f64s("y")?);
             let mut map = [0.0f64; BINS * BINS];
-            let (mut made, mut ended) = (0.0, 0.0);
+            let (mut born, mut ended) = (0.0, 0.0);
             for k in 0..kind.len() {
                 if kind[k] == "creation" {
                     creations.push((x[k], y[k]));
                     map[bin(x[k], y[k])] += 1.0;
-                    made += 1.0;
+                    born += 1.0;
                 } else if kind[k] == "annihilation" {
                     ended += 1.0;
                     annihilations += 1;
                 }
             }
             let run_unpaired: f64 = un.iter().filter(|x| x.is_finite()).sum();
-            if let Some((f, q)) = pairing(made, run_unpaired, time.len(), BOX * BOX, RADIUS) {
+            if let Some((f, q)) = pairing(born, run_unpaired, time.len(), BOX * BOX, RADIUS) {
                 fractions.push(f);
                 nulls.push(q);
             }
@@ -307,12 +328,9 @@ fn one_form(
             maps.push((r.seed, map));
         }
     }
-    write_text(
-        &dir.join(format!("defects_in_time_{pressure}.csv")),
-        &time_csv,
-    )?;
-    drawn(pt.save_png(&dir.join(format!("defect_density_in_time_{pressure}.png"))))?;
-    drawn(pq.save_png(&dir.join(format!("net_charge_in_time_{pressure}.png"))))?;
+    made.add_table(format!("defects_in_time_{pressure}.csv"), time_csv);
+    made.add_plot(format!("defect_density_in_time_{pressure}.png"), pt);
+    made.add_plot(format!("net_charge_in_time_{pressure}.png"), pq);
 
     // Where pairs are created: counts in BINS × BINS cells of the box.
     let mut counts = [0usize; BINS * BINS];
@@ -321,14 +339,11 @@ fn one_form(
     }
     let correlations = map_correlations(&maps);
     let (v_pairs, why_pairs) = pairs_at_random_places(&fractions, &nulls, &correlations);
-    let mut pos_csv = String::from("bin_x,bin_y,creations\n");
+    let mut pos_csv = Csv::new(&["bin_x", "bin_y", "creations"]);
     for (k, c) in counts.iter().enumerate() {
-        pos_csv += &format!("{},{},{c}\n", k / BINS, k % BINS);
+        pos_csv.row([cell(k / BINS), cell(k % BINS), cell(c)]);
     }
-    write_text(
-        &dir.join(format!("creation_positions_{pressure}.csv")),
-        &pos_csv,
-    )?;
+    made.add_table(format!("creation_positions_{pressure}.csv"), pos_csv);
 
     let active: Vec<AtValue> = density.iter().filter(|d| d.0 > 0.0).cloned().collect();
     let (vd, td) = trend(&density, 1.0);
@@ -408,12 +423,14 @@ fn one_form(
     ])
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (zeta, _) = turbulence(p)?;
     p.reporter.stage("defects: tables and plots");
+    let points = zeta.points(None)?;
+    let mut made = Made::new(Vec::new(), String::new());
     let mut claims = Vec::new();
     for pressure in PRESSURES {
-        claims.extend(one_form(p, dir, &zeta, pressure)?);
+        claims.extend(one_form(p, &mut made, &zeta, &points, pressure)?);
     }
     let (t, from) = times(p.scale);
     let settings = format!(
@@ -424,7 +441,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         ZETAS.join(", "),
         p.scale.seeds()
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
 }
 
 #[cfg(test)]

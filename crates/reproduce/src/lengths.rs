@@ -6,11 +6,9 @@ use std::path::Path;
 use render::{Plot, Series};
 
 use super::column_stats;
+use super::pipeline::{cell, point, sci, Csv, Made, PointRuns};
 use super::AtValue;
-use super::{
-    drawn, g, mean_std, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob, SweepResult,
-    Verdict,
-};
+use super::{g, mean_std, Claim, Rec, ReproduceParams, Scale, SweepJob, SweepResult, Verdict};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
@@ -155,7 +153,7 @@ const FIELDS: [(&str, &str); 3] = [
     ("Q", "length_q"),
 ];
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (zeta, gamma) = turbulence(p)?;
     p.reporter.stage("lengths: tables and plots");
     let active: Vec<&str> = ZETAS
@@ -165,14 +163,33 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .collect();
 
     // The correlation curves, averaged over seeds, per ζ.
-    let recs = zeta.records(None)?;
-    let mut corr_csv = String::from(
-        "pressure,zeta,r,c_velocity,c_velocity_std,c_vorticity,c_vorticity_std,c_q,c_q_std\n",
-    );
+    let points = zeta.points(None)?;
+    let runs_of = |pressure: &str, z: &str| -> Vec<&Rec> {
+        point(&points, &[pressure, z]).map_or(Vec::new(), PointRuns::refs)
+    };
+    let mut made = Made::new(Vec::new(), String::new());
+    let mut corr_csv = Csv::new(&[
+        "pressure",
+        "zeta",
+        "r",
+        "c_velocity",
+        "c_velocity_std",
+        "c_vorticity",
+        "c_vorticity_std",
+        "c_q",
+        "c_q_std",
+    ]);
     let box_side = analysis::smooth::paper_box_side(8.0) as f64;
     let mut claims = Vec::new();
-    let mut csv_z = String::from("pressure,zeta,field,length,length_std,seeds\n");
-    let mut csv_g = String::from("pressure,gamma,field,length,length_std,seeds\n");
+    let mut csv_z = Csv::new(&["pressure", "zeta", "field", "length", "length_std", "seeds"]);
+    let mut csv_g = Csv::new(&[
+        "pressure",
+        "gamma",
+        "field",
+        "length",
+        "length_std",
+        "seeds",
+    ]);
     for pressure in PRESSURES {
         let mut plots = [
             Plot::new(
@@ -196,10 +213,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             pl.legend = render::LegendAt::UpperRight;
         }
         for z in &active {
-            let runs: Vec<&Rec> = recs
-                .iter()
-                .filter(|r| r.values[0] == pressure && r.values[1] == *z)
-                .collect();
+            let runs = runs_of(pressure, z);
             let cols = ["c_velocity", "c_vorticity", "c_q"];
             let rows = column_stats(&runs, "analysis/correlations.csv", "r", &cols, 1)?;
             if rows.is_empty() {
@@ -208,12 +222,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             let r: Vec<f64> = rows.iter().map(|row| row.0).collect();
             let mut stats = vec![Vec::new(); 3];
             for (rk, st) in &rows {
-                corr_csv += &format!("{pressure},{z},{rk}");
+                corr_csv.row(
+                    [cell(pressure), cell(z), cell(rk)]
+                        .into_iter()
+                        .chain(st.iter().flat_map(|s| [sci(s.0), sci(s.1)])),
+                );
                 for (c, s) in st.iter().enumerate() {
-                    corr_csv += &format!(",{:e},{:e}", s.0, s.1);
                     stats[c].push(*s);
                 }
-                corr_csv += "\n";
             }
             // Out to r = 50 (a quarter of the box): the minimum sits well inside.
             let n = r.len().min(51);
@@ -228,9 +244,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     .push(Series::new(format!("ζ = {z}")).with_points(&r[..n], &m, &e));
             }
         }
-        drawn(plots[0].save_png(&dir.join(format!("fig3a_c_vorticity_{pressure}.png"))))?;
-        drawn(plots[1].save_png(&dir.join(format!("c_velocity_{pressure}.png"))))?;
-        drawn(plots[2].save_png(&dir.join(format!("c_q_{pressure}.png"))))?;
+        let [c_vorticity, c_velocity, c_q] = plots;
+        made = made
+            .plot(format!("fig3a_c_vorticity_{pressure}.png"), c_vorticity)
+            .plot(format!("c_velocity_{pressure}.png"), c_velocity)
+            .plot(format!("c_q_{pressure}.png"), c_q);
 
         // The lengths against ζ and γ.
         let mut pz = Plot::new(
@@ -250,11 +268,17 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         for (name, col) in FIELDS {
             let lz = by_value(&zeta, pressure, &active, col)?;
             let lg = by_value(&gamma, pressure, &GAMMAS, col)?;
-            for (x, (m, s), n) in &lz {
-                csv_z += &format!("{pressure},{x},{name},{m},{s},{n}\n");
-            }
-            for (x, (m, s), n) in &lg {
-                csv_g += &format!("{pressure},{x},{name},{m},{s},{n}\n");
+            for (csv, pts) in [(&mut csv_z, &lz), (&mut csv_g, &lg)] {
+                for (x, (m, s), n) in pts {
+                    csv.row([
+                        cell(pressure),
+                        cell(x),
+                        cell(name),
+                        cell(m),
+                        cell(s),
+                        cell(n),
+                    ]);
+                }
             }
             let series = |pts: &[AtValue]| {
                 let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
@@ -299,28 +323,38 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             reason(vg, "grows"),
         ));
         }
-        drawn(pz.save_png(&dir.join(format!("fig3b_lengths_vs_zeta_{pressure}.png"))))?;
-        drawn(pg.save_png(&dir.join(format!("fig3c_lengths_vs_gamma_{pressure}.png"))))?;
+        made = made
+            .plot(format!("fig3b_lengths_vs_zeta_{pressure}.png"), pz)
+            .plot(format!("fig3c_lengths_vs_gamma_{pressure}.png"), pg);
     }
     // No net flow of the whole tissue: the mean cell velocity U(t) = ⟨v_i⟩ over the frames of
     // the second half, against the cell speed.
     let (_, from) = times(p.scale);
-    let mut flow_csv = String::from("pressure,zeta,seed,net_flow,cell_speed_rms,ratio,cells\n");
+    let mut flow_csv = Csv::new(&[
+        "pressure",
+        "zeta",
+        "seed",
+        "net_flow",
+        "cell_speed_rms",
+        "ratio",
+        "cells",
+    ]);
     for pressure in PRESSURES {
         let mut ratios = Vec::new();
         let mut cells = 0usize;
         for z in &active {
-            for r in recs
-                .iter()
-                .filter(|r| r.values[0] == pressure && r.values[1] == *z)
-            {
+            for r in runs_of(pressure, z) {
                 let (u, speed, n) = net_flow(&r.run, from)?;
                 cells = n;
-                flow_csv += &format!(
-                    "{pressure},{z},{},{u:e},{speed:e},{:e},{n}\n",
-                    r.seed,
-                    u / speed
-                );
+                flow_csv.row([
+                    cell(pressure),
+                    cell(z),
+                    cell(r.seed),
+                    sci(u),
+                    sci(speed),
+                    sci(u / speed),
+                    cell(n),
+                ]);
                 ratios.push(u / speed);
             }
         }
@@ -336,11 +370,18 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             why,
         ));
     }
-    write_text(&dir.join("net_flow.csv"), &flow_csv)?;
+    made = made.table("net_flow.csv", flow_csv);
     // Fig. 2a at L = 200 as the paper draws it: v_rms of the raw flow and of the flow smoothed
     // over the 3R box, time means over the analysed frames, against ζ.
-    let mut v_csv =
-        String::from("pressure,zeta,v_rms,v_rms_std,v_rms_smooth,v_rms_smooth_std,seeds\n");
+    let mut v_csv = Csv::new(&[
+        "pressure",
+        "zeta",
+        "v_rms",
+        "v_rms_std",
+        "v_rms_smooth",
+        "v_rms_smooth_std",
+        "seeds",
+    ]);
     for pressure in PRESSURES {
         let mut plot = Plot::new(
             format!("Fig. 2a at L = 200: v_rms raw and smoothed over 3R ({pressure} pressure)"),
@@ -350,10 +391,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         plot.log_y = true;
         let (mut zs, mut raw, mut smooth) = (Vec::new(), Vec::new(), Vec::new());
         for z in ZETAS {
-            let runs: Vec<&Rec> = recs
-                .iter()
-                .filter(|r| r.values[0] == pressure && r.values[1] == z)
-                .collect();
+            let runs = runs_of(pressure, z);
             let (mut a, mut b) = (Vec::new(), Vec::new());
             for run in &runs {
                 let t = super::Table::read(&run.run.join("analysis/observables.csv"))?;
@@ -368,10 +406,15 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             }
             let (ma, sa) = mean_std(&a);
             let (mb, sb) = mean_std(&b);
-            v_csv += &format!(
-                "{pressure},{z},{ma:e},{sa:e},{mb:e},{sb:e},{}\n",
-                runs.len()
-            );
+            v_csv.row([
+                cell(pressure),
+                cell(z),
+                sci(ma),
+                sci(sa),
+                sci(mb),
+                sci(sb),
+                cell(runs.len()),
+            ]);
             zs.push(z.parse::<f64>().unwrap_or(f64::NAN));
             raw.push((ma, sa));
             smooth.push((mb, sb));
@@ -387,13 +430,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             .iter()
             .any(|s| s.points.iter().any(|p| p.1 > 0.0))
         {
-            drawn(plot.save_png(&dir.join(format!("fig2a_v_rms_raw_smooth_{pressure}.png"))))?;
+            made = made.plot(format!("fig2a_v_rms_raw_smooth_{pressure}.png"), plot);
         }
     }
-    write_text(&dir.join("v_rms_raw_smooth.csv"), &v_csv)?;
-    write_text(&dir.join("correlations.csv"), &corr_csv)?;
-    write_text(&dir.join("lengths_vs_zeta.csv"), &csv_z)?;
-    write_text(&dir.join("lengths_vs_gamma.csv"), &csv_g)?;
+    made = made
+        .table("v_rms_raw_smooth.csv", v_csv)
+        .table("correlations.csv", corr_csv)
+        .table("lengths_vs_zeta.csv", csv_z)
+        .table("lengths_vs_gamma.csv", csv_g);
     let (t, from) = times(p.scale);
     let settings = format!(
         "- Paper scene on L = 200 (240 cells, as the paper's Fig. 2a), both pressure forms. ζ sweep at γ = 0.01: ζ ∈ {{{}}} (lengths for ζ ≥ {ACTIVE}); γ sweep at ζ = {ZETA_OF_GAMMA_SWEEP}: γ ∈ {{{}}}; seeds {}.\n\
@@ -407,7 +451,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         p.scale.seeds(),
         p.scale.integrator_name()
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
 }
 
 /// The net flow of a run: `|⟨U⟩_t|`, the time mean over the frames at `t ≥ from` of the mean

@@ -464,15 +464,15 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
     use pipeline::Made;
     let made = match figure {
         Figure::Threshold => Made::written(threshold::make(p, &dir)?),
-        Figure::Lengths => Made::written(lengths::make(p, &dir)?),
-        Figure::Defects => Made::written(defects::make(p, &dir)?),
+        Figure::Lengths => lengths::make(p)?,
+        Figure::Defects => defects::make(p)?,
         Figure::DefectFields => defect_fields::make(p)?,
         Figure::Contractile => contractile::make(p)?,
         Figure::Scaling => Made::written(scaling::make(p, &dir)?),
         Figure::Stability => Made::written(stability::make(p, &dir)?),
         Figure::RunLength => Made::written(run_length::make(p, &dir)?),
         Figure::Channel => channel::make(p)?,
-        Figure::Rotation => Made::written(rotation::make(p, &dir)?),
+        Figure::Rotation => rotation::make(p)?,
         Figure::Flocking => flocking::make(p)?,
         Figure::Sorting => sorting::make(p)?,
         Figure::Jamming => jamming::make(p)?,

@@ -75,14 +75,24 @@ impl Made {
 
     /// With the table `csv` written as `name`.
     pub(crate) fn table(mut self, name: impl Into<String>, csv: Csv) -> Self {
-        self.tables.push((name.into(), csv));
+        self.add_table(name, csv);
         self
     }
 
     /// With the picture `plot` drawn as `name`.
     pub(crate) fn plot(mut self, name: impl Into<String>, plot: impl Into<Picture>) -> Self {
-        self.plots.push((name.into(), plot.into()));
+        self.add_plot(name, plot);
         self
+    }
+
+    /// Adds the table `csv`, to be written as `name`.
+    pub(crate) fn add_table(&mut self, name: impl Into<String>, csv: Csv) {
+        self.tables.push((name.into(), csv));
+    }
+
+    /// Adds the picture `plot`, to be drawn as `name`.
+    pub(crate) fn add_plot(&mut self, name: impl Into<String>, plot: impl Into<Picture>) {
+        self.plots.push((name.into(), plot.into()));
     }
 
     /// Writes the tables and draws the plots into `dir`.

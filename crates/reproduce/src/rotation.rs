@@ -12,13 +12,12 @@
 //! `Ω̄`); of a point, the mean and standard error over seeds of `|Ω̄|` and the mean
 //! persistence. [`classify`] says whether a point rotates.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
-use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made};
+use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 
 /// The disc scene: polar cells of radius 8 in a disc, the interaction pressure (docs/model.md
 /// §11.4), no activity; the figure sets the disc's radius, the domain and the cell count.
@@ -198,7 +197,7 @@ struct PointResult {
     persistence: f64,
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (radii, densities, t) = settings(p.scale);
     let relax = 100.0;
     let from = relax + t / 2.0;
@@ -235,78 +234,90 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     seeds: Some(seeds(p.scale)),
                 },
             )?;
-            let recs = res.records(None)?;
-            for rule in RULES {
-                for rate in RATES {
-                    for alpha in ALPHAS {
-                        let mut runs = Vec::new();
-                        for r in recs.iter().filter(|r| {
-                            r.values[0].trim_matches('"') == rule
-                                && r.values[1] == rate
-                                && r.values[2] == alpha
-                        }) {
-                            let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-                            let (times, omega) = (tab.f64s("time")?, tab.f64s("rotation")?);
-                            let (o, per) = run_statistic(&times, &omega, from);
-                            runs.push((r.seed, o, per));
-                            if (rule, rate, alpha) == SCENE_POINT
-                                && rk == SCENE_RADIUS
-                                && dens == SCENE_DENSITY
-                            {
-                                series_of_scene.push((r.seed, times, omega));
-                            }
-                        }
-                        let (state, abs, persistence) = classify(
-                            &runs.iter().map(|r| r.1).collect::<Vec<_>>(),
-                            &runs.iter().map(|r| r.2).collect::<Vec<_>>(),
-                        );
-                        points.push(PointResult {
-                            radius: rk,
-                            density: dens,
-                            cells,
-                            rule: rule.into(),
-                            rate: rate.into(),
-                            alpha: alpha.into(),
-                            runs,
-                            state,
-                            abs,
-                            persistence,
-                        });
+            // The points in the sweep's order: rule, then rate, then α.
+            for pt in res.points(None)? {
+                let (rule, rate, alpha) = (
+                    pt.values[0].trim_matches('"'),
+                    pt.values[1].as_str(),
+                    pt.values[2].as_str(),
+                );
+                let mut runs = Vec::new();
+                for r in &pt.runs {
+                    let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
+                    let (times, omega) = (tab.f64s("time")?, tab.f64s("rotation")?);
+                    let (o, per) = run_statistic(&times, &omega, from);
+                    runs.push((r.seed, o, per));
+                    if (rule, rate, alpha) == SCENE_POINT
+                        && rk == SCENE_RADIUS
+                        && dens == SCENE_DENSITY
+                    {
+                        series_of_scene.push((r.seed, times, omega));
                     }
                 }
+                let (state, abs, persistence) = classify(
+                    &runs.iter().map(|r| r.1).collect::<Vec<_>>(),
+                    &runs.iter().map(|r| r.2).collect::<Vec<_>>(),
+                );
+                points.push(PointResult {
+                    radius: rk,
+                    density: dens,
+                    cells,
+                    rule: rule.into(),
+                    rate: rate.into(),
+                    alpha: alpha.into(),
+                    runs,
+                    state,
+                    abs,
+                    persistence,
+                });
             }
         }
     }
     p.reporter.stage("rotation: tables and plots");
-    let mut runs_csv = String::from(
-        "radius_over_r,area_fraction,cells,align,align_rate,alpha,seed,omega_mean,persistence\n",
-    );
-    let mut points_csv = String::from(
-        "radius_over_r,area_fraction,cells,align,align_rate,alpha,abs_omega_mean,abs_omega_se,persistence,state\n",
+    let point_columns = [
+        "radius_over_r",
+        "area_fraction",
+        "cells",
+        "align",
+        "align_rate",
+        "alpha",
+    ];
+    let mut runs_csv =
+        Csv::new(&[&point_columns[..], &["seed", "omega_mean", "persistence"]].concat());
+    let mut points_csv = Csv::new(
+        &[
+            &point_columns[..],
+            &["abs_omega_mean", "abs_omega_se", "persistence", "state"],
+        ]
+        .concat(),
     );
     for pt in &points {
+        let point = [
+            cell(pt.radius),
+            cell(pt.density),
+            cell(pt.cells),
+            cell(&pt.rule),
+            cell(&pt.rate),
+            cell(&pt.alpha),
+        ];
         for (seed, o, per) in &pt.runs {
-            runs_csv += &format!(
-                "{},{},{},{},{},{},{seed},{o:e},{per:e}\n",
-                pt.radius, pt.density, pt.cells, pt.rule, pt.rate, pt.alpha
+            runs_csv.row(
+                point
+                    .iter()
+                    .cloned()
+                    .chain([cell(seed), sci(*o), sci(*per)]),
             );
         }
-        points_csv += &format!(
-            "{},{},{},{},{},{},{:e},{:e},{:e},{}\n",
-            pt.radius,
-            pt.density,
-            pt.cells,
-            pt.rule,
-            pt.rate,
-            pt.alpha,
-            pt.abs.0,
-            pt.abs.1,
-            pt.persistence,
-            pt.state.name()
-        );
+        points_csv.row(point.into_iter().chain([
+            sci(pt.abs.0),
+            sci(pt.abs.1),
+            sci(pt.persistence),
+            cell(pt.state.name()),
+        ]));
     }
-    write_text(&dir.join("rotation_runs.csv"), &runs_csv)?;
-    write_text(&dir.join("rotation_points.csv"), &points_csv)?;
+    let mut made = Made::new(Vec::new(), String::new())
+        .table("rotation_runs.csv", runs_csv)
+        .table("rotation_points.csv", points_csv);
     for rule in RULES {
         let mut plot = Plot::new(
             format!("Rotation in a disc, align = \"{rule}\""),
@@ -340,7 +351,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 }
             }
         }
-        drawn(plot.save_png(&dir.join(format!("rotation_{rule}.png"))))?;
+        made = made.plot(format!("rotation_{rule}.png"), plot);
     }
     let mut tplot = Plot::new(
         format!(
@@ -358,7 +369,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         );
     }
     if !series_of_scene.is_empty() {
-        drawn(tplot.save_png(&dir.join("rotation_in_time.png")))?;
+        made = made.plot("rotation_in_time.png", tplot);
     }
 
     let states: Vec<State> = points.iter().map(|q| q.state).collect();
@@ -434,7 +445,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         SCENE_POINT.1,
         SCENE_POINT.2,
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
 }
 
 /// The alignment rule, rate and propulsion of `scenes/disc.toml`, drawn in time.
