@@ -463,14 +463,14 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
     let dir = p.figure_dir(figure)?;
     use pipeline::Made;
     let made = match figure {
-        Figure::Threshold => Made::written(threshold::make(p, &dir)?),
+        Figure::Threshold => threshold::make(p)?,
         Figure::Lengths => lengths::make(p)?,
         Figure::Defects => defects::make(p)?,
         Figure::DefectFields => defect_fields::make(p)?,
         Figure::Contractile => contractile::make(p)?,
-        Figure::Scaling => Made::written(scaling::make(p, &dir)?),
+        Figure::Scaling => scaling::make(p)?,
         Figure::Stability => Made::written(stability::make(p, &dir)?),
-        Figure::RunLength => Made::written(run_length::make(p, &dir)?),
+        Figure::RunLength => run_length::make(p)?,
         Figure::Channel => channel::make(p)?,
         Figure::Rotation => rotation::make(p)?,
         Figure::Flocking => flocking::make(p)?,

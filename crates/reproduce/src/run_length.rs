@@ -8,11 +8,10 @@
 //! are the run of length T); ζ_cr(T) is found per seed, and `ζ_cr(T) = ζ_∞ + a T^(−b)` is
 //! fitted to the seed means.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 
-use super::{drawn, g, mean_se, write_text, Claim, ReproduceParams, Scale, SweepJob, Verdict};
+use super::pipeline::{cell, sci, Csv, Made};
+use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 use study::threshold::{growth_threshold, RatePoint, Threshold};
 use study::SweepError;
 
@@ -255,7 +254,7 @@ fn per_seed(rates: &[(f64, u64, f64)], seed: u64) -> Threshold {
     growth_threshold(&points)
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t_max = LENGTHS[LENGTHS.len() - 1];
     let mut sets = vec![
         format!("run.time={t_max}"),
@@ -281,10 +280,17 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         let s = seeds_of(p.scale);
         (s.first..=s.last).collect()
     };
-    let mut csv = String::from("pressure,run_time,seed,zeta_cr,censored\n");
-    let mut means = String::from(
-        "pressure,run_time,zeta_cr,zeta_cr_err,seeds_bracketed,seeds_below,seeds_above,seeds\n",
-    );
+    let mut csv = Csv::new(&["pressure", "run_time", "seed", "zeta_cr", "censored"]);
+    let mut means = Csv::new(&[
+        "pressure",
+        "run_time",
+        "zeta_cr",
+        "zeta_cr_err",
+        "seeds_bracketed",
+        "seeds_below",
+        "seeds_above",
+        "seeds",
+    ]);
     let mut plot = Plot::new(
         "ζ_cr of the random packing against the run length (L = 100, γ = 0.01)",
         "run length T (TU)",
@@ -293,16 +299,30 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     plot.log_x = true;
     plot.zero_y = true;
     let mut claims = Vec::new();
-    let mut fits = String::from(
-        "pressure,zeta_inf,zeta_inf_err,a,b,b_lo,b_hi,chi2,dof,zero_a,zero_b,zero_chi2,zero_dof\n",
-    );
+    let mut fits = Csv::new(&[
+        "pressure",
+        "zeta_inf",
+        "zeta_inf_err",
+        "a",
+        "b",
+        "b_lo",
+        "b_hi",
+        "chi2",
+        "dof",
+        "zero_a",
+        "zero_b",
+        "zero_chi2",
+        "zero_dof",
+    ]);
     for pressure in PRESSURES {
         let mut pts = Vec::new();
         for &t in &LENGTHS {
-            let recs = res.records(Some(t))?;
-            let rates: Vec<(f64, u64, f64)> = recs
+            // Each run cut at T.
+            let points = res.points(Some(t))?;
+            let rates: Vec<(f64, u64, f64)> = points
                 .iter()
-                .filter(|r| r.values[0] == pressure)
+                .filter(|pt| pt.values[0] == pressure)
+                .flat_map(|pt| &pt.runs)
                 .map(|r| {
                     (
                         r.values[1].parse().unwrap_or(f64::NAN),
@@ -328,7 +348,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                         (String::new(), "above")
                     }
                 };
-                csv += &format!("{pressure},{t},{s},{value},{censored}\n");
+                csv.row([cell(pressure), cell(t), cell(s), value, cell(censored)]);
             }
             let mean = if above > 0 {
                 None
@@ -336,12 +356,16 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 censored_mean(&found, &below)
             };
             let (m, se) = mean.unwrap_or((f64::NAN, f64::NAN));
-            means += &format!(
-                "{pressure},{t},{m:e},{se:e},{},{},{above},{}\n",
-                found.len(),
-                below.len(),
-                seeds.len()
-            );
+            means.row([
+                cell(pressure),
+                cell(t),
+                sci(m),
+                sci(se),
+                cell(found.len()),
+                cell(below.len()),
+                cell(above),
+                cell(seeds.len()),
+            ]);
             if mean.is_some() {
                 pts.push((t, m, se));
             }
@@ -363,21 +387,21 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                 chi2: f64::NAN,
                 dof: 0,
             });
-            fits += &format!(
-                "{pressure},{:e},{:e},{:e},{},{},{},{},{},{:e},{},{},{}\n",
-                f.zeta_inf,
-                f.zeta_inf_err,
-                f.a,
-                f.b,
-                f.b_range.0,
-                f.b_range.1,
-                f.chi2,
-                f.dof,
-                z.a,
-                z.b,
-                z.chi2,
-                z.dof
-            );
+            fits.row([
+                cell(pressure),
+                sci(f.zeta_inf),
+                sci(f.zeta_inf_err),
+                sci(f.a),
+                cell(f.b),
+                cell(f.b_range.0),
+                cell(f.b_range.1),
+                cell(f.chi2),
+                cell(f.dof),
+                sci(z.a),
+                cell(z.b),
+                cell(z.chi2),
+                cell(z.dof),
+            ]);
             let tt: Vec<f64> = (0..=40)
                 .map(|k| 100.0 * (t_max / 100.0).powf(k as f64 / 40.0))
                 .collect();
@@ -399,10 +423,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             why,
         ));
     }
-    write_text(&dir.join("zeta_cr_per_seed.csv"), &csv)?;
-    write_text(&dir.join("zeta_cr_vs_run_length.csv"), &means)?;
-    write_text(&dir.join("fit.csv"), &fits)?;
-    drawn(plot.save_png(&dir.join("zeta_cr_vs_run_length.png")))?;
+
     let settings = format!(
         "- The paper's scene (L = 100, 60 cells, γ = 0.01, random packing relaxed 200 TU at ζ = 0), {}, both pressure forms, ζ ∈ {{{ZETAS}}}, seeds {}–{}, each run {t_max} TU of activity.\n\
          - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] first turns positive (linear interpolation between the activities around the crossing); seeds whose crossing lies below the lowest ζ are censored, not dropped: each lies in [0, lowest ζ], and the mean puts them at the middle with the half-width of the mean's range added to its standard error in quadrature; a run length where a seed's crossing lies above the grid is left out (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
@@ -413,7 +434,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         seeds.last().copied().unwrap_or(1),
         LENGTHS.map(|t| t.to_string()).join(", "),
     );
-    Ok((claims, settings))
+    Ok(Made::new(claims, settings)
+        .table("zeta_cr_per_seed.csv", csv)
+        .table("zeta_cr_vs_run_length.csv", means)
+        .table("fit.csv", fits)
+        .plot("zeta_cr_vs_run_length.png", plot))
 }
 
 #[cfg(test)]

@@ -8,11 +8,10 @@
 //! Each point is timed `REPEATS` times, each for at least `MIN_CPU_S` of CPU (the clock ticks
 //! at 10 ms); the exponent is fitted per repeat, and the rule reads their spread.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 
-use super::{drawn, g, mean_std, write_text, Claim, ReproduceParams, Scale, Verdict, PAPER_SCENE};
+use super::pipeline::{cell, sci, Csv, Made};
+use super::{g, mean_std, Claim, ReproduceParams, Scale, Verdict, PAPER_SCENE};
 use study::SweepError;
 
 /// Timings per point.
@@ -152,7 +151,7 @@ fn exponent(x: &[f64], y: &[f64]) -> f64 {
     study::summary::slope(&lx, &ly)
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (sub, full): (Vec<usize>, Vec<usize>) = match p.scale {
         Scale::Quick => (vec![100, 200, 400], vec![50, 100, 150, 200]),
         Scale::Paper => (vec![100, 200, 400, 800], vec![50, 100, 150, 200, 250]),
@@ -162,7 +161,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .num_threads(1)
         .build()
         .map_err(|e| SweepError::Threads(e.to_string()))?;
-    let mut csv = String::from("method,lx,cells,repeat,cpu_seconds_per_step,heap_bytes\n");
+    let mut csv = Csv::new(&[
+        "method",
+        "lx",
+        "cells",
+        "repeat",
+        "cpu_seconds_per_step",
+        "heap_bytes",
+    ]);
     type Row<'a> = (&'a str, Vec<(f64, Vec<f64>, f64)>);
     let mut rows: Vec<Row> = Vec::new();
     for (method, sizes, margin) in [("subdomains", &sub, 16usize), ("full domain", &full, 0)] {
@@ -171,13 +177,19 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             let cells = (lx * lx * 15 / 2500) as f64;
             let (t, m) = pool.install(|| measure(lx, margin))?;
             for (k, tk) in t.iter().enumerate() {
-                csv += &format!("{method},{lx},{cells},{k},{tk:e},{m}\n");
+                csv.row([
+                    cell(method),
+                    cell(lx),
+                    cell(cells),
+                    cell(k),
+                    sci(*tk),
+                    cell(m),
+                ]);
             }
             pts.push((cells, t, m));
         }
         rows.push((method, pts));
     }
-    write_text(&dir.join("scaling.csv"), &csv)?;
     let mut pt = Plot::new(
         "CPU time per step at the paper's density (1 thread, f32)",
         "cells N",
@@ -225,8 +237,6 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             .collect();
         summary.push((method.to_string(), per_repeat, exponent(&n, &m)));
     }
-    drawn(pt.save_png(&dir.join("time_per_step.png")))?;
-    drawn(pm.save_png(&dir.join("memory.png")))?;
     for (method, kt, km) in &summary {
         let (want, lo, hi) = if method == "subdomains" {
             ("O(N)", 0.8, 1.25)
@@ -255,7 +265,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         sub.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", "),
         full.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", ")
     );
-    Ok((claims, settings))
+    Ok(Made::new(claims, settings)
+        .table("scaling.csv", csv)
+        .plot("time_per_step.png", pt)
+        .plot("memory.png", pm))
 }
 
 #[cfg(test)]

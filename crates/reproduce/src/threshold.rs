@@ -3,15 +3,11 @@
 //! [`study::threshold`], its dependence on the run length, and (quick scale) the paper's
 //! integrator on one box.
 
-use std::path::Path;
-
 use render::{Plot, Series};
 
+use super::pipeline::{cell, sci, Csv, Made};
 use super::rules::{rule_box, rule_converged, rule_linear, rule_proportional};
-use super::{
-    drawn, g, mean_se, mean_std, pm, write_text, Claim, Rec, ReproduceParams, Scale, SweepJob,
-    Verdict,
-};
+use super::{g, mean_se, mean_std, pm, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict};
 use study::threshold::{csv_fields, growth_threshold, threshold, RatePoint, Threshold};
 use study::SweepError;
 
@@ -174,7 +170,7 @@ fn bracket(t: Threshold) -> (f64, f64, f64) {
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = run_time(p.scale);
     let integ = p.scale.integrator();
     let integ_name = p.scale.integrator_name();
@@ -233,51 +229,94 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
     p.reporter.stage("threshold: tables and plots");
 
     // threshold.csv
-    let mut csv = String::from(
-        "gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi,seeds,activities,run_time,integrator,zeta_cr_seed_mean,zeta_cr_seed_se,seeds_bracketed\n",
+    let bracket_columns = [
+        "zeta_cr",
+        "zeta_cr_lo",
+        "zeta_cr_hi",
+        "zeta_cr_excess",
+        "zeta_cr_excess_lo",
+        "zeta_cr_excess_hi",
+    ];
+    let mut csv = Csv::new(
+        &[
+            &["gamma", "lx", "pressure"][..],
+            &bracket_columns,
+            &[
+                "seeds",
+                "activities",
+                "run_time",
+                "integrator",
+                "zeta_cr_seed_mean",
+                "zeta_cr_seed_se",
+                "seeds_bracketed",
+            ],
+        ]
+        .concat(),
     );
     for gr in all.iter().chain(&compare) {
         let (m, se, n) = gr.seed_zeta();
-        csv += &format!(
-            "{},{},{},{},{},{},{},{t},{},{m:e},{se:e},{n}\n",
-            gr.gamma,
-            gr.lx,
-            gr.pressure,
-            csv_fields(gr.threshold).join(","),
-            csv_fields(gr.excess).join(","),
-            gr.seeds,
-            gr.zetas.len() - 1,
-            gr.integrator
+        csv.row(
+            [cell(gr.gamma), cell(gr.lx), cell(&gr.pressure)]
+                .into_iter()
+                .chain(csv_fields(gr.threshold))
+                .chain(csv_fields(gr.excess))
+                .chain([
+                    cell(gr.seeds),
+                    cell(gr.zetas.len() - 1),
+                    cell(t),
+                    cell(&gr.integrator),
+                    sci(m),
+                    sci(se),
+                    cell(n),
+                ]),
         );
     }
-    write_text(&dir.join("threshold.csv"), &csv)?;
+    let mut made = Made::new(Vec::new(), String::new()).table("threshold.csv", csv);
 
     // fig2a.csv: the seed statistics of every group.
-    let mut a = String::from("gamma,lx,pressure,integrator,zeta,v_rms,v_rms_std,s_rms_excess,s_rms_excess_std,growth_rate,growth_rate_std,growth_rate_excess,growth_rate_excess_std\n");
+    let mut a = Csv::new(&[
+        "gamma",
+        "lx",
+        "pressure",
+        "integrator",
+        "zeta",
+        "v_rms",
+        "v_rms_std",
+        "s_rms_excess",
+        "s_rms_excess_std",
+        "growth_rate",
+        "growth_rate_std",
+        "growth_rate_excess",
+        "growth_rate_excess_std",
+    ]);
     for gr in all.iter().chain(&compare) {
         for (k, z) in gr.zetas.iter().enumerate() {
-            a += &format!(
-                "{},{},{},{},{z},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}\n",
-                gr.gamma,
-                gr.lx,
-                gr.pressure,
-                gr.integrator,
-                gr.v_rms[k].0,
-                gr.v_rms[k].1,
-                gr.s_excess[k].0,
-                gr.s_excess[k].1,
-                gr.rate[k].0,
-                gr.rate[k].1,
-                gr.rate_excess[k].0,
-                gr.rate_excess[k].1
+            a.row(
+                [
+                    cell(gr.gamma),
+                    cell(gr.lx),
+                    cell(&gr.pressure),
+                    cell(&gr.integrator),
+                    cell(z),
+                ]
+                .into_iter()
+                .chain(
+                    [gr.v_rms[k], gr.s_excess[k], gr.rate[k], gr.rate_excess[k]]
+                        .into_iter()
+                        .flat_map(|(m, e)| [sci(m), sci(e)]),
+                ),
             );
         }
     }
-    write_text(&dir.join("fig2a.csv"), &a)?;
+    made.add_table("fig2a.csv", a);
 
     // How the estimate moves with the run length: the same runs, cut at T/4 and T/2.
-    let mut by_length = String::from(
-        "run_time,gamma,lx,pressure,zeta_cr,zeta_cr_lo,zeta_cr_hi,zeta_cr_excess,zeta_cr_excess_lo,zeta_cr_excess_hi\n",
+    let mut by_length = Csv::new(
+        &[
+            &["run_time", "gamma", "lx", "pressure"][..],
+            &bracket_columns,
+        ]
+        .concat(),
     );
     let mut length_series: Vec<Series> = Vec::new();
     for (lx, _, res) in &long_recs {
@@ -285,12 +324,11 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             let tt = t * frac;
             let recs = res.records(Some(tt))?;
             for gr in groups(&recs, *lx, &integ_name, true) {
-                by_length += &format!(
-                    "{tt},{},{lx},{},{},{}\n",
-                    gr.gamma,
-                    gr.pressure,
-                    csv_fields(gr.threshold).join(","),
-                    csv_fields(gr.excess).join(",")
+                by_length.row(
+                    [cell(tt), cell(gr.gamma), cell(lx), cell(&gr.pressure)]
+                        .into_iter()
+                        .chain(csv_fields(gr.threshold))
+                        .chain(csv_fields(gr.excess)),
                 );
                 let (z, lo, hi) = bracket(gr.threshold);
                 if gr.gamma == 0.01 {
@@ -308,7 +346,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             }
         }
     }
-    write_text(&dir.join("threshold_vs_run_length.csv"), &by_length)?;
+    made.add_table("threshold_vs_run_length.csv", by_length);
 
     // Pictures.
     for pressure in PRESSURES {
@@ -354,9 +392,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
                     .push(Series::new(&label).with_points(&gr.zetas, &m, &e));
             }
         }
-        drawn(v.save_png(&dir.join(format!("fig2a_v_rms_{pressure}.png"))))?;
-        drawn(s.save_png(&dir.join(format!("fig2a_s_rms_{pressure}.png"))))?;
-        drawn(r.save_png(&dir.join(format!("growth_rate_{pressure}.png"))))?;
+        made.add_plot(format!("fig2a_v_rms_{pressure}.png"), v);
+        made.add_plot(format!("fig2a_s_rms_{pressure}.png"), s);
+        made.add_plot(format!("growth_rate_{pressure}.png"), r);
     }
     let mut b = Plot::new(
         "Fig. 2b: threshold against γ",
@@ -381,14 +419,14 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             b.series.push(sr);
         }
     }
-    drawn(b.save_png(&dir.join("fig2b_zeta_cr.png")))?;
+    made.add_plot("fig2b_zeta_cr.png", b);
     let mut rl = Plot::new(
         "ζ_cr against the run length (γ = 0.01)",
         "active time of the runs (TU)",
         "ζ_cr (bar: ± half the bracket)",
     );
     rl.series.extend(length_series);
-    drawn(rl.save_png(&dir.join("threshold_vs_run_length.png")))?;
+    made.add_plot("threshold_vs_run_length.png", rl);
 
     // The same runs cut at T/2, for 9.1's test of whether ζ_cr has settled.
     let mut half = Vec::new();
@@ -410,7 +448,9 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             "\n- The paper's integrator (dt 0.2, margin 12) on L = 100, γ = 0.01, both forms, for comparison (rows with that integrator in `threshold.csv`).".to_string()
         }
     );
-    Ok((claims, settings))
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
 }
 
 /// The middle of a bracket and its half-width, for a bar; an open bracket draws nothing.
