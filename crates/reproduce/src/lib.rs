@@ -461,7 +461,6 @@ pub(crate) fn sweep(p: &ReproduceParams, job: SweepJob) -> Result<SweepResult, S
 pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, SweepError> {
     let start = Instant::now();
     let dir = p.figure_dir(figure)?;
-    use pipeline::Made;
     let made = match figure {
         Figure::Threshold => threshold::make(p)?,
         Figure::Lengths => lengths::make(p)?,
@@ -469,7 +468,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::DefectFields => defect_fields::make(p)?,
         Figure::Contractile => contractile::make(p)?,
         Figure::Scaling => scaling::make(p)?,
-        Figure::Stability => Made::written(stability::make(p, &dir)?),
+        Figure::Stability => stability::make(p, &dir)?,
         Figure::RunLength => run_length::make(p)?,
         Figure::Channel => channel::make(p)?,
         Figure::Rotation => rotation::make(p)?,

@@ -4,8 +4,8 @@
 //! plots and claims, and returns them as one [`Made`], which [`crate::reproduce`] writes: the
 //! CSV files, the PNG plots and `verdict.md` with the settings.
 //!
-//! A figure that is not on the pipeline yet writes its own files and returns
-//! [`Made::written`].
+//! A figure writes nothing itself, but for what it keeps to resume (the `stability` figure's
+//! finished configurations).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -35,6 +35,8 @@ pub(crate) enum Picture {
         cols: usize,
         panel_px: u32,
     },
+    /// A picture already drawn (a tissue).
+    Raster(render::Picture),
 }
 
 impl From<Plot> for Picture {
@@ -53,6 +55,7 @@ impl Picture {
                 cols,
                 panel_px,
             } => render::save_heatmaps(path, title, panels, *cols, *panel_px),
+            Self::Raster(p) => p.save_png(path),
         }
     }
 }
@@ -66,11 +69,6 @@ impl Made {
             tables: Vec::new(),
             plots: Vec::new(),
         }
-    }
-
-    /// A figure that wrote its own files.
-    pub(crate) fn written((claims, settings): (Vec<Claim>, String)) -> Self {
-        Self::new(claims, settings)
     }
 
     /// With the table `csv` written as `name`.

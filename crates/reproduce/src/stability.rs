@@ -19,8 +19,9 @@ use stability::{
     StabilityError, StepMap, Threshold, ThresholdOptions,
 };
 
+use super::pipeline::{cell, sci, Csv, Made, Picture};
 use super::rules::{rule_agree, rule_box, rule_continuum, rule_linear, rule_proportional};
-use super::{drawn, g, write_text, Claim, ReproduceParams, Scale, Verdict};
+use super::{g, write_text, Claim, ReproduceParams, Scale, Verdict};
 use study::SweepError;
 
 /// The γ of the study: five values, so that a line and its curvature can be told apart.
@@ -221,7 +222,7 @@ impl Row {
     }
 }
 
-pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, String), SweepError> {
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> {
     let plan = plan(p.scale);
     let mut rests: BTreeMap<String, RestState> = BTreeMap::new();
     let relax = Relaxation::default();
@@ -302,22 +303,24 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
             result,
         });
     }
-    write_tables(dir, &rows, &rests, &key)?;
+    let mut made = Made::new(Vec::new(), String::new());
+    write_tables(&mut made, &rows, &rests, &key);
     p.reporter
         .stage("stability: the uniform translations and the map's drift");
-    translations(dir, &rows, &rests, &key)?;
+    translations(dir, &mut made, &rows, &rests, &key)?;
     p.reporter
         .stage("stability: convergence in dt, margin, Krylov dimension and ε");
-    let convergence = convergence(dir, &rows, &plan, &rests, &key)?;
+    let convergence = convergence(dir, &mut made, &rows, &plan, &rests, &key)?;
     p.reporter.stage("stability: pictures");
-    draw(dir, &rows)?;
+    draw(&mut made, &rows);
     if let Some(row) = rows
         .iter()
         .find(|r| r.method == "arnoldi" && r.config.gamma == 0.01 && r.config.hex == hex(6, 10))
     {
         if let Ok(t) = &row.result {
             if let Some(sp) = &t.spectrum {
-                draw_mode(dir, &rests[&key(&row.config)].tissue, &sp.mode, t.zeta_cr)?;
+                let mode = draw_mode(&rests[&key(&row.config)].tissue, &sp.mode, t.zeta_cr)?;
+                made.add_plot("mode.png", Picture::Raster(mode));
             }
         }
     }
@@ -325,64 +328,91 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<(Vec<Claim>, Strin
         .stage("stability: an isolated cell under activity");
     let mut claims = claims(&rows);
     claims.push(isolated_cell()?);
-    let settings = settings(p.scale, &plan, &rests, &convergence);
-    Ok((claims, settings))
+    made.settings = settings(p.scale, &plan, &rests, &convergence);
+    made.claims = claims;
+    Ok(made)
 }
 
 fn write_tables(
-    dir: &Path,
+    made: &mut Made,
     rows: &[Row],
     rests: &BTreeMap<String, RestState>,
     key: &dyn Fn(&Config) -> String,
-) -> Result<(), SweepError> {
-    let mut zc = String::from("gamma,lx,pressure,method,zeta_cr,zeta_cr_err\n");
-    let mut gr = String::from("gamma,lx,pressure,method,zeta,sigma,sigma_err\n");
-    let mut sp = String::from("gamma,lx,pressure,zeta,rank,sigma,omega,residual\n");
+) {
+    let mut zc = Csv::new(&[
+        "gamma",
+        "lx",
+        "pressure",
+        "method",
+        "zeta_cr",
+        "zeta_cr_err",
+    ]);
+    let mut gr = Csv::new(&[
+        "gamma",
+        "lx",
+        "pressure",
+        "method",
+        "zeta",
+        "sigma",
+        "sigma_err",
+    ]);
+    let mut sp = Csv::new(&[
+        "gamma", "lx", "pressure", "zeta", "rank", "sigma", "omega", "residual",
+    ]);
     for r in rows {
         let c = &r.config;
+        let config = [
+            cell(c.gamma),
+            cell(c.hex.lx),
+            cell(pressure_name(c.pressure)),
+        ];
         let (z, e) = r.zeta().unwrap_or((f64::NAN, f64::NAN));
-        zc += &format!(
-            "{},{},{},{},{z:e},{e:e}\n",
-            c.gamma,
-            c.hex.lx,
-            pressure_name(c.pressure),
-            r.method
+        zc.row(
+            config
+                .iter()
+                .cloned()
+                .chain([cell(r.method), sci(z), sci(e)]),
         );
         if let Ok(t) = &r.result {
             for ev in &t.evaluations {
-                gr += &format!(
-                    "{},{},{},{},{:e},{:e},{:e}\n",
-                    c.gamma,
-                    c.hex.lx,
-                    pressure_name(c.pressure),
-                    r.method,
-                    ev.zeta,
-                    ev.sigma,
-                    ev.sigma_err
-                );
+                gr.row(config.iter().cloned().chain([
+                    cell(r.method),
+                    sci(ev.zeta),
+                    sci(ev.sigma),
+                    sci(ev.sigma_err),
+                ]));
             }
             if let Some(s) = &t.spectrum {
                 let last = t.evaluations.last().map_or(f64::NAN, |e| e.zeta);
                 for (rank, ritz) in s.ritz.iter().enumerate().take(10) {
-                    sp += &format!(
-                        "{},{},{},{last:e},{rank},{:e},{:e},{:e}\n",
-                        c.gamma,
-                        c.hex.lx,
-                        pressure_name(c.pressure),
-                        ritz.sigma,
-                        ritz.omega,
-                        ritz.residual
-                    );
+                    sp.row(config.iter().cloned().chain([
+                        sci(last),
+                        cell(rank),
+                        sci(ritz.sigma),
+                        sci(ritz.omega),
+                        sci(ritz.residual),
+                    ]));
                 }
             }
         }
     }
-    write_text(&dir.join("zeta_cr.csv"), &zc)?;
-    write_text(&dir.join("growth_rates.csv"), &gr)?;
-    write_text(&dir.join("spectrum.csv"), &sp)?;
-    let mut rs = String::from(
-        "cols,rows,lx,ly,cells,anisotropy,gamma,pressure,relax_time,v_max,phi_rate,s_rms\n",
-    );
+    made.add_table("zeta_cr.csv", zc);
+    made.add_table("growth_rates.csv", gr);
+    made.add_table("spectrum.csv", sp);
+    let mut rs = Csv::new(&[
+        "cols",
+        "rows",
+        "lx",
+        "ly",
+        "cells",
+        "anisotropy",
+        "gamma",
+        "pressure",
+        "relax_time",
+        "v_max",
+        "phi_rate",
+        "s_rms",
+    ]);
     let mut seen = std::collections::BTreeSet::new();
     for r in rows {
         let k = key(&r.config);
@@ -391,23 +421,22 @@ fn write_tables(
         }
         let c = &r.config;
         let s = &rests[&k];
-        rs += &format!(
-            "{},{},{},{},{},{:e},{},{},{},{:e},{:e},{:e}\n",
-            c.hex.cols,
-            c.hex.rows,
-            c.hex.lx,
-            c.hex.ly,
-            c.hex.n_cells(),
-            c.hex.anisotropy(),
-            c.gamma,
-            pressure_name(c.pressure),
-            s.time,
-            s.v_max,
-            s.phi_rate,
-            s.s_rms
-        );
+        rs.row([
+            cell(c.hex.cols),
+            cell(c.hex.rows),
+            cell(c.hex.lx),
+            cell(c.hex.ly),
+            cell(c.hex.n_cells()),
+            sci(c.hex.anisotropy()),
+            cell(c.gamma),
+            cell(pressure_name(c.pressure)),
+            cell(s.time),
+            sci(s.v_max),
+            sci(s.phi_rate),
+            sci(s.s_rms),
+        ]);
     }
-    write_text(&dir.join("rest_states.csv"), &rs)
+    made.add_table("rest_states.csv", rs);
 }
 
 /// One line of `translations.csv`: the growth rates of the two uniform translations (which the
@@ -425,12 +454,15 @@ struct TranslationRow {
 /// ζ_cr, into `translations.csv` (each kept in `configurations/` as it finishes).
 fn translations(
     dir: &Path,
+    made: &mut Made,
     rows: &[Row],
     rests: &BTreeMap<String, RestState>,
     key: &dyn Fn(&Config) -> String,
 ) -> Result<(), SweepError> {
     let done = dir.join("configurations");
-    let mut csv = String::from("gamma,lx,ly,pressure,zeta,sigma_x,sigma_y,drift\n");
+    let mut csv = Csv::new(&[
+        "gamma", "lx", "ly", "pressure", "zeta", "sigma_x", "sigma_y", "drift",
+    ]);
     for r in rows.iter().filter(|r| r.method == "arnoldi") {
         let c = &r.config;
         let zetas = [0.0, r.zeta().map_or(f64::NAN, |z| z.0)];
@@ -465,20 +497,20 @@ fn translations(
                     keep(&file, &fingerprint, row)?
                 }
             };
-            csv += &format!(
-                "{},{},{},{},{:e},{:e},{:e},{:e}\n",
-                c.gamma,
-                c.hex.lx,
-                c.hex.ly,
-                pressure_name(c.pressure),
-                row.zeta,
-                row.sigma_x,
-                row.sigma_y,
-                row.drift
-            );
+            csv.row([
+                cell(c.gamma),
+                cell(c.hex.lx),
+                cell(c.hex.ly),
+                cell(pressure_name(c.pressure)),
+                sci(row.zeta),
+                sci(row.sigma_x),
+                sci(row.sigma_y),
+                sci(row.drift),
+            ]);
         }
     }
-    write_text(&dir.join("translations.csv"), &csv)
+    made.add_table("translations.csv", csv);
+    Ok(())
 }
 
 /// One line of the convergence table: what changed, σ at the reference ζ, its error.
@@ -493,6 +525,7 @@ struct Conv {
 /// the shift of ζ_cr it implies is Δσ over the slope dσ/dζ.
 fn convergence(
     dir: &Path,
+    made: &mut Made,
     rows: &[Row],
     plan: &Plan,
     rests: &BTreeMap<String, RestState>,
@@ -593,22 +626,22 @@ fn convergence(
         };
         out.push(keep(&file, &fingerprint, conv)?);
     }
-    let mut csv = String::from("case,zeta,sigma,sigma_err,zeta_shift\n");
+    let mut csv = Csv::new(&["case", "zeta", "sigma", "sigma_err", "zeta_shift"]);
     let reference = out[0].sigma;
     for c in &out {
-        csv += &format!(
-            "\"{}\",{zeta:e},{:e},{:e},{:e}\n",
-            c.what,
-            c.sigma,
-            c.err,
-            (c.sigma - reference) / t.slope
-        );
+        csv.row([
+            format!("\"{}\"", c.what),
+            sci(zeta),
+            sci(c.sigma),
+            sci(c.err),
+            sci((c.sigma - reference) / t.slope),
+        ]);
     }
-    write_text(&dir.join("convergence.csv"), &csv)?;
+    made.add_table("convergence.csv", csv);
     Ok(out)
 }
 
-fn draw(dir: &Path, rows: &[Row]) -> Result<(), SweepError> {
+fn draw(made: &mut Made, rows: &[Row]) {
     // ζ_cr against γ, from zero, one series per (box, form, method).
     let mut pg = Plot::new(
         "ζ_cr of the hexagonal rest state against γ",
@@ -687,7 +720,7 @@ fn draw(dir: &Path, rows: &[Row]) -> Result<(), SweepError> {
                 .push(Series::new(label.clone()).with_points(&x, &y, &e));
         }
         if !plot.series.is_empty() {
-            drawn(plot.save_png(&dir.join(path)))?;
+            made.add_plot(path, plot.clone());
         }
     }
     // σ(ζ) of γ = 0.01 on the smallest box, both methods.
@@ -726,14 +759,13 @@ fn draw(dir: &Path, rows: &[Row]) -> Result<(), SweepError> {
         }
     }
     if !ps.series.is_empty() {
-        drawn(ps.save_png(&dir.join("growth_rates.png")))?;
+        made.add_plot("growth_rates.png", ps);
     }
-    Ok(())
 }
 
 /// The leading mode: each cell filled by the change of its area, its shape change drawn as an
 /// axis, and the displacement field `Σ_i φ_i δc_i` as arrows.
-fn draw_mode(dir: &Path, base: &Tissue<f64>, mode: &[f64], zeta: f64) -> Result<(), SweepError> {
+fn draw_mode(base: &Tissue<f64>, mode: &[f64], zeta: f64) -> Result<render::Picture, SweepError> {
     let cells = base.cells();
     let shape = cells.shape();
     let lattice = cells.lattice();
@@ -815,10 +847,8 @@ fn draw_mode(dir: &Path, base: &Tissue<f64>, mode: &[f64], zeta: f64) -> Result<
         every: 6,
     });
     pic.title = format!("Leading mode at ζ = {}: δA, δS axes, displacement", g(zeta));
-    let img = pic
-        .draw()
-        .map_err(|e| SweepError::Reproduce { why: e.to_string() })?;
-    drawn(img.save_png(&dir.join("mode.png")))
+    pic.draw()
+        .map_err(|e| SweepError::Reproduce { why: e.to_string() })
 }
 
 /// An isolated cell (one disc of radius R on 41 × 41 nodes, margin 16) run for 200 TU at
