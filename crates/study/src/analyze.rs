@@ -119,48 +119,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
     let shape = scene.patch_shape();
     let FrameList { frames, notes } = list_frames(run_dir, &scene)?;
     let from = opts.from.unwrap_or(scene.file().run.relax_time);
-    let radius = scene.file().cells.radius;
-    let box_side = opts.box_side.unwrap_or_else(|| default_box(&scene));
-    box_smooth(lattice, &vec![0.0; lattice.len()], box_side)
-        .map_err(|e| AnalyzeError::Options(format!("--box {box_side}: {e}")))?;
-    let crop_side = opts.crop_side.unwrap_or_else(|| default_crop(lattice));
-    if crop_side % 2 != 1 {
-        return Err(AnalyzeError::Options(
-            "--crop must be odd (the defect sits on the centre node), e.g. 101".into(),
-        ));
-    }
-    // A crop wraps the periodic lattice; beyond twice its side it only repeats it (and a
-    // huge one exhausts memory: --crop 100001 asked for 10¹⁰ nodes per component).
-    let most = 2 * lattice.lx.min(lattice.ly) + 1;
-    if crop_side > most {
-        return Err(AnalyzeError::Options(format!(
-            "--crop {}: more than twice the lattice ({}×{}) only repeats it; use an odd side up to {most} (default 101)",
-            crop_side, lattice.lx, lattice.ly
-        )));
-    }
-    for (flag, v) in [
-        ("--max-link", opts.max_link),
-        ("--max-pair", opts.max_pair),
-        ("--s-rms-baseline", opts.s_rms_baseline),
-    ] {
-        if let Some(v) = v {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(AnalyzeError::Options(format!(
-                    "{flag} {v}: give a positive number (the defaults are R for --max-link and 2R for --max-pair)"
-                )));
-            }
-        }
-    }
-    if opts.from.is_some_and(|f| !f.is_finite()) {
-        return Err(AnalyzeError::Options(
-            "--from must be a finite time (default: the end of relaxation)".into(),
-        ));
-    }
-    let defaults = TrackParams::for_radius(radius);
-    let params = TrackParams::new(
-        opts.max_link.unwrap_or(defaults.max_link),
-        opts.max_pair.unwrap_or(defaults.max_pair),
-    );
+    let settings = Settings::checked(opts, &scene)?;
 
     let selected: Vec<PathBuf> = frames
         .into_iter()
@@ -178,32 +137,6 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         path: out.clone(),
         source,
     })?;
-    // The rows first: the columns the terms add (`CellTerm::observables`, beyond the
-    // documented `polar_order`) are known once a frame is read.
-    let mut obs = String::new();
-    let mut term_columns: Option<Vec<&'static str>> = None;
-    let mut defects_csv = String::new();
-    // Axes and angle conventions are in the README: a comment line here would be taken for
-    // the header by pandas and numpy.
-    row!(defects_csv, "frame,time,x,y,charge,angle,track");
-    let mut events_csv = String::new();
-    row!(events_csv, "frame,time,kind,x,y");
-
-    let mut ws: Option<Workspace> = None;
-    let mut corr = [
-        Correlator::new(lattice),
-        Correlator::new(lattice),
-        Correlator::new(lattice),
-    ];
-    let mut tracker = Tracker::new(lattice, params);
-    let mut avg = DefectAverage::new(crop_side);
-    let mut info = AnalyzeInfo {
-        frames: 0,
-        defects: 0,
-        events: 0,
-        cell_events: 0,
-        notes,
-    };
     // With `[division]`: each frame's ±½ defects and the random baseline, for the distances
     // of the divisions and extrusions to the defects (`cell_events.csv`).
     let lineage = rundir::read_lineage(run_dir)
@@ -214,34 +147,197 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             "is missing, but the run's scene has [division]: cell_events.csv (the divisions and extrusions against the defects) and the check of each frame's cells need it; restore the run's lineage.csv (a run rewrites it with every frame)".to_string(),
         ));
     }
-    let mut near: Vec<FrameDefects> = Vec::new();
-    let mut prev_time: Option<f64> = None;
-    let area = lattice.len() as f64;
-    // A wound's band: the solid of the walls during the relaxation, when they open after it.
-    let wound: Option<Vec<bool>> = scene
-        .walls()
-        .filter(|w| w.open_when_active())
-        .and_then(|w| {
-            w.field(false)
-                .map(|f| (0..lattice.len()).map(|k| f.is_solid(k)).collect())
-        });
-    let mut positions: Vec<analysis::motion::Positions> = Vec::new();
-    let disc_centre = scene
-        .file()
-        .walls
-        .as_ref()
-        .filter(|w| w.kind == scene::WallKind::Disc)
-        .map(|_| {
-            [
-                (lattice.lx as f64 - 1.0) / 2.0,
-                (lattice.ly as f64 - 1.0) / 2.0,
-            ]
-        });
+    let mut acc = Accumulator::new(&scene, &settings, lineage.is_some(), notes);
     for path in &selected {
         let frame = load_frame(path, &scene, &shape, lattice)?;
         if let Some(lineage) = &lineage {
             check_lineage(path, &frame.ids, frame.tissue.time(), lineage)?;
         }
+        acc.add(frame, &shape, opts.s_rms_baseline)?;
+    }
+    acc.write(&out, lineage.as_deref())
+}
+
+/// The analysis's settings from its options and the scene, each checked: the smoothing box,
+/// the crop of the defect averages and the tracking distances.
+struct Settings {
+    box_side: usize,
+    crop_side: usize,
+    track: TrackParams,
+}
+
+impl Settings {
+    /// The settings of `opts` for `scene`, or the option that is wrong and what to give.
+    fn checked(opts: &AnalyzeOptions, scene: &scene::Scene) -> Result<Self> {
+        let lattice = scene.lattice();
+        let radius = scene.file().cells.radius;
+        let box_side = opts.box_side.unwrap_or_else(|| default_box(&scene));
+        box_smooth(lattice, &vec![0.0; lattice.len()], box_side)
+            .map_err(|e| AnalyzeError::Options(format!("--box {box_side}: {e}")))?;
+        let crop_side = opts.crop_side.unwrap_or_else(|| default_crop(lattice));
+        if crop_side % 2 != 1 {
+            return Err(AnalyzeError::Options(
+                "--crop must be odd (the defect sits on the centre node), e.g. 101".into(),
+            ));
+        }
+        // A crop wraps the periodic lattice; beyond twice its side it only repeats it (and a
+        // huge one exhausts memory: --crop 100001 asked for 10¹⁰ nodes per component).
+        let most = 2 * lattice.lx.min(lattice.ly) + 1;
+        if crop_side > most {
+            return Err(AnalyzeError::Options(format!(
+                "--crop {}: more than twice the lattice ({}×{}) only repeats it; use an odd side up to {most} (default 101)",
+                crop_side, lattice.lx, lattice.ly
+            )));
+        }
+        for (flag, v) in [
+            ("--max-link", opts.max_link),
+            ("--max-pair", opts.max_pair),
+            ("--s-rms-baseline", opts.s_rms_baseline),
+        ] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(AnalyzeError::Options(format!(
+                        "{flag} {v}: give a positive number (the defaults are R for --max-link and 2R for --max-pair)"
+                    )));
+                }
+            }
+        }
+        if opts.from.is_some_and(|f| !f.is_finite()) {
+            return Err(AnalyzeError::Options(
+                "--from must be a finite time (default: the end of relaxation)".into(),
+            ));
+        }
+        let defaults = TrackParams::for_radius(radius);
+        let params = TrackParams::new(
+            opts.max_link.unwrap_or(defaults.max_link),
+            opts.max_pair.unwrap_or(defaults.max_pair),
+        );
+        Ok(Self {
+            box_side,
+            crop_side,
+            track: params,
+        })
+    }
+}
+
+/// What the analysis gathers frame by frame, then writes ([`Accumulator::write`]): the rows
+/// of its tables, the correlations, the defect tracks and averages, the cells' positions.
+struct Accumulator {
+    lattice: Lattice,
+    box_side: usize,
+    radius: f64,
+    area: f64,
+    /// A wound's band: the solid of the walls during the relaxation, when they open after it.
+    wound: Option<Vec<bool>>,
+    /// The centre of a disc's walls, for the rotation.
+    disc_centre: Option<[f64; 2]>,
+    /// Whether the run has a lineage (`cell_events.csv`).
+    lineage: bool,
+    obs: String,
+    /// The columns the terms add (`CellTerm::observables`, beyond the documented
+    /// `polar_order`), known once a frame is read.
+    term_columns: Option<Vec<&'static str>>,
+    defects_csv: String,
+    events_csv: String,
+    ws: Option<Workspace>,
+    corr: [Correlator; 3],
+    tracker: Tracker,
+    avg: DefectAverage,
+    info: AnalyzeInfo,
+    near: Vec<FrameDefects>,
+    prev_time: Option<f64>,
+    positions: Vec<analysis::motion::Positions>,
+}
+
+impl Accumulator {
+    fn new(scene: &scene::Scene, settings: &Settings, lineage: bool, notes: FrameNotes) -> Self {
+        let lattice = scene.lattice();
+        let mut defects_csv = String::new();
+        // Axes and angle conventions are in the README: a comment line here would be taken
+        // for the header by pandas and numpy.
+        row!(defects_csv, "frame,time,x,y,charge,angle,track");
+        let mut events_csv = String::new();
+        row!(events_csv, "frame,time,kind,x,y");
+        Self {
+            lattice,
+            box_side: settings.box_side,
+            radius: scene.file().cells.radius,
+            area: lattice.len() as f64,
+            wound: scene
+                .walls()
+                .filter(|w| w.open_when_active())
+                .and_then(|w| {
+                    w.field(false)
+                        .map(|f| (0..lattice.len()).map(|k| f.is_solid(k)).collect())
+                }),
+            disc_centre: scene
+                .file()
+                .walls
+                .as_ref()
+                .filter(|w| w.kind == scene::WallKind::Disc)
+                .map(|_| {
+                    [
+                        (lattice.lx as f64 - 1.0) / 2.0,
+                        (lattice.ly as f64 - 1.0) / 2.0,
+                    ]
+                }),
+            lineage,
+            obs: String::new(),
+            term_columns: None,
+            defects_csv,
+            events_csv,
+            ws: None,
+            corr: [
+                Correlator::new(lattice),
+                Correlator::new(lattice),
+                Correlator::new(lattice),
+            ],
+            tracker: Tracker::new(lattice, settings.track),
+            avg: DefectAverage::new(settings.crop_side),
+            info: AnalyzeInfo {
+                frames: 0,
+                defects: 0,
+                events: 0,
+                cell_events: 0,
+                notes,
+            },
+            near: Vec::new(),
+            prev_time: None,
+            positions: Vec::new(),
+        }
+    }
+
+    /// Adds a frame: its row of observables, its defects and their events, its fields to the
+    /// correlations and the defect averages, its cells' positions.
+    fn add(
+        &mut self,
+        frame: LoadedFrame,
+        shape: &PatchShape,
+        s_rms_baseline: Option<f64>,
+    ) -> Result<()> {
+        let Self {
+            lattice,
+            box_side,
+            radius,
+            area,
+            wound,
+            disc_centre,
+            lineage,
+            obs,
+            term_columns,
+            defects_csv,
+            events_csv,
+            ws,
+            corr,
+            tracker,
+            avg,
+            info,
+            near,
+            prev_time,
+            positions,
+        } = self;
+        let (lattice, box_side, radius, area, lineage) =
+            (*lattice, *box_side, *radius, *area, *lineage);
         let (demix, polar, term_obs) = mixing_and_order(&frame, &shape);
         let columns = term_columns.get_or_insert_with(|| term_obs.iter().map(|o| o.0).collect());
         // Each cell's shape index P/√A, averaged; and the centres for the MSD.
@@ -273,9 +369,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         let gap = wound.as_ref().map_or(f64::NAN, |band| {
             analysis::confinement::uncovered_fraction(&phi_sum, band)
         });
-        let covered: Option<Vec<bool>> = lineage
-            .as_ref()
-            .map(|_| phi_sum.iter().map(|&v| v >= 0.5).collect());
+        let covered: Option<Vec<bool>> =
+            lineage.then(|| phi_sum.iter().map(|&v| v >= 0.5).collect());
         let LoadedFrame {
             tissue,
             shapes,
@@ -299,30 +394,8 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             .map_err(|e| AnalyzeError::Options(e.to_string()))?;
         let tracks = tracker.push(&found);
         let time = tissue.time();
-        for (d, t) in found.iter().zip(&tracks.track) {
-            row!(
-                defects_csv,
-                "{step},{time:.6},{},{},{},{},{t}",
-                d.x,
-                d.y,
-                d.charge,
-                d.angle
-            );
-        }
-        let (mut creations, mut annihilations) = (0, 0);
-        for e in &tracks.events {
-            match e.kind {
-                analysis::tracking::EventKind::Creation => creations += 1,
-                analysis::tracking::EventKind::Annihilation => annihilations += 1,
-            }
-            row!(
-                events_csv,
-                "{step},{time:.6},{},{},{}",
-                e.kind.name(),
-                e.x,
-                e.y
-            );
-        }
+        let (creations, annihilations) =
+            write_defect_rows(defects_csv, events_csv, step, time, &found, &tracks);
         if let Some(mask) = &covered {
             let at = |q: f64| -> Vec<[f64; 2]> {
                 found
@@ -347,7 +420,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
         let n_plus = found.iter().filter(|d| d.charge == 0.5).count();
         let n_minus = found.iter().filter(|d| d.charge == -0.5).count();
         let s = s_rms(&shapes);
-        let rate = match prev_time {
+        let rate = match *prev_time {
             Some(p) if time > p => creations as f64 / ((time - p) * area),
             _ => f64::NAN,
         };
@@ -355,7 +428,7 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
-            opts.s_rms_baseline.map_or(f64::NAN, |b| s / b),
+            s_rms_baseline.map_or(f64::NAN, |b| s / b),
             found.len() - n_plus - n_minus,
             net_charge(&found),
             found.len() as f64 / area,
@@ -378,59 +451,118 @@ pub fn analyze(run_dir: &Path, opts: &AnalyzeOptions) -> Result<AnalyzeInfo> {
             line += &format!(",{v:e}");
         }
         row!(obs, "{line}");
-        prev_time = Some(time);
+        *prev_time = Some(time);
         info.frames += 1;
         info.defects += found.len();
         info.events += tracks.events.len();
-    }
-    let mut header = rundir::OBSERVABLES_HEADER.to_string();
-    for name in term_columns.iter().flatten() {
-        header += &format!(",{name}");
-    }
-    write_file(
-        &out.join("observables.csv"),
-        format!("{header}\n{obs}").as_bytes(),
-    )?;
-    let mut msd_csv = String::new();
-    row!(msd_csv, "{}", rundir::MSD_HEADER);
-    for p in analysis::motion::msd(&positions, [lattice.lx as f64, lattice.ly as f64]) {
-        row!(
-            msd_csv,
-            "{:.6},{:e},{:e},{}",
-            p.lag,
-            p.msd,
-            p.msd_raw,
-            p.samples
-        );
-    }
-    write_file(&out.join("msd.csv"), msd_csv.as_bytes())?;
-    write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
-    write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
-    if let Some(lineage) = &lineage {
-        info.cell_events = write_cell_events(&out, lattice, lineage, &near)?;
+        Ok(())
     }
 
-    let radial: Vec<Vec<f64>> = corr.iter().map(|c| c.radial()).collect();
-    let mut c = String::new();
-    row!(c, "r,c_velocity,c_vorticity,c_q");
-    for r in 0..radial[0].len() {
+    /// Writes the tables and averages into `out`.
+    fn write(
+        self,
+        out: &Path,
+        lineage: Option<&[mechanics::division::LineageRecord]>,
+    ) -> Result<AnalyzeInfo> {
+        let Self {
+            lattice,
+            term_columns,
+            obs,
+            defects_csv,
+            events_csv,
+            corr,
+            avg,
+            mut info,
+            near,
+            positions,
+            ..
+        } = self;
+        let mut header = rundir::OBSERVABLES_HEADER.to_string();
+        for name in term_columns.iter().flatten() {
+            header += &format!(",{name}");
+        }
+        write_file(
+            &out.join("observables.csv"),
+            format!("{header}\n{obs}").as_bytes(),
+        )?;
+        let mut msd_csv = String::new();
+        row!(msd_csv, "{}", rundir::MSD_HEADER);
+        for p in analysis::motion::msd(&positions, [lattice.lx as f64, lattice.ly as f64]) {
+            row!(
+                msd_csv,
+                "{:.6},{:e},{:e},{}",
+                p.lag,
+                p.msd,
+                p.msd_raw,
+                p.samples
+            );
+        }
+        write_file(&out.join("msd.csv"), msd_csv.as_bytes())?;
+        write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
+        write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
+        if let Some(lineage) = &lineage {
+            info.cell_events = write_cell_events(&out, lattice, lineage, &near)?;
+        }
+
+        let radial: Vec<Vec<f64>> = corr.iter().map(|c| c.radial()).collect();
+        let mut c = String::new();
+        row!(c, "r,c_velocity,c_vorticity,c_q");
+        for r in 0..radial[0].len() {
+            row!(
+                c,
+                "{r},{:e},{:e},{:e}",
+                radial[0][r],
+                radial[1][r],
+                radial[2][r]
+            );
+        }
+        write_file(&out.join("correlations.csv"), c.as_bytes())?;
+        let mut l = String::new();
+        row!(l, "field,length");
+        for (name, r) in ["velocity", "vorticity", "q"].iter().zip(&radial) {
+            row!(l, "{name},{}", first_minimum(r).unwrap_or(f64::NAN));
+        }
+        write_file(&out.join("lengths.csv"), l.as_bytes())?;
+        write_averages(&out.join("defect_averages.npz"), &avg)?;
+        Ok(info)
+    }
+}
+
+/// The rows of `defects.csv` and `defect_events.csv` of one frame; the numbers of pair
+/// creations and annihilations among its events.
+fn write_defect_rows(
+    defects_csv: &mut String,
+    events_csv: &mut String,
+    step: u64,
+    time: f64,
+    found: &[analysis::defects::Defect],
+    tracks: &analysis::tracking::FrameTracks,
+) -> (usize, usize) {
+    for (d, t) in found.iter().zip(&tracks.track) {
         row!(
-            c,
-            "{r},{:e},{:e},{:e}",
-            radial[0][r],
-            radial[1][r],
-            radial[2][r]
+            defects_csv,
+            "{step},{time:.6},{},{},{},{},{t}",
+            d.x,
+            d.y,
+            d.charge,
+            d.angle
         );
     }
-    write_file(&out.join("correlations.csv"), c.as_bytes())?;
-    let mut l = String::new();
-    row!(l, "field,length");
-    for (name, r) in ["velocity", "vorticity", "q"].iter().zip(&radial) {
-        row!(l, "{name},{}", first_minimum(r).unwrap_or(f64::NAN));
+    let (mut creations, mut annihilations) = (0, 0);
+    for e in &tracks.events {
+        match e.kind {
+            analysis::tracking::EventKind::Creation => creations += 1,
+            analysis::tracking::EventKind::Annihilation => annihilations += 1,
+        }
+        row!(
+            events_csv,
+            "{step},{time:.6},{},{},{}",
+            e.kind.name(),
+            e.x,
+            e.y
+        );
     }
-    write_file(&out.join("lengths.csv"), l.as_bytes())?;
-    write_averages(&out.join("defect_averages.npz"), &avg)?;
-    Ok(info)
+    (creations, annihilations)
 }
 
 /// One analysed frame's ±½ defects, and the mean distance of a random point of its tissue
