@@ -21,7 +21,56 @@ pub(crate) fn walls_of(
     lattice: Lattice,
     reach: f64,
 ) -> Result<Walls, SceneError> {
-    let (lx, ly) = (lattice.lx as f64, lattice.ly as f64);
+    check_keys(spec)?;
+    let shape = shape_of(spec, lattice)?;
+    let solid = shape.solid(lattice);
+    let n_solid = solid.iter().filter(|&&s| s).count();
+    if n_solid == 0 || n_solid == solid.len() {
+        return Err(invalid(
+            "walls",
+            if spec.kind == WallKind::Mask {
+                "mask"
+            } else {
+                "kind"
+            },
+            format!("\"{}\"", kind_name(spec.kind)),
+            if n_solid == 0 {
+                "no node is solid"
+            } else {
+                "every node is solid"
+            },
+            if spec.kind == WallKind::Mask {
+                "check the mask (bright or non-zero is solid; invert = true swaps them)"
+            } else {
+                "enlarge [domain] or change the wall's size"
+            },
+        ));
+    }
+    let walls = Walls::new(
+        WallField::new(lattice, &solid, spec.thickness, reach),
+        spec.kappa,
+        spec.omega,
+    );
+    Ok(match spec.kind {
+        WallKind::Wound => walls.replaced_when_active(None),
+        _ => walls,
+    })
+}
+
+/// The name of a kind of walls, as the scene writes it.
+fn kind_name(k: WallKind) -> &'static str {
+    match k {
+        WallKind::Channel => "channel",
+        WallKind::Box => "box",
+        WallKind::Disc => "disc",
+        WallKind::Wound => "wound",
+        WallKind::Mask => "mask",
+    }
+}
+
+/// The keys of `[walls]` that do not depend on the lattice: the thickness and coefficients,
+/// and each key given only for the kinds it applies to.
+fn check_keys(spec: &WallsSpec) -> Result<(), SceneError> {
     if !(spec.thickness.is_finite() && spec.thickness > 0.0 && spec.thickness <= 10.0) {
         return Err(invalid(
             "walls",
@@ -46,13 +95,6 @@ pub(crate) fn walls_of(
             ));
         }
     }
-    let kind_name = |k: WallKind| match k {
-        WallKind::Channel => "channel",
-        WallKind::Box => "box",
-        WallKind::Disc => "disc",
-        WallKind::Wound => "wound",
-        WallKind::Mask => "mask",
-    };
     let only = |key: &'static str, set: bool, kinds: &[WallKind]| {
         if set && !kinds.contains(&spec.kind) {
             let names: Vec<_> = kinds
@@ -92,6 +134,12 @@ pub(crate) fn walls_of(
             "give radius for a disc or semi_axes for an ellipse",
         ));
     }
+    Ok(())
+}
+
+/// The shape of the walls of `spec` on `lattice`, its sizes checked against the domain.
+fn shape_of(spec: &WallsSpec, lattice: Lattice) -> Result<WallShape, SceneError> {
+    let (lx, ly) = (lattice.lx as f64, lattice.ly as f64);
     let width = |default: f64, most: f64, along: &str| -> Result<f64, SceneError> {
         let w = spec.width.unwrap_or(default);
         if !(w.is_finite() && w >= 1.0 && w <= most) {
@@ -105,7 +153,7 @@ pub(crate) fn walls_of(
         }
         Ok(w)
     };
-    let shape = match spec.kind {
+    Ok(match spec.kind {
         WallKind::Channel => WallShape::Channel {
             width: width(ly - 2.0, ly - 2.0, "ly")?,
         },
@@ -159,38 +207,6 @@ pub(crate) fn walls_of(
             }
             WallShape::Mask(solid)
         }
-    };
-    let solid = shape.solid(lattice);
-    let n_solid = solid.iter().filter(|&&s| s).count();
-    if n_solid == 0 || n_solid == solid.len() {
-        return Err(invalid(
-            "walls",
-            if spec.kind == WallKind::Mask {
-                "mask"
-            } else {
-                "kind"
-            },
-            format!("\"{}\"", kind_name(spec.kind)),
-            if n_solid == 0 {
-                "no node is solid"
-            } else {
-                "every node is solid"
-            },
-            if spec.kind == WallKind::Mask {
-                "check the mask (bright or non-zero is solid; invert = true swaps them)"
-            } else {
-                "enlarge [domain] or change the wall's size"
-            },
-        ));
-    }
-    let walls = Walls::new(
-        WallField::new(lattice, &solid, spec.thickness, reach),
-        spec.kappa,
-        spec.omega,
-    );
-    Ok(match spec.kind {
-        WallKind::Wound => walls.replaced_when_active(None),
-        _ => walls,
     })
 }
 

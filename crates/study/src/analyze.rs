@@ -171,7 +171,7 @@ impl Settings {
     fn checked(opts: &AnalyzeOptions, scene: &scene::Scene) -> Result<Self> {
         let lattice = scene.lattice();
         let radius = scene.file().cells.radius;
-        let box_side = opts.box_side.unwrap_or_else(|| default_box(&scene));
+        let box_side = opts.box_side.unwrap_or_else(|| default_box(scene));
         box_smooth(lattice, &vec![0.0; lattice.len()], box_side)
             .map_err(|e| AnalyzeError::Options(format!("--box {box_side}: {e}")))?;
         let crop_side = opts.crop_side.unwrap_or_else(|| default_crop(lattice));
@@ -338,7 +338,7 @@ impl Accumulator {
         } = self;
         let (lattice, box_side, radius, area, lineage) =
             (*lattice, *box_side, *radius, *area, *lineage);
-        let (demix, polar, term_obs) = mixing_and_order(&frame, &shape);
+        let (demix, polar, term_obs) = mixing_and_order(&frame, shape);
         let columns = term_columns.get_or_insert_with(|| term_obs.iter().map(|o| o.0).collect());
         // Each cell's shape index P/√A, averaged; and the centres for the MSD.
         let cells_n = frame.centres.len();
@@ -501,7 +501,7 @@ impl Accumulator {
         write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
         write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
         if let Some(lineage) = &lineage {
-            info.cell_events = write_cell_events(&out, lattice, lineage, &near)?;
+            info.cell_events = write_cell_events(out, lattice, lineage, &near)?;
         }
 
         let radial: Vec<Vec<f64>> = corr.iter().map(|c| c.radial()).collect();
