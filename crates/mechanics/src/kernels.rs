@@ -275,12 +275,7 @@ pub(crate) fn evaluate<T: Real>(
 
     // The node terms' coefficient classes (`crate::node_terms`): one, or one per population
     // when a term's coefficients depend on it; each class's summed `[k_p, c_p]`.
-    let per_population = terms.iter().flatten().any(|t| t.per_population());
-    let classes = if per_population {
-        pops.kinds().len().max(1)
-    } else {
-        1
-    };
+    let per_population = class_constants(terms, pops, node_constants);
     let class = |i: usize| {
         if per_population {
             pops.population(ids[i])
@@ -288,114 +283,37 @@ pub(crate) fn evaluate<T: Real>(
             0
         }
     };
-    node_constants.clear();
-    node_constants.extend((0..classes).map(|p| {
-        let asked = |t: &&dyn NodeTerm| if t.per_population() { p } else { 0 };
-        let sum = |f: fn(&dyn NodeTerm, usize) -> f64| {
-            terms.iter().flatten().map(|t| f(*t, asked(t))).sum::<f64>()
-        };
-        [
-            sum(|t, p| t.cell_pressure_coefficient(p)),
-            sum(|t, p| t.laplacian_coefficient(p)),
-        ]
-    }));
     let node_constants: &[[f64; 2]] = node_constants;
 
     // 2. Lattice sums.
     let coef = energy.coefficients();
     let kind = params.pressure;
-    // Whether a node term has a single-cell pressure `k_p φ ∇²φ` (adhesion's).
-    let cell_part = node_constants.iter().any(|k| k[0] != 0.0);
-    {
-        let cs: &[CellState] = cell_state;
-        // What the scatter needs of cell `i`, once per cell and stripe: its energy
-        // coefficients, its area factor, its deformation tensor weighted by its ζ and the
-        // node terms' `k_p` of its class.
-        let per_cell = |i: usize| {
-            let k = constants(i);
-            let [sxx, sxy] = cs[i].shape.components();
-            let sh = [k.zeta_weight * sxx, k.zeta_weight * sxy];
-            let k_node = node_constants[class(i)][0];
-            (k.coef, k.coef.area_factor(cs[i].area), sh, k_node)
-        };
-        let node = move |p: f64, u: f64, sh: [f64; 2]| {
-            let [q_xx, q_xy] = nematic_density(p, sh);
-            [p, p * p, u, q_xx, q_xy]
-        };
-        // The pressure, once per lattice node, where the force pass would compute it again for
-        // every cell over the node: the same formula on the same sums, so the same values to
-        // the bit.
-        let finish = |[s1, s2, u, _, _, p]: [&mut [f64]; N_SUMS]| {
-            for (((p, &s1), &s2), &u) in p.iter_mut().zip(&*s1).zip(&*s2).zip(&*u) {
-                *p = pressure(kind, &coef, s1, s2, u);
-            }
-        };
-        // One scatter (`scatter_sums`) with the single-cell part of the pressure that each
-        // node adds to `U` for each pressure form, and with the node terms' `k_p φ ∇²φ` added:
-        // the choice is made once per evaluation, and each node loop is compiled alone with
-        // its form (without adhesion the loops are what they were).
-        match (kind, cell_part) {
-            (PressureKind::Paper, false) => scatter_sums(
-                cells,
-                phi,
-                global,
-                &per_cell,
-                node,
-                &finish,
-                move |coef, s, a, _| {
-                    pressure_cell_part(PressureKind::Paper, coef, s.c, s.laplacian(), a)
-                },
-            ),
-            (PressureKind::Interaction, false) => scatter_sums(
-                cells,
-                phi,
-                global,
-                &per_cell,
-                node,
-                &finish,
-                move |coef, s, _, _| {
-                    pressure_cell_part(PressureKind::Interaction, coef, s.c, 0.0, 0.0)
-                },
-            ),
-            (kind, true) => scatter_sums(
-                cells,
-                phi,
-                global,
-                &per_cell,
-                node,
-                &finish,
-                move |coef, s, a, k_node| {
-                    let (p, lap) = (s.c, s.laplacian());
-                    pressure_cell_part(kind, coef, p, lap, a)
-                        + adhesion_pressure_cell_part(k_node, p, lap)
-                },
-            ),
-        }
-    }
+    lattice_sums(
+        cells,
+        phi,
+        global,
+        cell_state,
+        (kind, &coef),
+        &constants,
+        &class,
+        node_constants,
+    );
 
     // Each population's `s1_p`, for the node terms that read them; then the terms' lattice
     // parts of the pressure, then their coefficients, gathered by the force pass.
-    if terms.iter().flatten().any(|t| t.needs_population_sums()) {
-        let n = pops.kinds().len().max(1);
-        population_sums.fill(cells, phi, n, |i| pops.population(ids[i]));
-    }
-    let nodes = cells.lattice().len();
-    {
-        let mut rest: &mut [f64] = node_scratch;
-        for t in terms.iter().flatten() {
-            let (mine, after) = std::mem::take(&mut rest).split_at_mut(t.scratch_fields() * nodes);
-            t.add_pressure(global, population_sums, mine);
-            rest = after;
-        }
-    }
-    let node_terms = terms.iter().any(Option::is_some).then(|| {
-        fill_node_terms(terms, node_scratch, nodes, node_buf);
-        ClassCoefficients {
-            fields: node_buf,
+    let node_terms = node_term_pass(
+        cells,
+        phi,
+        (pops, ids),
+        terms,
+        global,
+        NodeBuffers {
+            scratch: node_scratch,
+            coefficients: node_buf,
             constants: node_constants,
-            nodes,
-        }
-    });
+            population_sums,
+        },
+    );
 
     // 3. Forces, velocities and the right-hand side.
     let g: &LatticeSums<N_SUMS> = global;
@@ -439,6 +357,51 @@ pub(crate) fn evaluate<T: Real>(
             }
         }
     };
+    for_each_cell(rhs_out, phi, cell_state, cells.n_cells(), plen, post, body);
+}
+
+/// The node terms' coefficient classes (`crate::node_terms`): one, or one per population of
+/// `pops` when a term's coefficients depend on it (the value returned); each class's summed
+/// `[k_p, c_p]` into `node_constants`.
+fn class_constants(
+    terms: &[Option<&dyn NodeTerm>],
+    pops: &Populations,
+    node_constants: &mut Vec<[f64; 2]>,
+) -> bool {
+    let per_population = terms.iter().flatten().any(|t| t.per_population());
+    let classes = if per_population {
+        pops.kinds().len().max(1)
+    } else {
+        1
+    };
+    node_constants.clear();
+    node_constants.extend((0..classes).map(|p| {
+        let asked = |t: &&dyn NodeTerm| if t.per_population() { p } else { 0 };
+        let sum = |f: fn(&dyn NodeTerm, usize) -> f64| {
+            terms.iter().flatten().map(|t| f(*t, asked(t))).sum::<f64>()
+        };
+        [
+            sum(|t, p| t.cell_pressure_coefficient(p)),
+            sum(|t, p| t.laplacian_coefficient(p)),
+        ]
+    }));
+    per_population
+}
+
+/// Pass 3's loop over the cells, in parallel: `body(i, out, cell, state, post)` for each cell
+/// `i` with its slices of the right-hand side, the fields, its state and of what `post`
+/// updates (the predictor's or the corrector's fields, its centre and range). Inlined into
+/// [`evaluate`], whose code it was.
+#[inline(always)]
+fn for_each_cell<T: Real>(
+    rhs_out: &mut [T],
+    phi: &[T],
+    cell_state: &mut [CellState],
+    n_cells: usize,
+    plen: usize,
+    post: Post<'_, T>,
+    body: impl Fn(usize, &mut [T], &[T], &mut CellState, CellPost<'_, T>) + Sync,
+) {
     let cells_iter = rhs_out
         .par_chunks_mut(plen)
         .zip(phi.par_chunks(plen))
@@ -474,8 +437,8 @@ pub(crate) fn evaluate<T: Real>(
                 "the corrector's field holds every cell"
             );
             assert_eq!(k1.len(), phi.len(), "k1 holds every cell");
-            assert_eq!(centres.len(), cells.n_cells(), "a centre for every cell");
-            assert_eq!(ranges.len(), cells.n_cells(), "a range for every cell");
+            assert_eq!(centres.len(), n_cells, "a centre for every cell");
+            assert_eq!(ranges.len(), n_cells, "a range for every cell");
             cells_iter
                 .zip(old.par_chunks(plen))
                 .zip(k1.par_chunks_mut(plen).zip(centres.par_iter_mut()))
@@ -494,6 +457,141 @@ pub(crate) fn evaluate<T: Real>(
                 });
         }
     }
+}
+
+/// Pass 2's scatter: every cell's `s1, s2, U, Q_xx, Q_xy` onto the lattice, then the pressure
+/// `P` of each node, with the pressure form `kind` (and the energy coefficients `coef`), each
+/// cell's constants and coefficient class, and the node terms' `[k_p, c_p]` of each class.
+/// One scatter (`scatter_sums`) with the single-cell part of the pressure that each node adds
+/// to `U` for each pressure form, and with the node terms' `k_p φ ∇²φ` added: the choice is
+/// made once per evaluation, and each node loop is compiled alone with its form (without
+/// adhesion the loops are what they were). Inlined into [`evaluate`], whose code it was.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn lattice_sums<T: Real>(
+    cells: &Cells<T>,
+    phi: &[T],
+    global: &mut LatticeSums<N_SUMS>,
+    cs: &[CellState],
+    (kind, coef): (PressureKind, &EnergyCoefficients),
+    constants: &(impl Fn(usize) -> CellConstants + Sync),
+    class: &(impl Fn(usize) -> usize + Sync),
+    node_constants: &[[f64; 2]],
+) {
+    let coef = *coef;
+    // Whether a node term has a single-cell pressure `k_p φ ∇²φ` (adhesion's).
+    let cell_part = node_constants.iter().any(|k| k[0] != 0.0);
+    // What the scatter needs of cell `i`, once per cell and stripe: its energy
+    // coefficients, its area factor, its deformation tensor weighted by its ζ and the
+    // node terms' `k_p` of its class.
+    let per_cell = |i: usize| {
+        let k = constants(i);
+        let [sxx, sxy] = cs[i].shape.components();
+        let sh = [k.zeta_weight * sxx, k.zeta_weight * sxy];
+        let k_node = node_constants[class(i)][0];
+        (k.coef, k.coef.area_factor(cs[i].area), sh, k_node)
+    };
+    let node = move |p: f64, u: f64, sh: [f64; 2]| {
+        let [q_xx, q_xy] = nematic_density(p, sh);
+        [p, p * p, u, q_xx, q_xy]
+    };
+    // The pressure, once per lattice node, where the force pass would compute it again for
+    // every cell over the node: the same formula on the same sums, so the same values to
+    // the bit.
+    let finish = |[s1, s2, u, _, _, p]: [&mut [f64]; N_SUMS]| {
+        for (((p, &s1), &s2), &u) in p.iter_mut().zip(&*s1).zip(&*s2).zip(&*u) {
+            *p = pressure(kind, &coef, s1, s2, u);
+        }
+    };
+    // One scatter (`scatter_sums`) with the single-cell part of the pressure that each
+    // node adds to `U` for each pressure form, and with the node terms' `k_p φ ∇²φ` added:
+    // the choice is made once per evaluation, and each node loop is compiled alone with
+    // its form (without adhesion the loops are what they were).
+    match (kind, cell_part) {
+        (PressureKind::Paper, false) => scatter_sums(
+            cells,
+            phi,
+            global,
+            &per_cell,
+            node,
+            &finish,
+            move |coef, s, a, _| {
+                pressure_cell_part(PressureKind::Paper, coef, s.c, s.laplacian(), a)
+            },
+        ),
+        (PressureKind::Interaction, false) => scatter_sums(
+            cells,
+            phi,
+            global,
+            &per_cell,
+            node,
+            &finish,
+            move |coef, s, _, _| pressure_cell_part(PressureKind::Interaction, coef, s.c, 0.0, 0.0),
+        ),
+        (kind, true) => scatter_sums(
+            cells,
+            phi,
+            global,
+            &per_cell,
+            node,
+            &finish,
+            move |coef, s, a, k_node| {
+                let (p, lap) = (s.c, s.laplacian());
+                pressure_cell_part(kind, coef, p, lap, a)
+                    + adhesion_pressure_cell_part(k_node, p, lap)
+            },
+        ),
+    }
+}
+
+/// The node terms' buffers of an evaluation ([`EvalScratch`]).
+struct NodeBuffers<'a> {
+    scratch: &'a mut [f64],
+    coefficients: &'a mut [f64],
+    constants: &'a [[f64; 2]],
+    population_sums: &'a mut PopulationSums,
+}
+
+/// The node terms after the scatter: each population's `s1_p` for the terms that read them
+/// (with the populations `pops` and each slot's identity `ids`), the terms' lattice parts of
+/// the pressure into `global`, then their coefficients of every class, which it returns for
+/// the force pass (`None` without node terms). Inlined into [`evaluate`], whose code it was.
+#[inline(always)]
+fn node_term_pass<'a, T: Real>(
+    cells: &Cells<T>,
+    phi: &[T],
+    (pops, ids): (&Populations, &[usize]),
+    terms: &[Option<&dyn NodeTerm>],
+    global: &mut LatticeSums<N_SUMS>,
+    buffers: NodeBuffers<'a>,
+) -> Option<ClassCoefficients<'a>> {
+    let NodeBuffers {
+        scratch: node_scratch,
+        coefficients: node_buf,
+        constants: node_constants,
+        population_sums,
+    } = buffers;
+    if terms.iter().flatten().any(|t| t.needs_population_sums()) {
+        let n = pops.kinds().len().max(1);
+        population_sums.fill(cells, phi, n, |i| pops.population(ids[i]));
+    }
+    let nodes = cells.lattice().len();
+    {
+        let mut rest: &mut [f64] = node_scratch;
+        for t in terms.iter().flatten() {
+            let (mine, after) = std::mem::take(&mut rest).split_at_mut(t.scratch_fields() * nodes);
+            t.add_pressure(global, population_sums, mine);
+            rest = after;
+        }
+    }
+    terms.iter().any(Option::is_some).then(|| {
+        fill_node_terms(terms, node_scratch, nodes, node_buf);
+        ClassCoefficients {
+            fields: node_buf,
+            constants: node_constants,
+            nodes,
+        }
+    })
 }
 
 /// Pass 2: every cell's `s1, s2, U, Q_xx, Q_xy` scattered onto the lattice (`scatter`), then
