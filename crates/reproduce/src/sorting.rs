@@ -167,6 +167,18 @@ const SPECS: [Spec; 7] = [
     },
 ];
 
+/// The figure's settings, as `verdict.md` states them, for runs of `t` TU at `scale`.
+fn settings(scale: Scale, t: f64) -> String {
+    format!(
+    "- Two populations of 59 cells (R = 8) in a periodic 140² box (the paper's density), the paper's parameters and pressure form, ζ_a/ζ_b and γ_a/γ_b per point (`sorting.csv`); the control has identical populations (ζ = 0.005, γ = 0.01), so that its labels are a random partition: it checks the shuffled-label null under the same dynamics. Seeds {}.\n\
+     - 100 TU of relaxation at ζ = 0, then {t} TU; dt = {}; frames every 50 TU.\n\
+     - Statistic: the demixing parameter (`demixing` of `analysis/observables.csv`: the fraction of touching cells of the same population less its value for labels dealt at random) averaged over the second half of the active phase per run; a point's mean and standard error over seeds. The shuffled-label null has mean 0 by the parameter's construction. A point sorts when its mean exceeds two standard errors and {MATERIAL}; it stays mixed when its mean plus two standard errors is below {MATERIAL}; otherwise not established. A claim holds when one of its points sorts and does not hold when every one stays mixed.\n\
+     - Data: `sorting.csv`; plot `sorting_in_time.png` (the mean over seeds of each point in time).",
+    seeds(scale),
+    scale.own_dt(),
+)
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 2000.0,
@@ -308,14 +320,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             "not testable in this model: `[adhesion] omega` is one ω for every pair of cells, so a heterotypic contact is as adhesive as a homotypic one, and each cell's interface energy γ_i ∫|∇φ_i|² does not depend on its neighbour, so a heterotypic contact costs γ_a + γ_b, exactly the mean of the two homotypic ones (2γ_a, 2γ_b): the driving force of differential adhesion or interfacial tension is zero by construction. A pair-dependent ω is needed",
         ),
     ];
-    let settings = format!(
-        "- Two populations of 59 cells (R = 8) in a periodic 140² box (the paper's density), the paper's parameters and pressure form, ζ_a/ζ_b and γ_a/γ_b per point (`sorting.csv`); the control has identical populations (ζ = 0.005, γ = 0.01), so that its labels are a random partition: it checks the shuffled-label null under the same dynamics. Seeds {}.\n\
-         - 100 TU of relaxation at ζ = 0, then {t} TU; dt = {}; frames every 50 TU.\n\
-         - Statistic: the demixing parameter (`demixing` of `analysis/observables.csv`: the fraction of touching cells of the same population less its value for labels dealt at random) averaged over the second half of the active phase per run; a point's mean and standard error over seeds. The shuffled-label null has mean 0 by the parameter's construction. A point sorts when its mean exceeds two standard errors and {MATERIAL}; it stays mixed when its mean plus two standard errors is below {MATERIAL}; otherwise not established. A claim holds when one of its points sorts and does not hold when every one stays mixed.\n\
-         - Data: `sorting.csv`; plot `sorting_in_time.png` (the mean over seeds of each point in time).",
-        seeds(p.scale),
-        p.scale.own_dt(),
-    );
+    let settings = settings(p.scale, t);
     Ok(Made::new(claims, settings)
         .table("sorting.csv", csv)
         .plot("sorting_in_time.png", plot))
