@@ -183,34 +183,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     // Each width's activities, each with its runs' net flow Φ and v_rms by seed.
     let mut flows: Vec<(usize, Vec<Flow>)> = Vec::new();
     for &w in &ws {
-        let ly = w + 2;
-        let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
-        let mut sets = vec![
-            format!("domain.lx={lx}"),
-            format!("domain.ly={ly}"),
-            format!("cells.count={count}"),
-            "walls.kind=\"channel\"".to_string(),
-            "model.pressure=\"interaction\"".to_string(),
-            format!("run.time={t}"),
-            "run.output_every=10".to_string(),
-        ];
-        sets.extend(p.scale.integrator());
-        let margin: usize = match p.scale {
-            Scale::Quick => 16,
-            Scale::Paper => 12,
-        };
-        sets.push(format!("integrator.margin={}", margin.min((ly - 1) / 2)));
-        let res = super::sweep(
-            p,
-            SweepJob {
-                scene: super::PAPER_SCENE,
-                name: format!("channel-w{w}-{}", p.scale.name()),
-                sets,
-                varies: vec![format!("model.zeta={}", ZETAS.join(","))],
-                analyze: Some(study::analyze::AnalyzeOptions::default()),
-                seeds: None,
-            },
-        )?;
+        let res = width_sweep(p, lx, w, t)?;
         let by_zeta = res
             .points(None)?
             .iter()
@@ -314,9 +287,59 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let mut made = Made::new(Vec::new(), String::new())
         .table("channel_flow.csv", csv)
         .plot("channel_flow.png", plot);
+    if let Some(wplot) = critical_width_plot(&zetas, &wc) {
+        made = made.plot("channel_critical_width.png", wplot);
+    }
+    let claims = vec![claim(b, se, &wc, ws[0])];
+    let settings = settings(p.scale, lx, t, &ws);
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
+}
+
+/// The sweep over ζ of the channel of width `w` (and length `lx`), runs of `t` TU.
+fn width_sweep(
+    p: &ReproduceParams,
+    lx: usize,
+    w: usize,
+    t: f64,
+) -> Result<super::SweepResult, SweepError> {
+    let ly = w + 2;
+    let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
+    let mut sets = vec![
+        format!("domain.lx={lx}"),
+        format!("domain.ly={ly}"),
+        format!("cells.count={count}"),
+        "walls.kind=\"channel\"".to_string(),
+        "model.pressure=\"interaction\"".to_string(),
+        format!("run.time={t}"),
+        "run.output_every=10".to_string(),
+    ];
+    sets.extend(p.scale.integrator());
+    let margin: usize = match p.scale {
+        Scale::Quick => 16,
+        Scale::Paper => 12,
+    };
+    sets.push(format!("integrator.margin={}", margin.min((ly - 1) / 2)));
+    super::sweep(
+        p,
+        SweepJob {
+            scene: super::PAPER_SCENE,
+            name: format!("channel-w{w}-{}", p.scale.name()),
+            sets,
+            varies: vec![format!("model.zeta={}", ZETAS.join(","))],
+            analyze: Some(study::analyze::AnalyzeOptions::default()),
+            seeds: None,
+        },
+    )
+}
+
+/// The plot of the critical width against ζ, with the continuum's slope through the first
+/// point: `None` when no activity has an onset inside the widths.
+fn critical_width_plot(zetas: &[f64], wc: &[Onset]) -> Option<Plot> {
     let (x, y): (Vec<f64>, Vec<f64>) = zetas
         .iter()
-        .zip(&wc)
+        .zip(wc)
         .filter_map(|(z, w)| match w {
             Onset::At(w) => Some((*z, *w)),
             _ => None,
@@ -325,7 +348,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let mut wplot = Plot::new("Critical width against activity", "ζ", "W_c (nodes)");
     (wplot.log_x, wplot.log_y) = (true, true);
     // Drawn only when an activity has an onset inside the widths.
-    if !x.is_empty() {
+    if x.is_empty() {
+        return None;
+    }
+    {
         wplot.series.push(
             Series::new("W_c (seed means)")
                 .with_points(&x, &y, &vec![0.0; x.len()])
@@ -338,24 +364,29 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 .with_points(&x, &line, &vec![0.0; x.len()])
                 .line_only(),
         );
-        made = made.plot("channel_critical_width.png", wplot);
     }
-    let (v, reason) = verdict(b, se, &wc);
+    Some(wplot)
+}
+
+/// The claim on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se`, the onsets `wc` of the activities
+/// and the narrowest width.
+fn claim(b: f64, se: f64, wc: &[Onset], narrowest: usize) -> Claim {
+    let (v, reason) = verdict(b, se, wc);
     let wc_text: Vec<String> = ZETAS[1..]
         .iter()
-        .zip(&wc)
+        .zip(wc)
         .map(|(z, w)| {
             format!(
                 "ζ = {z}: {}",
                 match w {
                     Onset::At(w) => g(*w),
-                    Onset::Narrower => format!("flows at W = {}", ws[0]),
+                    Onset::Narrower => format!("flows at W = {narrowest}"),
                     Onset::Wider => "does not flow".into(),
                 }
             )
         })
         .collect();
-    let claims = vec![Claim::new(
+    Claim::new(
         "channel (extensions T3.4): the critical width of channel flow scales as W_c ∝ ζ^(−1/2)",
         format!(
             "W_c: {}; exponent b = {} ± {} (jackknife over seeds)",
@@ -365,20 +396,22 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         ),
         v,
         reason,
-    )];
-    let settings = format!(
+    )
+}
+
+/// The figure's settings, as `verdict.md` states them: channels `lx` long of the widths `ws`,
+/// runs of `t` TU at `scale`.
+fn settings(scale: Scale, lx: usize, t: f64, ws: &[usize]) -> String {
+    format!(
         "- A channel along x: `[walls] kind = \"channel\"`, lx = {lx}, free width W ∈ {{{}}} (ly = W + 2), the paper's density (a cell per {:.1} nodes), the paper's parameters with the interaction pressure (docs/model.md §11.4: in the paper's form the walls' push dominates v_rms); ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {} (margin at most (ly − 1)/2); f32 storage; frames every 10 TU, analysed. The narrowest width is 24 nodes (3R): narrower channels clip an R = 8 cell's patch.\n\
          - Order parameter, zero at rest: the net flow along the channel Φ = ⟨|v̄_x|⟩, the time mean over the second half of the active phase of the magnitude of the lattice mean of v_x (`v_mean_x` of `analysis/observables.csv`). Statistic: the coherence C = Φ/v_rms of each run (1 for a plug flow, about 1/√(πN) for N cells in random directions). W_c: the narrowest width at which the seed mean of C reaches {FLOWS}, linear from the width below (a fixed level: it does not depend on the widest width). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: not testable when no activity flows coherently at any width, or every one that does already at the narrowest; holds within 2 standard errors of −½ (error below 0.25), does not hold beyond 3, inconclusive between. Data in `channel_flow.csv` (Φ, C and v_rms), plots `channel_flow.png` and, when an onset is found, `channel_critical_width.png`.",
         ws.iter().map(|w| w.to_string()).collect::<Vec<_>>().join(", "),
         AREA_PER_CELL,
         ZETAS.join(", "),
-        p.scale.seeds(),
-        p.scale.integrator_name()
-    );
-    made.claims = claims;
-    made.settings = settings;
-    Ok(made)
+        scale.seeds(),
+        scale.integrator_name()
+    )
 }
 
 /// One activity of one width: its runs' net flow `Φ` and `v_rms`, by seed.
