@@ -254,6 +254,74 @@ fn per_seed(rates: &[(f64, u64, f64)], seed: u64) -> Threshold {
     growth_threshold(&points)
 }
 
+/// The mean ζ_cr of the runs of `pressure` cut at each run length, with its standard error:
+/// `(T, ζ_cr, s.e.)` where it is measured; each seed's threshold into `csv` and each mean
+/// into `means`.
+fn thresholds_by_length(
+    res: &super::SweepResult,
+    pressure: &str,
+    seeds: &[u64],
+    csv: &mut Csv,
+    means: &mut Csv,
+) -> Result<Vec<(f64, f64, f64)>, SweepError> {
+    let mut pts = Vec::new();
+    for &t in &LENGTHS {
+        // Each run cut at T.
+        let points = res.points(Some(t))?;
+        let rates: Vec<(f64, u64, f64)> = points
+            .iter()
+            .filter(|pt| pt.values[0] == pressure)
+            .flat_map(|pt| &pt.runs)
+            .map(|r| {
+                (
+                    r.values[1].parse().unwrap_or(f64::NAN),
+                    r.seed,
+                    r.summary.growth_rate,
+                )
+            })
+            .collect();
+        let (mut found, mut below, mut above) = (Vec::new(), Vec::new(), 0usize);
+        for &s in seeds {
+            let (value, censored) = match per_seed(&rates, s) {
+                Threshold::Bracketed { zeta_cr, .. } => {
+                    found.push(zeta_cr);
+                    (zeta_cr.to_string(), "")
+                }
+                Threshold::Below { hi } => {
+                    below.push(hi);
+                    (String::new(), "below")
+                }
+                // Above the grid (`Threshold::Above`; the enum may grow).
+                _ => {
+                    above += 1;
+                    (String::new(), "above")
+                }
+            };
+            csv.row([cell(pressure), cell(t), cell(s), value, cell(censored)]);
+        }
+        let mean = if above > 0 {
+            None
+        } else {
+            censored_mean(&found, &below)
+        };
+        let (m, se) = mean.unwrap_or((f64::NAN, f64::NAN));
+        means.row([
+            cell(pressure),
+            cell(t),
+            sci(m),
+            sci(se),
+            cell(found.len()),
+            cell(below.len()),
+            cell(above),
+            cell(seeds.len()),
+        ]);
+        if mean.is_some() {
+            pts.push((t, m, se));
+        }
+    }
+    Ok(pts)
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t_max = LENGTHS[LENGTHS.len() - 1];
     let mut sets = vec![
@@ -315,61 +383,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "zero_dof",
     ]);
     for pressure in PRESSURES {
-        let mut pts = Vec::new();
-        for &t in &LENGTHS {
-            // Each run cut at T.
-            let points = res.points(Some(t))?;
-            let rates: Vec<(f64, u64, f64)> = points
-                .iter()
-                .filter(|pt| pt.values[0] == pressure)
-                .flat_map(|pt| &pt.runs)
-                .map(|r| {
-                    (
-                        r.values[1].parse().unwrap_or(f64::NAN),
-                        r.seed,
-                        r.summary.growth_rate,
-                    )
-                })
-                .collect();
-            let (mut found, mut below, mut above) = (Vec::new(), Vec::new(), 0usize);
-            for &s in &seeds {
-                let (value, censored) = match per_seed(&rates, s) {
-                    Threshold::Bracketed { zeta_cr, .. } => {
-                        found.push(zeta_cr);
-                        (zeta_cr.to_string(), "")
-                    }
-                    Threshold::Below { hi } => {
-                        below.push(hi);
-                        (String::new(), "below")
-                    }
-                    // Above the grid (`Threshold::Above`; the enum may grow).
-                    _ => {
-                        above += 1;
-                        (String::new(), "above")
-                    }
-                };
-                csv.row([cell(pressure), cell(t), cell(s), value, cell(censored)]);
-            }
-            let mean = if above > 0 {
-                None
-            } else {
-                censored_mean(&found, &below)
-            };
-            let (m, se) = mean.unwrap_or((f64::NAN, f64::NAN));
-            means.row([
-                cell(pressure),
-                cell(t),
-                sci(m),
-                sci(se),
-                cell(found.len()),
-                cell(below.len()),
-                cell(above),
-                cell(seeds.len()),
-            ]);
-            if mean.is_some() {
-                pts.push((t, m, se));
-            }
-        }
+        let pts = thresholds_by_length(&res, pressure, &seeds, &mut csv, &mut means)?;
         let (t, y, e): (Vec<f64>, Vec<f64>, Vec<f64>) = (
             pts.iter().map(|p| p.0).collect(),
             pts.iter().map(|p| p.1).collect(),
