@@ -236,6 +236,89 @@ pub(crate) fn verdict_shape(q: &[(f64, f64)]) -> (Verdict, String) {
     }
 }
 
+/// The transition line α_c against γ, with its jackknife errors: `None` when no γ has an α_c.
+fn line_plot(gammas: &[f64], ac_pts: &[(f64, f64)]) -> Option<Plot> {
+    let (x, y): (Vec<f64>, Vec<f64>) = gammas
+        .iter()
+        .zip(ac_pts)
+        .filter(|(_, a)| a.0.is_finite())
+        .map(|(g, a)| (*g, a.0))
+        .unzip();
+    let e: Vec<f64> = ac_pts
+        .iter()
+        .filter(|a| a.0.is_finite())
+        .map(|a| if a.1.is_finite() { a.1 } else { 0.0 })
+        .collect();
+    if x.is_empty() {
+        return None;
+    }
+    {
+        let mut lplot = Plot::new(
+            "The transition line: α_c against γ",
+            "interface stiffness γ",
+            "α_c (MSD(τ_L) = R²), ± jackknife",
+        );
+        lplot.log_x = true;
+        lplot.zero_y = true;
+        lplot
+            .series
+            .push(Series::new("α_c").with_points(&x, &y, &e));
+        Some(lplot)
+    }
+}
+
+/// The figure's claims from each γ's phases and α_c (`rows`), the α_c with their errors, the
+/// shape index at α_c, and the text of the line.
+fn claims(
+    rows: &[(Vec<Phase>, Option<f64>, f64)],
+    gammas: &[f64],
+    ac_pts: &[(f64, f64)],
+    q_at: &[(f64, f64)],
+    line_text: &[String],
+) -> Vec<Claim> {
+    let (v1, w1) = verdict_line(rows);
+    let (v2, w2) = verdict_deformability(gammas, ac_pts);
+    let (v3, w3) = verdict_shape(q_at);
+    let line = line_text.join("; ");
+    vec![
+        Claim::new(
+            "jamming (issue 41): a confluent tissue of self-propelled cells has a solid–liquid transition line α_c(γ) (Bi et al. 2016; Loewe et al. 2020)",
+            line.clone(),
+            v1,
+            w1,
+        ),
+        Claim::new(
+            "jamming: deformability fluidises: softer cells (smaller γ) fluidise at a lower propulsion",
+            line.clone(),
+            v2,
+            w2,
+        ),
+        Claim::new(
+            "jamming: the shape index marks the transition, q(α_c) ≈ 3.81 as in vertex models",
+            line,
+            v3,
+            w3,
+        ),
+    ]
+}
+
+/// The figure's settings, as `verdict.md` states them, for runs of `t` TU at `scale` and the
+/// longest lag `lag_l`.
+fn settings(scale: Scale, t: f64, lag_l: f64) -> String {
+    format!(
+        "- The paper's tissue (60 cells, R = 8, periodic 100², ζ = 0) with persistent random propulsion: `[polarity] align = \"none\"`, D_r = 0.01 (persistence time 100 TU); γ ∈ {{{}}}, α ∈ {{{}}}; seeds {}.\n\
+         - 200 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
+         - Statistic: the mean squared displacement at the longest lag τ_L = {} TU (half the active phase) with the tissue's drift removed (`analysis/msd.csv`), its logarithm's mean ± standard error over seeds; D_eff = MSD/(4τ_L) in `jamming_runs.csv`. Fluid when ln MSD − 2 se > ln R², solid when ln MSD + 2 se < ln R² (a cell that moved its radius relative to the tissue in τ_L has left its cage; a finite-time criterion: longer runs can only move the line to lower α). α_c: where the seed mean crosses ln R², linear in ln α; error: jackknife over seeds. The shape index q = P/√A (`shape_index` of `analysis/observables.csv`), mean over the second half.\n\
+         - Rules: claim 1 holds when at every γ the weakest α is solid, the strongest fluid and α_c has an error, does not hold when every point is on one side. Claim 2: the weighted slope of ln α_c against ln γ, positive or negative by two standard errors. Claim 3: every q(α_c) within 0.05 of 3.81 (errors counted) holds; one more than 0.1 and two errors away does not hold.\n\
+         - Data: `jamming_runs.csv`, `jamming.csv`; plots `jamming_msd.png`, `jamming_shape_index.png`, `jamming_line.png`.",
+        GAMMAS.join(", "),
+        ALPHAS.join(", "),
+        scale.seeds(),
+        scale.own_dt(),
+        g(lag_l),
+    )
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 2000.0,
@@ -415,66 +498,11 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .table("jamming.csv", points_csv)
         .plot("jamming_msd.png", plot)
         .plot("jamming_shape_index.png", qplot);
-    let (x, y): (Vec<f64>, Vec<f64>) = gammas
-        .iter()
-        .zip(&ac_pts)
-        .filter(|(_, a)| a.0.is_finite())
-        .map(|(g, a)| (*g, a.0))
-        .unzip();
-    let e: Vec<f64> = ac_pts
-        .iter()
-        .filter(|a| a.0.is_finite())
-        .map(|a| if a.1.is_finite() { a.1 } else { 0.0 })
-        .collect();
-    if !x.is_empty() {
-        let mut lplot = Plot::new(
-            "The transition line: α_c against γ",
-            "interface stiffness γ",
-            "α_c (MSD(τ_L) = R²), ± jackknife",
-        );
-        lplot.log_x = true;
-        lplot.zero_y = true;
-        lplot
-            .series
-            .push(Series::new("α_c").with_points(&x, &y, &e));
+    if let Some(lplot) = line_plot(&gammas, &ac_pts) {
         made = made.plot("jamming_line.png", lplot);
     }
-    let (v1, w1) = verdict_line(&rows);
-    let (v2, w2) = verdict_deformability(&gammas, &ac_pts);
-    let (v3, w3) = verdict_shape(&q_at);
-    let line = line_text.join("; ");
-    let claims = vec![
-        Claim::new(
-            "jamming (issue 41): a confluent tissue of self-propelled cells has a solid–liquid transition line α_c(γ) (Bi et al. 2016; Loewe et al. 2020)",
-            line.clone(),
-            v1,
-            w1,
-        ),
-        Claim::new(
-            "jamming: deformability fluidises: softer cells (smaller γ) fluidise at a lower propulsion",
-            line.clone(),
-            v2,
-            w2,
-        ),
-        Claim::new(
-            "jamming: the shape index marks the transition, q(α_c) ≈ 3.81 as in vertex models",
-            line,
-            v3,
-            w3,
-        ),
-    ];
-    let settings = format!(
-        "- The paper's tissue (60 cells, R = 8, periodic 100², ζ = 0) with persistent random propulsion: `[polarity] align = \"none\"`, D_r = 0.01 (persistence time 100 TU); γ ∈ {{{}}}, α ∈ {{{}}}; seeds {}.\n\
-         - 200 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
-         - Statistic: the mean squared displacement at the longest lag τ_L = {} TU (half the active phase) with the tissue's drift removed (`analysis/msd.csv`), its logarithm's mean ± standard error over seeds; D_eff = MSD/(4τ_L) in `jamming_runs.csv`. Fluid when ln MSD − 2 se > ln R², solid when ln MSD + 2 se < ln R² (a cell that moved its radius relative to the tissue in τ_L has left its cage; a finite-time criterion: longer runs can only move the line to lower α). α_c: where the seed mean crosses ln R², linear in ln α; error: jackknife over seeds. The shape index q = P/√A (`shape_index` of `analysis/observables.csv`), mean over the second half.\n\
-         - Rules: claim 1 holds when at every γ the weakest α is solid, the strongest fluid and α_c has an error, does not hold when every point is on one side. Claim 2: the weighted slope of ln α_c against ln γ, positive or negative by two standard errors. Claim 3: every q(α_c) within 0.05 of 3.81 (errors counted) holds; one more than 0.1 and two errors away does not hold.\n\
-         - Data: `jamming_runs.csv`, `jamming.csv`; plots `jamming_msd.png`, `jamming_shape_index.png`, `jamming_line.png`.",
-        GAMMAS.join(", "),
-        ALPHAS.join(", "),
-        p.scale.seeds(),
-        p.scale.own_dt(),
-        g(lag_l),
-    );
+    let claims = claims(&rows, &gammas, &ac_pts, &q_at, &line_text);
+    let settings = settings(p.scale, t, lag_l);
     made.claims = claims;
     made.settings = settings;
     Ok(made)
