@@ -368,12 +368,7 @@ fn class_constants(
     pops: &Populations,
     node_constants: &mut Vec<[f64; 2]>,
 ) -> bool {
-    let per_population = terms.iter().flatten().any(|t| t.per_population());
-    let classes = if per_population {
-        pops.kinds().len().max(1)
-    } else {
-        1
-    };
+    let classes = crate::node_terms::classes(terms, pops);
     node_constants.clear();
     node_constants.extend((0..classes).map(|p| {
         let asked = |t: &&dyn NodeTerm| if t.per_population() { p } else { 0 };
@@ -385,7 +380,7 @@ fn class_constants(
             sum(|t, p| t.laplacian_coefficient(p)),
         ]
     }));
-    per_population
+    terms.iter().flatten().any(|t| t.per_population())
 }
 
 /// Pass 3's loop over the cells, in parallel: `body(i, out, cell, state, post)` for each cell

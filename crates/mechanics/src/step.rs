@@ -592,11 +592,7 @@ impl<T: Real> Tissue<T> {
             node_scratch.resize(n, 0.0);
         }
         // Their coefficients, two fields per class (made on first use too).
-        let classes = if node_terms.iter().flatten().any(|t| t.per_population()) {
-            self.ext.populations.kinds().len().max(1)
-        } else {
-            1
-        };
+        let classes = crate::node_terms::classes(&node_terms, &self.ext.populations);
         let m = if node_terms.iter().any(Option::is_some) {
             2 * classes * nodes
         } else {

@@ -44,6 +44,7 @@ use phasefield::{Cells, Lattice, Real};
 
 use crate::evaluation::N_SUMS;
 use crate::scatter::{scatter, LatticeSums};
+use crate::terms::Populations;
 
 /// A free-energy term that acts at the nodes (module docs).
 pub(crate) trait NodeTerm: Sync {
@@ -96,6 +97,18 @@ pub(crate) trait NodeTerm: Sync {
         a: &mut [f64],
         b: &mut [f64],
     );
+}
+
+/// The number of coefficient classes of an evaluation with the node terms `terms`: one per
+/// population of `populations` (at least one) when a term's coefficients depend on it
+/// ([`NodeTerm::per_population`]), otherwise one. The evaluation's classes and the size of its
+/// coefficient buffer both come from here.
+pub(crate) fn classes(terms: &[Option<&dyn NodeTerm>], populations: &Populations) -> usize {
+    if terms.iter().flatten().any(|t| t.per_population()) {
+        populations.kinds().len().max(1)
+    } else {
+        1
+    }
 }
 
 /// Populations per scatter of [`PopulationSums`]: one pass over the cells fills the sums of

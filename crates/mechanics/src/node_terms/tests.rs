@@ -44,11 +44,7 @@ fn evaluate_with(
     let n = cells.n_cells();
     let nodes = cells.lattice().len();
     let ids: Vec<usize> = (0..n).collect();
-    let classes = if terms.iter().flatten().any(|t| t.per_population()) {
-        pops.kinds().len()
-    } else {
-        1
-    };
+    let classes = classes(terms, pops);
     let scratch_fields: usize = terms.iter().flatten().map(|t| t.scratch_fields()).sum();
     let mut sums = LatticeSums::for_cells(cells.lattice(), n, cells.shape().nx);
     let mut cell_state = vec![CellState::default(); n];
