@@ -11,6 +11,10 @@
 //! gpu_check agree N STEPS               GPU against the CPU after STEPS steps
 //! gpu_check determinism N STEPS         a hash of the state after STEPS steps, twice
 //! gpu_check variants N STEPS            the shared-patch variant against the plain kernels
+//! gpu_check hashes N STEPS              a hash of the state after STEPS steps for every part,
+//!                                       variant and layout (one chunk and one lattice binding,
+//!                                       or split): a change that must keep the bits compares
+//!                                       these lines before and after
 //! ```
 //!
 //! The scene is the paper's (`scenes/paper.toml`, embedded: nothing is read from disk),
@@ -29,7 +33,7 @@ const PAPER: &str = include_str!("../../../scenes/paper.toml");
 
 fn usage() -> ! {
     eprintln!(
-        "usage: gpu_check adapter | bandwidth MIB | throughput N PART [STEPS] [VARIANT] | agree N STEPS | determinism N STEPS | variants N STEPS"
+        "usage: gpu_check adapter | bandwidth MIB | throughput N PART [STEPS] [VARIANT] | agree N STEPS | determinism N STEPS | variants N STEPS | hashes N STEPS"
     );
     std::process::exit(2)
 }
@@ -60,6 +64,11 @@ fn scene(n: usize, part: &str) -> Result<Scene, String> {
         "adhesion" => "[adhesion]\nomega = 0.0075\n".into(),
         "division" => format!(
             "[division]\ncycle_time = 300.0\ncycle_spread = 100.0\ngrowth_time = 50.0\nmax_cells = {}\n",
+            2 * n
+        ),
+        // Division whose growth phase is under way from the start (for `hashes`).
+        "growth" => format!(
+            "[division]\ncycle_time = 40.0\ncycle_spread = 5.0\ngrowth_time = 39.0\nmax_cells = {}\n",
             2 * n
         ),
         other => return Err(format!("no part {other:?}")),
@@ -120,6 +129,7 @@ fn main() {
         Some("agree") => agree(arg(&args, 1), arg(&args, 2)),
         Some("determinism") => determinism(arg(&args, 1), arg(&args, 2)),
         Some("variants") => variants(arg(&args, 1), arg(&args, 2)),
+        Some("hashes") => hashes(arg(&args, 1), arg(&args, 2)),
         _ => usage(),
     };
     match line {
@@ -315,4 +325,52 @@ fn variants(n: usize, steps: usize) -> Result<String, String> {
         if h0 == h1 { "yes" } else { "no" },
         if f64::from(dphi) <= 1e-5 { "yes" } else { "no" }
     ))
+}
+
+/// The state after `steps` steps for each part with each variant and layout, hashed: one line
+/// a case, `part=… variant=… layout=… hash=…` (or the refusal).
+fn hashes(n: usize, steps: usize) -> Result<String, String> {
+    let mut lines = Vec::new();
+    for part in [
+        "minimal",
+        "polarity",
+        "populations",
+        "walls",
+        "adhesion",
+        "division",
+        "growth",
+    ] {
+        let (start, sp) = tissue(n, part)?;
+        for variant in [gpu::Variant::Plain, gpu::Variant::SharedPatch] {
+            for split in [false, true] {
+                let options = gpu::GpuOptions {
+                    variant,
+                    max_chunk_cells: split.then_some(n.div_ceil(3)),
+                    max_lattice_nodes: split.then_some(start.cells().lattice().len() / 2 + 7),
+                };
+                let mut t = start.clone();
+                let head = format!(
+                    "check=hashes part={part} variant={} layout={} cells={n} steps={steps}",
+                    variant.name(),
+                    if split { "split" } else { "whole" }
+                );
+                let dev = gpu::Device::open().map_err(|e| e.to_string())?;
+                let mut gpu = match gpu::GpuBackend::with_options(dev, &t, &sp, options) {
+                    Ok(g) => g,
+                    Err(e) => {
+                        lines.push(format!("{head} refused=\"{e}\""));
+                        continue;
+                    }
+                };
+                for _ in 0..steps {
+                    gpu.step(&t, &sp).map_err(|e| e.to_string())?;
+                }
+                let obs = gpu.observables(&t).map_err(|e| e.to_string())?;
+                gpu.sync(&mut t).map_err(|e| e.to_string())?;
+                let v = obs.map_or(0, |o| o.v_rms.to_bits());
+                lines.push(format!("{head} hash={:016x} v_rms={v:016x}", hash(&t)));
+            }
+        }
+    }
+    Ok(lines.join("\n"))
 }
