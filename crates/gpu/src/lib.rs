@@ -25,15 +25,24 @@
 //! deterministic) is in ARCHITECTURE.md; [`Device`] finds the adapter, [`GpuBackend`] holds
 //! the buffers and records the steps.
 
+mod bindings;
 mod device;
+mod features;
+mod kernels;
+mod layout;
+mod memory;
+mod shader;
+mod shared;
 mod step;
 
 pub use device::{adapter_info, Device, GpuError};
-pub use step::{
-    unsupported, Chunk, Evaluation, GpuBackend, GpuMemory, GpuOptions, Kind, Params, Variant,
-    MAX_KINDS, SETTINGS, SUPPORTED,
-};
+pub use features::{unsupported, SETTINGS, SUPPORTED};
+pub use layout::GpuOptions;
+pub use memory::GpuMemory;
+pub use shader::Variant;
+pub use shared::{Chunk, Kind, Params, MAX_KINDS};
+pub use step::{Evaluation, GpuBackend};
 
 /// The WGSL source of the step's kernels, with the constants of a patch shape and pressure
 /// form filled in (for the tests that compare each equation with its Rust reference).
-pub use step::shader_source;
+pub use shader::shader_source;

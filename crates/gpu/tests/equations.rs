@@ -1,4 +1,4 @@
-//! Each WGSL function of `step.wgsl` that implements an equation against its Rust reference
+//! Each WGSL function of the kernels (`wgsl/`) that implements an equation against its Rust reference
 //! (`mechanics::equations`, `phasefield::EnergyCoefficients`), on random inputs, for both
 //! pressure forms: so that every formula keeps one reference, and a GPU formula that drifts
 //! from it fails here by name.
