@@ -61,7 +61,7 @@ fn bench_terms(c: &mut Criterion) {
                 Population::new().with_gamma(0.01).with_zeta(0.005),
                 Population::new().with_gamma(0.02).with_zeta(-0.005),
             ];
-            t.with_populations(Populations::new(kinds, &[n / 2, n - n / 2], 1))
+            t.with(Populations::new(kinds, &[n / 2, n - n / 2], 1))
         } else {
             t
         };

@@ -529,7 +529,7 @@ fn the_gpu_refuses_a_setting_it_has_not_implemented_by_name() {
     // A term of a user's: its table.
     let mut terms = mechanics::terms::Terms::default();
     terms.add(std::sync::Arc::new(HostTerm));
-    let ext = mechanics::Extensions::none().with_terms(terms);
+    let ext = mechanics::Extensions::none().with(terms);
     let params = mechanics::ModelParams::default();
     let refused = gpu::unsupported(&ext, &params);
     assert!(

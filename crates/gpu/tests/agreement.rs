@@ -80,7 +80,7 @@ fn two_populations(tissue: Tissue<f32>) -> Tissue<f32> {
             .with_radius(7.0)
             .with_mu(2.5),
     ];
-    tissue.with_populations(Populations::new(kinds, &[30, 30], 7))
+    tissue.with(Populations::new(kinds, &[30, 30], 7))
 }
 
 /// `tissue` in a channel 92 nodes wide (4 solid rows each side, where some cells sit and are
@@ -89,7 +89,7 @@ fn walled(tissue: Tissue<f32>) -> Tissue<f32> {
     let lattice = tissue.lattice();
     let solid = WallShape::Channel { width: 92.0 }.solid(lattice);
     let field = WallField::new(lattice, &solid, 1.0, 0.0);
-    tissue.with_walls(Walls::new(field, 1.0, 0.002))
+    tissue.with(Walls::new(field, 1.0, 0.002))
 }
 
 /// `tissue` with cell–cell adhesion ω = 0.0075 (half the doublet's): the lattice Laplacian of
@@ -113,7 +113,7 @@ fn polar(tissue: Tissue<f32>, align: Align, propulsion: Propulsion) -> Tissue<f3
         .with_rotational_diffusion(0.05)
         .with_alignment(align, 1.0)
         .with_contact_inhibition(1.0);
-    tissue.with_terms(Terms::new(11).with(polarity))
+    tissue.with(Terms::new(11).with(polarity))
 }
 
 #[test]
@@ -413,7 +413,7 @@ fn a_hundred_polar_steps_of_two_populations_agree_with_the_cpu() {
         .with_rotational_diffusion(0.05)
         .with_alignment(Align::Velocity, 1.0)
         .with_population(1, Some(-0.02), Some(0.2), Some(3.0));
-    let tissue = tissue.with_terms(Terms::new(5).with(polarity));
+    let tissue = tissue.with(Terms::new(5).with(polarity));
     let Some((dphi, dc, [dtheta, moved])) = polar_steps_agree(tissue, 100) else {
         return;
     };
@@ -436,7 +436,7 @@ fn an_unstable_alignment_is_refused_on_the_device_as_on_the_host() {
     }
     let tissue = paper_tissue(0.005);
     let polarity = Polarity::new(0.04).with_alignment(Align::Velocity, 5.0e4);
-    let tissue = tissue.with_terms(Terms::new(5).with(polarity));
+    let tissue = tissue.with(Terms::new(5).with(polarity));
     let sp = StepParams::paper();
     let mut ws = Workspace::new(tissue.cells());
     let mut host = tissue.clone();
@@ -833,7 +833,7 @@ fn division_on_the_device_follows_the_cpu() {
         .with_death_rate(0.002)
         .with_pressure_gate(0.01)
         .with_max_cells(90);
-    let tissue = start.with_proliferation(clock);
+    let tissue = start.with(clock);
     let steps = 250;
     let (g, c) = on_both_backends(&tissue, steps);
     let (lg, lc) = (lineage(&g), lineage(&c));
@@ -897,7 +897,7 @@ fn stress_based_extrusion_on_the_device_follows_the_cpu() {
     let clock = Proliferation::new(15.0, 0.2, 3, &start)
         .with_extrusion_pressure(0.05)
         .with_max_cells(90);
-    let tissue = start.with_proliferation(clock);
+    let tissue = start.with(clock);
     let steps = 250;
     let (g, c) = on_both_backends(&tissue, steps);
     let (lg, lc) = (lineage(&g), lineage(&c));
@@ -926,7 +926,7 @@ fn a_term_of_your_own_is_refused_by_name() {
     let sp = StepParams::paper();
     let polar_only = polar(paper_tissue(0.0), Align::Velocity, Propulsion::Cell);
     assert!(GpuBackend::check(&polar_only, &sp).is_ok());
-    let tissue = paper_tissue(0.0).with_terms(Terms::new(1).with(Polarity::new(0.01)).with(Push));
+    let tissue = paper_tissue(0.0).with(Terms::new(1).with(Polarity::new(0.01)).with(Push));
     let err = GpuBackend::check(&tissue, &sp).unwrap_err().to_string();
     assert!(
         err.contains("[terms.push]")

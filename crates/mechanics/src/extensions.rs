@@ -182,27 +182,11 @@ impl Extensions {
         Self::default()
     }
 
-    /// These extensions with the physics terms `terms`.
-    pub fn with_terms(mut self, terms: Terms) -> Self {
-        self.terms = terms;
-        self
-    }
-
-    /// These extensions with the populations `populations`.
-    pub fn with_populations(mut self, populations: Populations) -> Self {
-        self.populations = populations;
-        self
-    }
-
-    /// These extensions with walls.
-    pub fn with_walls(mut self, walls: Option<Walls>) -> Self {
-        self.walls = walls;
-        self
-    }
-
-    /// These extensions with a cell-cycle clock.
-    pub fn with_proliferation(mut self, clock: Option<Proliferation>) -> Self {
-        self.proliferation = clock.map(Box::new);
+    /// These extensions with the part `part` in its place (replacing the one there, or
+    /// removing it: `None::<Walls>`): the one builder of the parts, which
+    /// [`Tissue::with`](crate::Tissue::with) goes through too.
+    pub fn with(mut self, part: impl ExtensionPart) -> Self {
+        part.place(&mut self);
         self
     }
 
@@ -307,5 +291,50 @@ impl Extensions {
                 },
             })
             .collect()
+    }
+}
+
+/// A part of the model beyond the paper's, as the builders take it ([`Extensions::with`],
+/// [`Tissue::with`](crate::Tissue::with)): the physics terms, the populations, the walls and
+/// the cell-cycle clock, the last two also as an `Option` (`None` removes the part). Each
+/// part's place is written once, here.
+pub trait ExtensionPart {
+    /// Puts this part into `ext`, replacing the one there.
+    fn place(self, ext: &mut Extensions);
+}
+
+impl ExtensionPart for Terms {
+    fn place(self, ext: &mut Extensions) {
+        ext.terms = self;
+    }
+}
+
+impl ExtensionPart for Populations {
+    fn place(self, ext: &mut Extensions) {
+        ext.populations = self;
+    }
+}
+
+impl ExtensionPart for Option<Walls> {
+    fn place(self, ext: &mut Extensions) {
+        ext.walls = self;
+    }
+}
+
+impl ExtensionPart for Walls {
+    fn place(self, ext: &mut Extensions) {
+        Some(self).place(ext);
+    }
+}
+
+impl ExtensionPart for Option<Proliferation> {
+    fn place(self, ext: &mut Extensions) {
+        ext.proliferation = self.map(Box::new);
+    }
+}
+
+impl ExtensionPart for Proliferation {
+    fn place(self, ext: &mut Extensions) {
+        Some(self).place(ext);
     }
 }

@@ -78,7 +78,7 @@ mod workspace;
 
 pub use adaptive::{AdaptiveParams, Controller};
 pub use evaluation::{CellState, SumField};
-pub use extensions::{Extensions, Part, Setting};
+pub use extensions::{ExtensionPart, Extensions, Part, Setting};
 pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
 pub use nalgebra::Vector2;

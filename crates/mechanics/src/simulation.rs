@@ -446,7 +446,7 @@ impl<T: Real> Simulation<T> {
     /// cells whose area falls below `f πR²` are removed
     /// ([`crate::division::remove_extruded`]); both before the fixes and callbacks of the
     /// step ([`Tissue::proliferate`]). The tissue holds the clock
-    /// ([`Tissue::with_proliferation`], which this calls), so outputs see the lineage.
+    /// ([`Tissue::with`], which this calls), so outputs see the lineage.
     pub fn with_proliferation(
         mut self,
         clock: crate::division::Proliferation,
@@ -456,7 +456,7 @@ impl<T: Real> Simulation<T> {
             Some(f) => clock.with_extrusion(f),
             None => clock,
         };
-        self.tissue = self.tissue.with_proliferation(clock);
+        self.tissue = self.tissue.with(clock);
         self
     }
 

@@ -4,7 +4,7 @@ use nalgebra::Vector2;
 use phasefield::{Cells, ComTable, Lattice, Real};
 use rayon::prelude::*;
 
-use crate::extensions::{Extensions, Part};
+use crate::extensions::{ExtensionPart, Extensions, Part};
 use crate::params::ModelParams;
 use crate::terms::{Populations, Terms};
 use crate::walls::Walls;
@@ -142,25 +142,48 @@ impl<T: Real> Tissue<T> {
     /// # Panics
     /// If the populations do not assign every identity `0..`[`Tissue::next_id`], or the walls
     /// are on another lattice.
-    pub fn with_extensions(self, ext: Extensions) -> Self {
+    pub fn with_extensions(mut self, ext: Extensions) -> Self {
         let Extensions {
-            terms,
+            mut terms,
             populations,
             walls,
             proliferation,
             target_scale: _,
         } = ext;
-        let mut t = self.with_terms(terms).with_populations(populations);
-        t.ext.walls = None;
-        if let Some(walls) = walls {
-            t = t.with_walls(walls);
+        assert!(
+            populations.is_empty() || populations.of_cell().len() == self.next_id(),
+            "{} cells assigned to populations, {} identities in the tissue",
+            populations.of_cell().len(),
+            self.next_id()
+        );
+        if let Some(w) = &walls {
+            assert_eq!(
+                w.field(false).map(|f| f.lattice()),
+                Some(self.lattice()),
+                "the walls' lattice is the tissue's"
+            );
         }
-        t.ext.proliferation = None;
-        t.ext.target_scale.clear();
-        match proliferation {
-            Some(clock) => t.with_proliferation(*clock),
-            None => t,
-        }
+        terms.initialise(self.next_id());
+        self.ext = Extensions {
+            terms,
+            populations,
+            walls,
+            proliferation,
+            target_scale: Vec::new(),
+        };
+        self.refresh_target_scale();
+        self
+    }
+
+    /// This tissue with the part `part` of the extensions in its place (the physics terms,
+    /// the populations, the walls, the cell-cycle clock: [`ExtensionPart`]), replacing the
+    /// one there, as [`Tissue::with_extensions`] takes them all.
+    ///
+    /// # Panics
+    /// As [`Tissue::with_extensions`].
+    pub fn with(mut self, part: impl ExtensionPart) -> Self {
+        let ext = std::mem::take(&mut self.ext).with(part);
+        self.with_extensions(ext)
     }
 
     /// The extensions of the paper's model this tissue has.
@@ -172,40 +195,6 @@ impl<T: Real> Tissue<T> {
     /// backend's refusal: [`crate::backend::Backend`]).
     pub fn parts(&self) -> Vec<Part> {
         self.ext.parts(&self.params)
-    }
-
-    /// This tissue with the physics terms `terms` (`crate::terms`), their per-cell state
-    /// initialised from their seed unless it is there already.
-    pub fn with_terms(mut self, mut terms: Terms) -> Self {
-        terms.initialise(self.next_id());
-        self.ext.terms = terms;
-        self
-    }
-
-    /// This tissue with cells in populations of their own parameters (`crate::terms`).
-    ///
-    /// # Panics
-    /// If the populations do not assign every identity `0..`[`Tissue::next_id`].
-    pub fn with_populations(mut self, populations: Populations) -> Self {
-        assert!(
-            populations.is_empty() || populations.of_cell().len() == self.next_id(),
-            "{} cells assigned to populations, {} identities in the tissue",
-            populations.of_cell().len(),
-            self.next_id()
-        );
-        self.ext.populations = populations;
-        self
-    }
-
-    /// This tissue between walls (`crate::walls`).
-    pub fn with_walls(mut self, walls: Walls) -> Self {
-        assert_eq!(
-            walls.field(false).map(|f| f.lattice()),
-            Some(self.lattice()),
-            "the walls' lattice is the tissue's"
-        );
-        self.ext.walls = Some(walls);
-        self
     }
 
     /// The walls, if any.

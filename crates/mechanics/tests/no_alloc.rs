@@ -86,7 +86,7 @@ fn check_steps() {
         .with_growth_time(1e12)
         .with_extrusion(0.01)
         .with_death_rate(1e-12);
-    let mut t = t.with_proliferation(clock);
+    let mut t = t.with(clock);
     let mut ws = Workspace::new(t.cells());
     let sp = StepParams::new(0.2, 2);
     for _ in 0..3 {

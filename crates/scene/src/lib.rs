@@ -337,10 +337,10 @@ impl Scene {
     /// from it; a run uses [`Scene::extensions`].
     pub fn configured_extensions(&self) -> mechanics::Extensions {
         mechanics::Extensions::none()
-            .with_terms(self.terms())
-            .with_populations(self.file.populations())
-            .with_walls(self.walls())
-            .with_proliferation(self.file.division.as_ref().map(|spec| {
+            .with(self.terms())
+            .with(self.file.populations())
+            .with(self.walls())
+            .with(self.file.division.as_ref().map(|spec| {
                 let (t0, rate) = spec.cycle();
                 let clock =
                     mechanics::division::Proliferation::restore(t0, rate, self.file.run.seed, [])
@@ -362,7 +362,7 @@ impl Scene {
     /// a new run and for a checkpoint's (whose state arrays then replace the parts' state,
     /// [`mechanics::Extensions::restore_arrays`]).
     pub fn extensions<T: Real>(&self, tissue: &Tissue<T>) -> mechanics::Extensions {
-        self.configured_extensions().with_proliferation(
+        self.configured_extensions().with(
             self.file
                 .division
                 .as_ref()

@@ -294,7 +294,10 @@ impl LoadedFrame {
         rebuilt.set_active(tissue.active());
         // The parts' per-cell arrays, the rows of the living cells (what a frame writes).
         let arrays = tissue.extensions().frame_arrays();
-        let mut ext = tissue.extensions().clone().with_proliferation(None);
+        let mut ext = tissue
+            .extensions()
+            .clone()
+            .with(None::<mechanics::division::Proliferation>);
         ext.restore_arrays(
             n,
             mechanics::persist::Source::Frame,
@@ -590,8 +593,8 @@ pub(crate) fn load_frame(
     // is no cell-cycle clock, whose lineage a frame does not keep.
     let ext = scene
         .configured_extensions()
-        .with_proliferation(None)
-        .with_terms(frame_terms(path, scene, n)?);
+        .with(None::<mechanics::division::Proliferation>)
+        .with(frame_terms(path, scene, n)?);
     let mut tissue = Tissue::from_state(
         cells,
         scene.model_params(zeta),

@@ -22,7 +22,7 @@
 //! let shape = PatchShape::new(lattice, 14).unwrap();
 //! let cells = init::discs(lattice, shape, &[[24.0, 24.0]], 8.0, 2.5);
 //! let terms = Terms::new(7).with(Aoup { tau: 50.0, d: 1e-4 });
-//! let mut tissue = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(terms);
+//! let mut tissue = Tissue::new(cells, ModelParams::paper(0.0)).with(terms);
 //! let mut ws = Workspace::new(tissue.cells());
 //! for _ in 0..100 {
 //!     tissue.step(&mut ws, &StepParams::default()).unwrap();
@@ -222,7 +222,7 @@ mod tests {
             .collect();
         let cells = init::discs(lattice, shape, &centres, 8.0, 2.5);
         let terms = Terms::new(1).with(term);
-        let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(terms);
+        let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with(terms);
         let mut ws = Workspace::new(t.cells());
         let mut fx = vec![Vec::with_capacity(steps); centres.len()];
         for _ in 0..steps {

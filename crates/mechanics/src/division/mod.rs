@@ -10,7 +10,7 @@
 //! about half of it under the area term. The number of cells changes: call
 //! [`crate::Workspace::fit`] before the next step.
 //!
-//! A tissue holds its clock ([`Tissue::with_proliferation`]), so that the outputs and
+//! A tissue holds its clock ([`Tissue::with`]), so that the outputs and
 //! checkpoints that see the tissue see the lineage too; [`Tissue::proliferate`] applies it
 //! after a step, and [`crate::Simulation`] calls it after every step.
 
@@ -305,14 +305,6 @@ pub struct CellEvents {
 }
 
 impl<T: Real> Tissue<T> {
-    /// The same tissue with a cell-cycle clock (and its extrusion rule and death rate), which
-    /// [`Tissue::proliferate`] applies.
-    pub fn with_proliferation(mut self, clock: Proliferation) -> Self {
-        self.ext.proliferation = Some(Box::new(clock));
-        self.refresh_target_scale_at(self.time);
-        self
-    }
-
     /// Sets each identity's target-area factor from the clock (the growth phase) at `now`;
     /// nothing without a clock.
     fn refresh_target_scale_at(&mut self, now: f64) {

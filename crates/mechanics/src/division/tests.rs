@@ -13,8 +13,8 @@ fn relaxed_cell(l: usize) -> (Tissue, Workspace) {
     let shape = PatchShape::new(lattice, 16).unwrap();
     let c = l as f64 / 2.0;
     let cells = init::discs(lattice, shape, &[[c, c]], 8.0, 2.5);
-    let mut t = Tissue::new(cells, ModelParams::paper(0.0))
-        .with_terms(Terms::new(3).with(Polarity::new(0.0)));
+    let mut t =
+        Tissue::new(cells, ModelParams::paper(0.0)).with(Terms::new(3).with(Polarity::new(0.0)));
     let mut ws = Workspace::new(t.cells());
     for _ in 0..200 {
         t.step(&mut ws, &StepParams::default()).unwrap();
@@ -78,7 +78,7 @@ fn colony(time: f64, axis: SplitAxis) -> (Tissue, Proliferation) {
     let cells = init::discs(lattice, shape, &[[30.0, 40.0], [66.0, 50.0]], 3.0, 2.5);
     let mut p = ModelParams::paper(0.0);
     p.energy.radius = 5.0;
-    let mut t = Tissue::new(cells, p).with_terms(Terms::new(5).with(Polarity::new(0.01)));
+    let mut t = Tissue::new(cells, p).with(Terms::new(5).with(Polarity::new(0.01)));
     let mut ws = Workspace::new(t.cells());
     let mut clock = Proliferation::new(40.0, 0.05, 9, &t)
         .with_axis(axis)
@@ -192,7 +192,7 @@ fn colony_growth(t_g: f64) {
                 .with_axis(SplitAxis::Random)
                 .with_growth_time(t_g);
             clock.lineage[0].birth = 0.0;
-            let mut t = t.with_proliferation(clock);
+            let mut t = t.with(clock);
             let (mut n, mut first_area, mut largest) = (Vec::new(), 0.0, 0.0f64);
             for step in 0..(end / dt) as usize {
                 if step % 100 == 0 {
@@ -347,7 +347,7 @@ fn a_simulation_grows_the_colony_of_the_hand_loop() {
     let cells = init::discs(lattice, shape, &[[30.0, 40.0], [66.0, 50.0]], 3.0, 2.5);
     let mut p = ModelParams::paper(0.0);
     p.energy.radius = 5.0;
-    let t = Tissue::new(cells, p).with_terms(Terms::new(5).with(Polarity::new(0.01)));
+    let t = Tissue::new(cells, p).with(Terms::new(5).with(Polarity::new(0.01)));
     let clock = Proliferation::new(40.0, 0.05, 9, &t).with_max_cells(40);
     let counts = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let seen = counts.clone();
@@ -409,7 +409,7 @@ fn proliferation_decides_before_it_acts() {
     .unwrap()
     .with_extrusion(0.2);
     assert!(Proliferation::restore(1.0, 1.0, 5, [record(0, 1.0), record(0, 2.0)]).is_err());
-    let mut t = t.with_proliferation(clock);
+    let mut t = t.with(clock);
     let mut ws = Workspace::new(t.cells());
     t.refresh(&mut ws);
     let c1 = t.centres()[1];
@@ -449,7 +449,7 @@ fn deaths_follow_the_death_rate() {
     assert!((mean / 100.0 - 1.0).abs() < 0.063, "{mean}");
     // Cell by cell: a founder dies `phase·cycle + L` after its birth, i.e. `L` after the
     // start, whatever its age then.
-    let mut t = t.with_proliferation(clock.clone());
+    let mut t = t.with(clock.clone());
     let mut ws = Workspace::new(t.cells());
     let first = (0..2)
         .map(|id| clock.lifespan(id))
@@ -511,7 +511,7 @@ fn the_pressure_rule_extrudes_the_compressed_cells() {
     for (threshold, want) in [(quartile, expected), (p[p.len() - 1] * 1.01, Vec::new())] {
         let clock = Proliferation::new(1e9, 1.0, 4, &t0).with_extrusion_pressure(threshold);
         assert!(clock.extrudes());
-        let mut t = t0.clone().with_proliferation(clock);
+        let mut t = t0.clone().with(clock);
         let mut ws = Workspace::new(t.cells());
         t.refresh(&mut ws);
         let events = t.proliferate(&mut ws);

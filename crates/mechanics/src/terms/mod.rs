@@ -207,7 +207,7 @@ impl Entry {
 }
 
 /// The terms of a tissue with their per-cell state: built with [`Terms::new`] and
-/// [`Terms::with`], attached by [`crate::Tissue::with_terms`].
+/// [`Terms::with`], attached by [`crate::Tissue::with`].
 #[derive(Debug, Clone, Default)]
 pub struct Terms {
     entries: Vec<Entry>,
@@ -414,7 +414,7 @@ impl Terms {
         Ok(())
     }
 
-    /// Allocates and initialises the state of `n` cells (what [`crate::Tissue::with_terms`]
+    /// Allocates and initialises the state of `n` cells (what [`crate::Tissue::with`]
     /// does); a no-op when it is there already.
     pub(crate) fn initialise(&mut self, n: usize) {
         if self.n == n {

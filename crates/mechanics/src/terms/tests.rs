@@ -17,7 +17,7 @@ fn relaxed(l: usize, margin: usize, lambda: f64, terms: Terms) -> (Tissue, Works
     let cells = init::discs(lattice, shape, &[[half, half]], 8.0, lambda);
     let mut p = ModelParams::paper(0.0);
     p.energy.lambda = lambda;
-    let mut t = Tissue::new(cells, p).with_terms(terms);
+    let mut t = Tissue::new(cells, p).with(terms);
     let mut ws = Workspace::new(t.cells());
     t.set_active(false);
     for _ in 0..200 {
@@ -101,7 +101,7 @@ fn a_term_that_adds_nothing_changes_nothing_to_the_bit() {
     let run = |terms: Option<Terms>| {
         let mut t = four_cells();
         if let Some(terms) = terms {
-            t = t.with_terms(terms);
+            t = t.with(terms);
         }
         let mut ws = Workspace::new(t.cells());
         for _ in 0..30 {
@@ -247,7 +247,7 @@ fn terms_are_independent_of_threads_and_slots() {
                 .with_rotational_diffusion(0.05)
                 .with_alignment(Align::Force, 1.0);
             let mut t =
-                Tissue::new(cells, ModelParams::paper(0.005)).with_terms(Terms::new(11).with(pol));
+                Tissue::new(cells, ModelParams::paper(0.005)).with(Terms::new(11).with(pol));
             let mut ws = Workspace::new(t.cells());
             let mut scratch = Vec::new();
             for _ in 0..40 {
@@ -295,8 +295,7 @@ fn what_a_term_sees_does_not_depend_on_observation_or_slot_order() {
             .with_propulsion(Propulsion::Density)
             .with_rotational_diffusion(0.05)
             .with_contact_inhibition(2.0);
-        let mut t =
-            Tissue::new(cells, ModelParams::paper(0.005)).with_terms(Terms::new(11).with(pol));
+        let mut t = Tissue::new(cells, ModelParams::paper(0.005)).with(Terms::new(11).with(pol));
         let mut ws = Workspace::new(t.cells());
         let mut scratch = Vec::new();
         let mut moved = false;
@@ -487,7 +486,7 @@ fn uniform_populations_are_the_scalar_model_to_the_bit() {
     let run = |pops: Option<Populations>| {
         let mut t = four_cells();
         if let Some(p) = pops {
-            t = t.with_populations(p);
+            t = t.with(p);
         }
         let mut ws = Workspace::new(t.cells());
         for _ in 0..30 {
@@ -590,7 +589,7 @@ fn contact_inhibition_stalls_the_propulsion() {
         let shape = PatchShape::new(lattice, 14).unwrap();
         let cells = init::discs(lattice, shape, &[[28.0, 24.0], [52.0, 24.0]], 8.0, 2.5);
         let pol = Polarity::new(0.04).with_contact_inhibition(eta);
-        let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(Terms::new(1).with(pol));
+        let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with(Terms::new(1).with(pol));
         t.terms_mut()
             .set_variable("polarity/theta", &[0.0, std::f64::consts::PI])
             .unwrap();
@@ -624,7 +623,7 @@ fn a_rejected_adaptive_step_replays_its_noise() {
     let cells = init::discs(lattice, shape, &[[14.0, 14.0], [34.0, 30.0]], 6.0, 2.5);
     let d_r = 0.01;
     let pol = Polarity::new(0.04).with_rotational_diffusion(d_r);
-    let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with_terms(Terms::new(9).with(pol));
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with(Terms::new(9).with(pol));
     let mut ws = Workspace::new(t.cells());
     let params = crate::AdaptiveParams::new(1e-4, 2.0);
     let mut ctrl = crate::Controller::new(2.0);

@@ -61,7 +61,7 @@ fn walls_are_the_derivative_of_their_discrete_energy() {
             params.pressure = pressure;
             let mut t = Tissue::new(cells.clone(), params);
             if let Some(w) = walls {
-                t = t.with_walls(w);
+                t = t.with(w);
             }
             let mut ws = Workspace::new(t.cells());
             t.refresh(&mut ws);
@@ -110,8 +110,8 @@ fn cell_pushed_at_a_wall(omega: f64, time: f64) -> (Tissue, Workspace, WallField
     let field = WallField::of_shape(lattice, &WallShape::Channel { width: 46.0 }, 0.5, 0.0);
     let pol = Polarity::new(0.04).with_initial_angle(-std::f64::consts::FRAC_PI_2);
     let mut t = Tissue::new(cells, ModelParams::paper(0.0))
-        .with_terms(Terms::new(1).with(pol))
-        .with_walls(Walls::new(field.clone(), 1.0, omega));
+        .with(Terms::new(1).with(pol))
+        .with(Walls::new(field.clone(), 1.0, omega));
     let mut ws = Workspace::new(t.cells());
     let p = StepParams::default();
     t.set_active(false);
