@@ -8,9 +8,10 @@ use phasefield::PatchShape;
 use crate::shared::{Chunk, Kind, Params, MAX_KINDS};
 use crate::step::WG;
 
-/// The files of `wgsl/`, in the order they are joined (WGSL's module-scope declarations may
-/// come in any order; this one reads from the general to the particular).
-const STAGES: [&str; 11] = [
+/// The stages' files of `wgsl/`, in the order they are joined (WGSL's module-scope
+/// declarations may come in any order; this one reads from the general to the particular);
+/// each feature's file follows ([`crate::features::Feature::wgsl`]).
+const STAGES: [&str; 7] = [
     include_str!("wgsl/common.wgsl"),
     include_str!("wgsl/equations.wgsl"),
     include_str!("wgsl/cells.wgsl"),
@@ -18,10 +19,6 @@ const STAGES: [&str; 11] = [
     include_str!("wgsl/lattice.wgsl"),
     include_str!("wgsl/force.wgsl"),
     include_str!("wgsl/observe.wgsl"),
-    include_str!("wgsl/walls.wgsl"),
-    include_str!("wgsl/adhesion.wgsl"),
-    include_str!("wgsl/polarity.wgsl"),
-    include_str!("wgsl/growth.wgsl"),
 ];
 
 /// The WGSL source of the step for patches of `shape` and the pressure form `kind`, with
@@ -49,12 +46,16 @@ pub(crate) fn shader_source_split(
          const NPT: u32 = {npt}u;\nconst MARGIN: u32 = {margin}u;\nconst CAP: u32 = {cap}u;\n\
          const PAPER: u32 = {paper}u;\nconst LAT_SPLIT: u32 = {split}u;\n\
          const MAX_KINDS: u32 = {MAX_KINDS}u;\nconst LOCAL_PATCH: u32 = {lp}u;\n\
-         const LOCAL_LEN: u32 = {ll}u;\n{params}{kind}{chunk}{bindings}{stages}",
+         const LOCAL_LEN: u32 = {ll}u;\n{params}{kind}{chunk}{bindings}{stages}{features}",
         params = Params::WGSL,
         kind = Kind::WGSL,
         chunk = Chunk::WGSL,
         bindings = crate::bindings::declarations(),
         stages = STAGES.concat(),
+        features = crate::features::all(crate::features::On::default())
+            .iter()
+            .map(|f| f.wgsl())
+            .collect::<String>(),
         npt = plen.div_ceil(WG),
         paper = u32::from(kind == PressureKind::Paper),
         lp = u32::from(local),

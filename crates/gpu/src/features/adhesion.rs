@@ -18,6 +18,10 @@ impl Adhesion {
 }
 
 impl Feature for Adhesion {
+    fn wgsl(&self) -> &'static str {
+        include_str!("../wgsl/adhesion.wgsl")
+    }
+
     fn constant(&self) -> &'static str {
         "ADHESION"
     }

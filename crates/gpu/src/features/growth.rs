@@ -20,6 +20,10 @@ impl Growth {
 }
 
 impl Feature for Growth {
+    fn wgsl(&self) -> &'static str {
+        include_str!("../wgsl/growth.wgsl")
+    }
+
     fn constant(&self) -> &'static str {
         "GROWTH"
     }

@@ -1,9 +1,10 @@
 //! The extensions of the paper's model on the device, one module each behind one trait,
-//! [`Feature`]: the override constant that compiles it into the kernels, its buffers, its
-//! fields of the uniforms, the data it writes and reads back, the kernels of its own and the
-//! traffic it adds. [`GpuBackend`](crate::GpuBackend) holds them as a list ([`all`]) and asks
-//! each in turn; a new feature is a module here and its WGSL file (`wgsl/`), with its buffers
-//! in the binding table (`bindings.rs`) and its uniforms in [`Params`] or [`Kind`](crate::Kind).
+//! [`Feature`]: its WGSL, the override constant that compiles it into the kernels, its
+//! buffers, its fields of the uniforms, the data it writes and reads back, the kernels of its
+//! own and the traffic it adds. [`GpuBackend`](crate::GpuBackend) holds them as a list
+//! ([`all`]) and asks each in turn. A new feature is a module here, its WGSL file (`wgsl/`,
+//! which the module includes), an entry of [`all`], its buffers in the binding table
+//! (`bindings.rs`) and its uniforms in [`Params`] or [`Kind`](crate::Kind).
 
 mod adhesion;
 mod growth;
@@ -162,6 +163,10 @@ pub(crate) struct Host<'a> {
 
 /// One extension of the model on the device.
 pub(crate) trait Feature: Send {
+    /// Its WGSL (`wgsl/NAME.wgsl`): its override constant, its equations and its kernels,
+    /// joined to the stages' files in every module, whether it is on or not.
+    fn wgsl(&self) -> &'static str;
+
     /// The override constant that compiles it into the kernels (`WALLS`, …), 1 when on.
     fn constant(&self) -> &'static str;
 

@@ -46,6 +46,10 @@ fn angles(terms: &mechanics::terms::Terms) -> Vec<f64> {
 }
 
 impl Feature for Polarity {
+    fn wgsl(&self) -> &'static str {
+        include_str!("../wgsl/polarity.wgsl")
+    }
+
     fn constant(&self) -> &'static str {
         "POLARITY"
     }

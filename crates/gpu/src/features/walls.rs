@@ -20,6 +20,10 @@ impl Walls {
 }
 
 impl Feature for Walls {
+    fn wgsl(&self) -> &'static str {
+        include_str!("../wgsl/walls.wgsl")
+    }
+
     fn constant(&self) -> &'static str {
         "WALLS"
     }
