@@ -190,6 +190,60 @@ fn one_form(
         .collect();
     let density = by_value(zeta, pressure, &ZETAS, "defect_density")?;
     let rate = by_value(zeta, pressure, &ZETAS, "creation_rate")?;
+    against_zeta(made, pressure, &density, &rate);
+    let mut events = Events::default();
+    let mut time_csv = Csv::new(&[
+        "zeta",
+        "seed",
+        "time",
+        "n_plus",
+        "n_minus",
+        "defect_density",
+        "net_charge",
+    ]);
+    let mut pt = Plot::new(
+        format!("Defect density in time (seed 1, {pressure} pressure)"),
+        "time (TU)",
+        "±1/2 defects per node",
+    );
+    let mut pq = Plot::new(
+        format!("Net topological charge in time (every run, {pressure} pressure)"),
+        "time (TU)",
+        "net charge",
+    );
+    for &r in &recs {
+        events.add(p, r, &mut time_csv, [&mut pt, &mut pq])?;
+    }
+    made.add_table(format!("defects_in_time_{pressure}.csv"), time_csv);
+    made.add_plot(format!("defect_density_in_time_{pressure}.png"), pt);
+    made.add_plot(format!("net_charge_in_time_{pressure}.png"), pq);
+
+    // Where pairs are created: counts in BINS × BINS cells of the box.
+    let mut counts = [0usize; BINS * BINS];
+    for &(x, y) in &events.creations {
+        counts[bin(x, y)] += 1;
+    }
+    let correlations = map_correlations(&events.maps);
+    let (v_pairs, why_pairs) =
+        pairs_at_random_places(&events.fractions, &events.nulls, &correlations);
+    let mut pos_csv = Csv::new(&["bin_x", "bin_y", "creations"]);
+    for (k, c) in counts.iter().enumerate() {
+        pos_csv.row([cell(k / BINS), cell(k % BINS), cell(c)]);
+    }
+    made.add_table(format!("creation_positions_{pressure}.csv"), pos_csv);
+
+    Ok(events.claims(
+        pressure,
+        &density,
+        &rate,
+        &correlations,
+        (v_pairs, why_pairs),
+    ))
+}
+
+/// The defect density and the creation rate against ζ at one pressure form: their table and
+/// plots.
+fn against_zeta(made: &mut Made, pressure: &str, density: &[AtValue], rate: &[AtValue]) {
     let mut csv = Csv::new(&[
         "zeta",
         "defect_density",
@@ -198,7 +252,7 @@ fn one_form(
         "creation_rate_std",
         "seeds",
     ]);
-    for (d, r) in density.iter().zip(&rate) {
+    for (d, r) in density.iter().zip(rate) {
         csv.row([
             cell(d.0),
             sci(d.1 .0),
@@ -220,43 +274,59 @@ fn one_form(
         "activity ζ",
         "±1/2 defects per node",
     );
-    pd.series.push(series(&density, "defect density"));
+    pd.series.push(series(density, "defect density"));
     made.add_plot(format!("defect_density_vs_zeta_{pressure}.png"), pd);
     let mut pr = Plot::new(
         format!("Creation rate of defect pairs against ζ ({pressure} pressure)"),
         "activity ζ",
         "pair creations per node per TU",
     );
-    pr.series.push(series(&rate, "creation rate"));
+    pr.series.push(series(rate, "creation rate"));
     made.add_plot(format!("creation_rate_vs_zeta_{pressure}.png"), pr);
+}
 
-    // Over time, and the charge of every frame.
-    let mut time_csv = Csv::new(&[
-        "zeta",
-        "seed",
-        "time",
-        "n_plus",
-        "n_minus",
-        "defect_density",
-        "net_charge",
-    ]);
-    let mut pt = Plot::new(
-        format!("Defect density in time (seed 1, {pressure} pressure)"),
-        "time (TU)",
-        "±1/2 defects per node",
-    );
-    let mut pq = Plot::new(
-        format!("Net topological charge in time (every run, {pressure} pressure)"),
-        "time (TU)",
-        "net charge",
-    );
-    let (mut frames, mut charged, mut max_charge) = (0usize, 0usize, 0.0f64);
-    let (mut creations, mut unpaired) = (Vec::new(), 0.0f64);
-    // Per active run: paired fraction of births, its null expectation, bin counts of creations.
-    let (mut fractions, mut nulls, mut maps) = (Vec::new(), Vec::new(), Vec::new());
-    // The same for deaths: paired fraction of deaths (annihilations) and its null.
-    let (mut d_fractions, mut d_nulls, mut annihilations) = (Vec::new(), Vec::new(), 0usize);
-    for &r in &recs {
+/// What the frames and the defect events of one pressure form's runs add up to: the frames
+/// and those with a net charge, the pair creations and their places, the births and deaths
+/// without a partner, and per active run the paired fractions of births and deaths with their
+/// null expectations and the map of creations.
+#[derive(Default)]
+struct Events {
+    frames: usize,
+    charged: usize,
+    max_charge: f64,
+    creations: Vec<(f64, f64)>,
+    unpaired: f64,
+    fractions: Vec<f64>,
+    nulls: Vec<f64>,
+    maps: Vec<(u64, [f64; BINS * BINS])>,
+    d_fractions: Vec<f64>,
+    d_nulls: Vec<f64>,
+    annihilations: usize,
+}
+
+impl Events {
+    /// Adds the run `r`: its rows of the table in time, its series of the density (seed 1)
+    /// and net-charge plots, and its events.
+    fn add(
+        &mut self,
+        p: &ReproduceParams,
+        r: &Rec,
+        time_csv: &mut Csv,
+        [pt, pq]: [&mut Plot; 2],
+    ) -> Result<(), SweepError> {
+        let Self {
+            frames,
+            charged,
+            max_charge,
+            creations,
+            unpaired,
+            fractions,
+            nulls,
+            maps,
+            d_fractions,
+            d_nulls,
+            annihilations,
+        } = self;
         let t = Table::read(&r.run.join("analysis/observables.csv"))?;
         let (time, np, nm, dens, net, un) = (
             t.f64s("time")?,
@@ -276,13 +346,13 @@ fn one_form(
                 sci(dens[k]),
                 cell(net[k]),
             ]);
-            frames += 1;
+            *frames += 1;
             if net[k] != 0.0 {
-                charged += 1;
+                *charged += 1;
             }
-            max_charge = max_charge.max(net[k].abs());
+            *max_charge = max_charge.max(net[k].abs());
         }
-        unpaired += un.iter().filter(|x| x.is_finite()).sum::<f64>();
+        *unpaired += un.iter().filter(|x| x.is_finite()).sum::<f64>();
         if r.seed == p.scale.seeds().first {
             pt.series
                 .push(Series::new(format!("ζ = {}", r.values[1])).with_points(
@@ -312,7 +382,7 @@ fn one_form(
                     born += 1.0;
                 } else if kind[k] == "annihilation" {
                     ended += 1.0;
-                    annihilations += 1;
+                    *annihilations += 1;
                 }
             }
             let run_unpaired: f64 = un.iter().filter(|x| x.is_finite()).sum();
@@ -327,38 +397,47 @@ fn one_form(
             }
             maps.push((r.seed, map));
         }
+        Ok(())
     }
-    made.add_table(format!("defects_in_time_{pressure}.csv"), time_csv);
-    made.add_plot(format!("defect_density_in_time_{pressure}.png"), pt);
-    made.add_plot(format!("net_charge_in_time_{pressure}.png"), pq);
 
-    // Where pairs are created: counts in BINS × BINS cells of the box.
-    let mut counts = [0usize; BINS * BINS];
-    for &(x, y) in &creations {
-        counts[bin(x, y)] += 1;
-    }
-    let correlations = map_correlations(&maps);
-    let (v_pairs, why_pairs) = pairs_at_random_places(&fractions, &nulls, &correlations);
-    let mut pos_csv = Csv::new(&["bin_x", "bin_y", "creations"]);
-    for (k, c) in counts.iter().enumerate() {
-        pos_csv.row([cell(k / BINS), cell(k % BINS), cell(c)]);
-    }
-    made.add_table(format!("creation_positions_{pressure}.csv"), pos_csv);
-
-    let active: Vec<AtValue> = density.iter().filter(|d| d.0 > 0.0).cloned().collect();
-    let (vd, td) = trend(&density, 1.0);
-    let (va, ta) = trend(&active, 1.0);
-    let (vr, tr) = trend(
-        &rate
-            .iter()
-            .filter(|d| d.0 > 0.0)
-            .cloned()
-            .collect::<Vec<_>>(),
-        1.0,
-    );
-    let at_rest = density.first().map_or(f64::NAN, |d| d.1 .0);
-    let top = density.last().map_or(f64::NAN, |d| d.1 .0);
-    Ok(vec![
+    /// The claims of §9.5 at one pressure form.
+    fn claims(
+        &self,
+        pressure: &str,
+        density: &[AtValue],
+        rate: &[AtValue],
+        correlations: &[f64],
+        (v_pairs, why_pairs): (Verdict, String),
+    ) -> Vec<Claim> {
+        let Self {
+            frames,
+            charged,
+            max_charge,
+            creations,
+            unpaired,
+            fractions,
+            nulls,
+            d_fractions,
+            d_nulls,
+            annihilations,
+            ..
+        } = self;
+        let (frames, charged, max_charge, unpaired, annihilations) =
+            (*frames, *charged, *max_charge, *unpaired, *annihilations);
+        let active: Vec<AtValue> = density.iter().filter(|d| d.0 > 0.0).cloned().collect();
+        let (vd, td) = trend(density, 1.0);
+        let (va, ta) = trend(&active, 1.0);
+        let (vr, tr) = trend(
+            &rate
+                .iter()
+                .filter(|d| d.0 > 0.0)
+                .cloned()
+                .collect::<Vec<_>>(),
+            1.0,
+        );
+        let at_rest = density.first().map_or(f64::NAN, |d| d.1 .0);
+        let top = density.last().map_or(f64::NAN, |d| d.1 .0);
+        vec![
         Claim::new(
             format!("9.5 ({pressure} pressure): the total topological charge stays zero"),
             format!("{charged} of {frames} analysed frames have a non-zero net charge (largest |charge| {max_charge})"),
@@ -371,29 +450,29 @@ fn one_form(
                 "{} pair creations at ζ > 0, {} births or deaths without a partner within 2R; paired fraction of births {} ± {} (s.e. over {} runs) against {} ± {} for independent births at the same rate; creation maps ({BINS}×{BINS} bins) of two runs of different seeds correlate by r = {} ± {} (s.e. over {} pairs of runs, an underestimate, since the pairs share runs)",
                 creations.len(),
                 unpaired,
-                g(mean_se(&fractions).0),
-                g(mean_se(&fractions).1),
+                g(mean_se(fractions).0),
+                g(mean_se(fractions).1),
                 fractions.len(),
-                g(mean_se(&nulls).0),
-                g(mean_se(&nulls).1),
-                g(mean_se(&correlations).0),
-                g(mean_se(&correlations).1),
+                g(mean_se(nulls).0),
+                g(mean_se(nulls).1),
+                g(mean_se(correlations).0),
+                g(mean_se(correlations).1),
                 correlations.len()
             ),
             v_pairs,
             why_pairs,
         ),
         {
-            let (v, why) = annihilate_in_pairs(&d_fractions, &d_nulls);
+            let (v, why) = annihilate_in_pairs(d_fractions, d_nulls);
             Claim::new(
                 format!("9.5 ({pressure} pressure): ±1/2 defects annihilate in pairs"),
                 format!(
                     "{annihilations} pair annihilations at ζ > 0, {unpaired} births or deaths without a partner; paired fraction of deaths {} ± {} (s.e. over {} runs) against {} ± {} for independent deaths at the same rate",
-                    g(mean_se(&d_fractions).0),
-                    g(mean_se(&d_fractions).1),
+                    g(mean_se(d_fractions).0),
+                    g(mean_se(d_fractions).1),
                     d_fractions.len(),
-                    g(mean_se(&d_nulls).0),
-                    g(mean_se(&d_nulls).1),
+                    g(mean_se(d_nulls).0),
+                    g(mean_se(d_nulls).1),
                 ),
                 v,
                 why,
@@ -420,7 +499,8 @@ fn one_form(
                 Verdict::Inconclusive => "the change is within two standard errors",
             },
         ),
-    ])
+    ]
+    }
 }
 
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {

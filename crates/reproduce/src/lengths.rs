@@ -161,12 +161,8 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .copied()
         .filter(|z| z.parse::<f64>().unwrap_or(0.0) >= ACTIVE)
         .collect();
-
-    // The correlation curves, averaged over seeds, per ζ.
     let points = zeta.points(None)?;
-    let runs_of = |pressure: &str, z: &str| -> Vec<&Rec> {
-        point(&points, &[pressure, z]).map_or(Vec::new(), PointRuns::refs)
-    };
+    let box_side = analysis::smooth::paper_box_side(8.0) as f64;
     let mut made = Made::new(Vec::new(), String::new());
     let mut corr_csv = Csv::new(&[
         "pressure",
@@ -179,7 +175,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "c_q",
         "c_q_std",
     ]);
-    let box_side = analysis::smooth::paper_box_side(8.0) as f64;
     let mut claims = Vec::new();
     let mut csv_z = Csv::new(&["pressure", "zeta", "field", "length", "length_std", "seeds"]);
     let mut csv_g = Csv::new(&[
@@ -191,66 +186,129 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "seeds",
     ]);
     for pressure in PRESSURES {
-        let mut plots = [
-            Plot::new(
-                format!("Fig. 3a: vorticity autocorrelation ({pressure} pressure)"),
-                "r (nodes)",
-                "C_ω(r)",
-            ),
-            Plot::new(
-                format!("Velocity autocorrelation ({pressure} pressure)"),
-                "r (nodes)",
-                "C_v(r)",
-            ),
-            Plot::new(
-                format!("Q autocorrelation ({pressure} pressure)"),
-                "r (nodes)",
-                "C_Q(r)",
-            ),
-        ];
-        for pl in &mut plots {
-            pl.hlines.push((0.0, String::new()));
-            pl.legend = render::LegendAt::UpperRight;
-        }
-        for z in &active {
-            let runs = runs_of(pressure, z);
-            let cols = ["c_velocity", "c_vorticity", "c_q"];
-            let rows = column_stats(&runs, "analysis/correlations.csv", "r", &cols, 1)?;
-            if rows.is_empty() {
-                continue;
-            }
-            let r: Vec<f64> = rows.iter().map(|row| row.0).collect();
-            let mut stats = vec![Vec::new(); 3];
-            for (rk, st) in &rows {
-                corr_csv.row(
-                    [cell(pressure), cell(z), cell(rk)]
-                        .into_iter()
-                        .chain(st.iter().flat_map(|s| [sci(s.0), sci(s.1)])),
-                );
-                for (c, s) in st.iter().enumerate() {
-                    stats[c].push(*s);
-                }
-            }
-            // Out to r = 50 (a quarter of the box): the minimum sits well inside.
-            let n = r.len().min(51);
-            for (pl, c) in plots.iter_mut().zip([1, 0, 2]) {
-                let m: Vec<f64> = stats[c][..n].iter().map(|s| s.0).collect();
-                let e: Vec<f64> = stats[c][..n]
-                    .iter()
-                    .enumerate()
-                    .map(|(k, s)| if k % 5 == 0 { s.1 } else { 0.0 })
-                    .collect();
-                pl.series
-                    .push(Series::new(format!("ζ = {z}")).with_points(&r[..n], &m, &e));
-            }
-        }
-        let [c_vorticity, c_velocity, c_q] = plots;
+        let [c_vorticity, c_velocity, c_q] =
+            correlation_plots(&points, pressure, &active, &mut corr_csv)?;
         made = made
             .plot(format!("fig3a_c_vorticity_{pressure}.png"), c_vorticity)
             .plot(format!("c_velocity_{pressure}.png"), c_velocity)
             .plot(format!("c_q_{pressure}.png"), c_q);
+        let lengths = Lengths {
+            zeta: &zeta,
+            gamma: &gamma,
+            active: &active,
+            box_side,
+        };
+        let (pz, pg) = lengths.plots(pressure, [&mut csv_z, &mut csv_g], &mut claims)?;
+        made = made
+            .plot(format!("fig3b_lengths_vs_zeta_{pressure}.png"), pz)
+            .plot(format!("fig3c_lengths_vs_gamma_{pressure}.png"), pg);
+    }
+    made = made.table("net_flow.csv", net_flows(p, &points, &active, &mut claims)?);
+    let (v_csv, v_plots) = v_rms_raw_smooth(&points)?;
+    for (name, plot) in v_plots {
+        made = made.plot(name, plot);
+    }
+    made = made
+        .table("v_rms_raw_smooth.csv", v_csv)
+        .table("correlations.csv", corr_csv)
+        .table("lengths_vs_zeta.csv", csv_z)
+        .table("lengths_vs_gamma.csv", csv_g);
+    made.claims = claims;
+    made.settings = settings(p, box_side);
+    Ok(made)
+}
 
-        // The lengths against ζ and γ.
+/// The runs of the ζ sweep at one pressure form and activity.
+fn runs_of<'a>(points: &'a [PointRuns], pressure: &str, z: &str) -> Vec<&'a Rec> {
+    point(points, &[pressure, z]).map_or(Vec::new(), PointRuns::refs)
+}
+
+/// The correlation curves of one pressure form, averaged over seeds, per ζ of `active`
+/// (rows into `corr_csv`): the vorticity's (Fig. 3a), the velocity's and Q's.
+fn correlation_plots(
+    points: &[PointRuns],
+    pressure: &str,
+    active: &[&str],
+    corr_csv: &mut Csv,
+) -> Result<[Plot; 3], SweepError> {
+    let mut plots = [
+        Plot::new(
+            format!("Fig. 3a: vorticity autocorrelation ({pressure} pressure)"),
+            "r (nodes)",
+            "C_ω(r)",
+        ),
+        Plot::new(
+            format!("Velocity autocorrelation ({pressure} pressure)"),
+            "r (nodes)",
+            "C_v(r)",
+        ),
+        Plot::new(
+            format!("Q autocorrelation ({pressure} pressure)"),
+            "r (nodes)",
+            "C_Q(r)",
+        ),
+    ];
+    for pl in &mut plots {
+        pl.hlines.push((0.0, String::new()));
+        pl.legend = render::LegendAt::UpperRight;
+    }
+    for z in active {
+        let runs = runs_of(points, pressure, z);
+        let cols = ["c_velocity", "c_vorticity", "c_q"];
+        let rows = column_stats(&runs, "analysis/correlations.csv", "r", &cols, 1)?;
+        if rows.is_empty() {
+            continue;
+        }
+        let r: Vec<f64> = rows.iter().map(|row| row.0).collect();
+        let mut stats = vec![Vec::new(); 3];
+        for (rk, st) in &rows {
+            corr_csv.row(
+                [cell(pressure), cell(z), cell(rk)]
+                    .into_iter()
+                    .chain(st.iter().flat_map(|s| [sci(s.0), sci(s.1)])),
+            );
+            for (c, s) in st.iter().enumerate() {
+                stats[c].push(*s);
+            }
+        }
+        // Out to r = 50 (a quarter of the box): the minimum sits well inside.
+        let n = r.len().min(51);
+        for (pl, c) in plots.iter_mut().zip([1, 0, 2]) {
+            let m: Vec<f64> = stats[c][..n].iter().map(|s| s.0).collect();
+            let e: Vec<f64> = stats[c][..n]
+                .iter()
+                .enumerate()
+                .map(|(k, s)| if k % 5 == 0 { s.1 } else { 0.0 })
+                .collect();
+            pl.series
+                .push(Series::new(format!("ζ = {z}")).with_points(&r[..n], &m, &e));
+        }
+    }
+    Ok(plots)
+}
+
+/// The correlation lengths against ζ and γ.
+struct Lengths<'a> {
+    zeta: &'a SweepResult,
+    gamma: &'a SweepResult,
+    active: &'a [&'a str],
+    box_side: f64,
+}
+
+impl Lengths<'_> {
+    /// Fig. 3b and 3c at one pressure form, with their rows (`[ζ, γ]`) and claims.
+    fn plots(
+        &self,
+        pressure: &str,
+        [csv_z, csv_g]: [&mut Csv; 2],
+        claims: &mut Vec<Claim>,
+    ) -> Result<(Plot, Plot), SweepError> {
+        let Self {
+            zeta,
+            gamma,
+            active,
+            box_side,
+        } = *self;
         let mut pz = Plot::new(
             format!("Fig. 3b: correlation lengths against ζ (γ = 0.01, {pressure} pressure)"),
             "activity ζ",
@@ -266,9 +324,9 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         pg.hlines
             .push((box_side, format!("smoothing box side {box_side}")));
         for (name, col) in FIELDS {
-            let lz = by_value(&zeta, pressure, &active, col)?;
-            let lg = by_value(&gamma, pressure, &GAMMAS, col)?;
-            for (csv, pts) in [(&mut csv_z, &lz), (&mut csv_g, &lg)] {
+            let lz = by_value(zeta, pressure, active, col)?;
+            let lg = by_value(gamma, pressure, &GAMMAS, col)?;
+            for (csv, pts) in [(&mut *csv_z, &lz), (&mut *csv_g, &lg)] {
                 for (x, (m, s), n) in pts {
                     csv.row([
                         cell(pressure),
@@ -323,12 +381,19 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             reason(vg, "grows"),
         ));
         }
-        made = made
-            .plot(format!("fig3b_lengths_vs_zeta_{pressure}.png"), pz)
-            .plot(format!("fig3c_lengths_vs_gamma_{pressure}.png"), pg);
+        Ok((pz, pg))
     }
-    // No net flow of the whole tissue: the mean cell velocity U(t) = ⟨v_i⟩ over the frames of
-    // the second half, against the cell speed.
+}
+
+/// No net flow of the whole tissue: the mean cell velocity `U(t) = ⟨v_i⟩` over the frames of
+/// the second half, against the cell speed, per run (the table) and per pressure form (a
+/// claim each).
+fn net_flows(
+    p: &ReproduceParams,
+    points: &[PointRuns],
+    active: &[&str],
+    claims: &mut Vec<Claim>,
+) -> Result<Csv, SweepError> {
     let (_, from) = times(p.scale);
     let mut flow_csv = Csv::new(&[
         "pressure",
@@ -342,8 +407,8 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     for pressure in PRESSURES {
         let mut ratios = Vec::new();
         let mut cells = 0usize;
-        for z in &active {
-            for r in runs_of(pressure, z) {
+        for z in active {
+            for r in runs_of(points, pressure, z) {
                 let (u, speed, n) = net_flow(&r.run, from)?;
                 cells = n;
                 flow_csv.row([
@@ -370,9 +435,14 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             why,
         ));
     }
-    made = made.table("net_flow.csv", flow_csv);
-    // Fig. 2a at L = 200 as the paper draws it: v_rms of the raw flow and of the flow smoothed
-    // over the 3R box, time means over the analysed frames, against ζ.
+    Ok(flow_csv)
+}
+
+/// Fig. 2a at L = 200 as the paper draws it: v_rms of the raw flow and of the flow smoothed
+/// over the 3R box, time means over the analysed frames, against ζ: the table and a plot per
+/// pressure form (where any value is positive).
+fn v_rms_raw_smooth(points: &[PointRuns]) -> Result<(Csv, Vec<(String, Plot)>), SweepError> {
+    let mut plots = Vec::new();
     let mut v_csv = Csv::new(&[
         "pressure",
         "zeta",
@@ -391,7 +461,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         plot.log_y = true;
         let (mut zs, mut raw, mut smooth) = (Vec::new(), Vec::new(), Vec::new());
         for z in ZETAS {
-            let runs = runs_of(pressure, z);
+            let runs = runs_of(points, pressure, z);
             let (mut a, mut b) = (Vec::new(), Vec::new());
             for run in &runs {
                 let t = super::Table::read(&run.run.join("analysis/observables.csv"))?;
@@ -430,16 +500,16 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             .iter()
             .any(|s| s.points.iter().any(|p| p.1 > 0.0))
         {
-            made = made.plot(format!("fig2a_v_rms_raw_smooth_{pressure}.png"), plot);
+            plots.push((format!("fig2a_v_rms_raw_smooth_{pressure}.png"), plot));
         }
     }
-    made = made
-        .table("v_rms_raw_smooth.csv", v_csv)
-        .table("correlations.csv", corr_csv)
-        .table("lengths_vs_zeta.csv", csv_z)
-        .table("lengths_vs_gamma.csv", csv_g);
+    Ok((v_csv, plots))
+}
+
+/// The figure's settings, for its verdict.
+fn settings(p: &ReproduceParams, box_side: f64) -> String {
     let (t, from) = times(p.scale);
-    let settings = format!(
+    format!(
         "- Paper scene on L = 200 (240 cells, as the paper's Fig. 2a), both pressure forms. ζ sweep at γ = 0.01: ζ ∈ {{{}}} (lengths for ζ ≥ {ACTIVE}); γ sweep at ζ = {ZETA_OF_GAMMA_SWEEP}: γ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {}; a frame every 10 TU, analysed from t = {from} (the second half of the active phase).\n\
          - `monolayer analyze` on every run: v, ω and Q smoothed with a periodic {box_side}×{box_side} box (3R), their autocorrelations averaged over the frames; a length is the first minimum of the radially averaged correlation.\n\
@@ -450,10 +520,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         GAMMAS.join(", "),
         p.scale.seeds(),
         p.scale.integrator_name()
-    );
-    made.claims = claims;
-    made.settings = settings;
-    Ok(made)
+    )
 }
 
 /// The net flow of a run: `|⟨U⟩_t|`, the time mean over the frames at `t ≥ from` of the mean
