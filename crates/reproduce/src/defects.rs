@@ -425,9 +425,8 @@ impl Events {
         let (frames, charged, max_charge, unpaired, annihilations) =
             (*frames, *charged, *max_charge, *unpaired, *annihilations);
         let active: Vec<AtValue> = density.iter().filter(|d| d.0 > 0.0).cloned().collect();
-        let (vd, td) = trend(density, 1.0);
-        let (va, ta) = trend(&active, 1.0);
-        let (vr, tr) = trend(
+        let (td, ta) = (trend(density, 1.0), trend(&active, 1.0));
+        let tr = trend(
             &rate
                 .iter()
                 .filter(|d| d.0 > 0.0)
@@ -480,24 +479,20 @@ impl Events {
         },
         Claim::new(
             format!("9.5 ({pressure} pressure): the defect density grows with ζ"),
-            format!("ζ from 0: {td}; among ζ > 0: {ta}; at rest {} of the largest density is already there", g(at_rest / top)),
-            if vd == Verdict::Holds && va == Verdict::Holds { Verdict::Holds } else if vd == Verdict::DoesNotHold { Verdict::DoesNotHold } else { Verdict::Inconclusive },
-            match (vd, va) {
-                (Verdict::Holds, Verdict::Holds) => "it grows by more than two standard errors, from rest and among active runs".to_string(),
-                (Verdict::Holds, _) => "it grows from rest to the largest ζ, but among active runs the change is within two standard errors: most defects are already there at rest".to_string(),
-                (Verdict::DoesNotHold, _) => "it falls from rest to the largest ζ by more than two standard errors: the defects of the smoothed Q are mostly there at rest, and activity orders the tissue".to_string(),
-                _ => "the change is not beyond two standard errors".to_string(),
-            },
+            format!(
+                "ζ from 0: {}; among ζ > 0: {}; at rest {} of the largest density is already there",
+                td.measured,
+                ta.measured,
+                g(at_rest / top)
+            ),
+            td.verdict,
+            format!("from rest to the largest ζ: {}", td.why),
         ),
         Claim::new(
             format!("9.5 ({pressure} pressure): the creation rate grows with ζ"),
-            format!("among ζ > 0: {tr}"),
-            vr,
-            match vr {
-                Verdict::Holds => "it grows by more than two standard errors",
-                Verdict::DoesNotHold => "it falls by more than two standard errors",
-                Verdict::Inconclusive => "the change is within two standard errors",
-            },
+            format!("among ζ > 0: {}", tr.measured),
+            tr.verdict,
+            tr.why,
         ),
     ]
     }

@@ -62,35 +62,33 @@ fn seeds(scale: Scale) -> study::Seeds {
 }
 
 /// The verdict on "extrusions concentrate at the defects" from the per-seed means of
-/// `d − d_random`: holds when their mean plus two standard errors is below zero (closer than
-/// random points); does not hold when their mean less two standard errors is above
-/// −[`MATERIAL`] (an attraction of a quarter radius is excluded); inconclusive otherwise (and
-/// with fewer than two seeds).
+/// `d − d_random`, by the rule of an effect ([`super::rule::Rule::effect`]): the effect is how
+/// much closer to the defects than random points of the tissue the extrusions are, `−(d −
+/// d_random)`, over seeds, and the smallest that counts is [`MATERIAL`] (a quarter radius).
+/// Holds when it is resolved by two standard errors and at least that; does not hold when it
+/// is below that by two standard errors; inconclusive otherwise (and with fewer than two
+/// seeds). (The rule before issue 54 read "holds" and "does not hold" at once on
+/// −0.28 ± 0.14 nodes; now that reads "does not hold".)
 pub(crate) fn verdict(per_seed: &[f64]) -> (Verdict, String) {
     let (m, se) = mean_se(per_seed);
-    let what = format!(
+    let n = per_seed.iter().filter(|v| v.is_finite()).count();
+    let rule = super::rule::Rule::effect(
+        format!("d_random − d, how much closer to the defects than random points, over {n} seeds (nodes)"),
+        MATERIAL,
+    );
+    let o = rule.decide(-m, se);
+    (o.verdict, o.why)
+}
+
+/// The statistic of a rule: `d − d_random`, mean ± s.e. over the seeds.
+fn stat(per_seed: &[f64]) -> String {
+    let (m, se) = mean_se(per_seed);
+    format!(
         "d − d_random = {} ± {} nodes over {} seeds",
         g(m),
         g(se),
         per_seed.iter().filter(|v| v.is_finite()).count()
-    );
-    if !se.is_finite() {
-        (Verdict::Inconclusive, format!("{what}: too few seeds"))
-    } else if m + 2.0 * se < 0.0 {
-        (
-            Verdict::Holds,
-            format!(
-                "{what}: closer than random points of the tissue by more than two standard errors"
-            ),
-        )
-    } else if m - 2.0 * se > -MATERIAL {
-        (
-            Verdict::DoesNotHold,
-            format!("{what}: an attraction of {MATERIAL} nodes (R/4) or more is excluded by two standard errors"),
-        )
-    } else {
-        (Verdict::Inconclusive, what)
-    }
+    )
 }
 
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
@@ -165,21 +163,21 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         let n = mean_se(&counts);
         claims.push(Claim::new(
             format!("extrusion (issue 41), {rule} rule: extruded cells are found at +½ defects (Saw et al. 2017)"),
-            format!("{} extrusions per run (mean over seeds); {wp}", g(n.0)),
+            format!("{} extrusions per run (mean over seeds); {}", g(n.0), stat(&plus)),
             vp,
-            wp.clone(),
+            wp,
         ));
         claims.push(Claim::new(
             format!("extrusion, {rule} rule: extruded cells are found at −½ defects"),
-            format!("{} extrusions per run; {wm}", g(n.0)),
+            format!("{} extrusions per run; {}", g(n.0), stat(&minus)),
             vm,
-            wm.clone(),
+            wm,
         ));
     }
     let settings = format!(
         "- The paper's tissue (60 cells, R = 8, periodic 100², γ = 0.01, paper form) at ζ = 0.01 (active turbulence), with `[division] cycle_time = 300`, `growth_time = 50` and an extrusion rule: the stress-based rule `extrusion_pressure = 0.04` (a cell whose pressure p_i = Σφ_i P/Σφ_i, the isotropic stress at the cell, rises above it; the relaxed tissue's pressures are 0.005–0.013) or the area rule `extrusion = 0.3` (a cell below 30 % of its target area); seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; dt = {}; frames every 10 TU, analysed; at these settings the cell count holds at about 53 (pressure rule) and 86 (area rule) instead of growing to the cap.\n\
-         - Statistic: for each extrusion, `d₊ − d₊,random` (and `d₋ − d₋,random`): its distance to the nearest +½ (−½) defect of the frame nearest in time, less the mean distance of a point of that frame's tissue (`analysis/cell_events.csv`); its mean over a run's extrusions, then mean ± standard error over seeds. Rule: holds when the mean plus two standard errors is below 0 (closer than random); does not hold when the mean less two standard errors is above −{MATERIAL} nodes (an attraction of a quarter radius is excluded); inconclusive otherwise.\n\
+         - Statistic: for each extrusion, `d₊ − d₊,random` (and `d₋ − d₋,random`): its distance to the nearest +½ (−½) defect of the frame nearest in time, less the mean distance of a point of that frame's tissue (`analysis/cell_events.csv`); its mean over a run's extrusions, then mean ± standard error over seeds. Rule (issue 54's rule of an effect): the effect is how much closer than random the extrusions are, `−(d − d_random)`, and the smallest that counts is {MATERIAL} nodes (a quarter radius); holds when it is resolved by two standard errors and at least that, does not hold when it is below that by two standard errors, inconclusive otherwise.\n\
          - Data: `extrusion.csv` (each run: extrusions, divisions, the two excesses, the final cell count).",
         seeds(p.scale),
         p.scale.own_dt(),
@@ -201,6 +199,15 @@ mod tests {
         assert_eq!(verdict(&[2.0, 2.5, 1.5]).0, Verdict::DoesNotHold);
         // Seeds scattered over ±5 nodes: inconclusive.
         assert_eq!(verdict(&[-5.0, 4.0, -3.0, 3.0]).0, Verdict::Inconclusive);
+        // Issue 54's case, −0.28 ± 0.14 nodes: closer by two standard errors, but by less
+        // than a quarter radius, which that excludes: "does not hold", and only that.
+        let case = [-0.14, -0.42, -0.28, -0.56, 0.0];
+        let (m, se) = mean_se(&case);
+        assert!(
+            (m + 0.28).abs() < 1e-12 && (se - 0.0989949).abs() < 1e-6,
+            "{m} {se}"
+        );
+        assert_eq!(verdict(&case).0, Verdict::DoesNotHold);
         // NaN seeds (no extrusion) are left out; one seed left: inconclusive.
         assert_eq!(verdict(&[f64::NAN, -4.0]).0, Verdict::Inconclusive);
     }

@@ -111,15 +111,40 @@ pub(super) fn by_value(
         .collect())
 }
 
+/// The smallest change across a range that counts, as a fraction of the first value: 10 %.
+pub(super) const SMALLEST_CHANGE: f64 = 0.1;
+
+/// A quantity's change across an axis, judged by the rule of an effect
+/// ([`super::rule::Rule::effect`]).
+pub(super) struct Trend {
+    pub verdict: Verdict,
+    /// The statistic: the first and last values, the change with its error, the slope.
+    pub measured: String,
+    /// The rule's reading.
+    pub why: String,
+}
+
 /// Whether a quantity moves with the axis in the expected direction (`sign` ±1), from its
-/// first to its last point: more than two standard errors either way decides.
-pub(super) fn trend(pts: &[AtValue], sign: f64) -> (Verdict, String) {
+/// first to its last point: the change, in the claim's direction, with the standard error of
+/// the difference of the two means, against the smallest change that counts,
+/// [`SMALLEST_CHANGE`] of the first value. Holds when the change is resolved by two standard
+/// errors and at least that; does not hold when it is below that by two standard errors (no
+/// change of that size, or a change the other way); inconclusive otherwise.
+pub(super) fn trend(pts: &[AtValue], sign: f64) -> Trend {
     let pts: Vec<&AtValue> = pts.iter().filter(|p| p.1 .0.is_finite()).collect();
     let (Some(a), Some(b)) = (pts.first(), pts.last()) else {
-        return (Verdict::Inconclusive, "no finite value".into());
+        return Trend {
+            verdict: Verdict::Inconclusive,
+            measured: "no finite value".into(),
+            why: "not measured".into(),
+        };
     };
     if pts.len() < 2 {
-        return (Verdict::Inconclusive, "a single point".into());
+        return Trend {
+            verdict: Verdict::Inconclusive,
+            measured: "a single point".into(),
+            why: "a change needs two points".into(),
+        };
     }
     let se = |p: &AtValue| p.1 .1 / (p.2.max(1) as f64).sqrt();
     let d = b.1 .0 - a.1 .0;
@@ -127,7 +152,7 @@ pub(super) fn trend(pts: &[AtValue], sign: f64) -> (Verdict, String) {
     let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
     let y: Vec<f64> = pts.iter().map(|p| p.1 .0).collect();
     let slope = study::summary::slope(&x, &y);
-    let text = format!(
+    let measured = format!(
         "from {} at {} to {} at {} (change {} ± {} s.e.; slope {})",
         g(a.1 .0),
         a.0,
@@ -137,14 +162,20 @@ pub(super) fn trend(pts: &[AtValue], sign: f64) -> (Verdict, String) {
         g(err),
         g(slope)
     );
-    let v = if sign * d > 2.0 * err {
-        Verdict::Holds
-    } else if sign * d < -2.0 * err {
-        Verdict::DoesNotHold
-    } else {
-        Verdict::Inconclusive
-    };
-    (v, text)
+    let rule = super::rule::Rule::effect(
+        if sign > 0.0 { "the rise" } else { "the fall" },
+        SMALLEST_CHANGE * a.1 .0.abs(),
+    );
+    let o = rule.decide(sign * d, err);
+    Trend {
+        verdict: o.verdict,
+        measured,
+        why: format!(
+            "{} ({} % of the first value counts)",
+            o.why,
+            g(100.0 * SMALLEST_CHANGE)
+        ),
+    }
 }
 
 const FIELDS: [(&str, &str); 3] = [
@@ -346,8 +377,7 @@ impl Lengths<'_> {
             };
             pz.series.push(series(&lz));
             pg.series.push(series(&lg));
-            let (vz, tz) = trend(&lz, -1.0);
-            let (vg, tg) = trend(&lg, 1.0);
+            let (tz, tg) = (trend(&lz, -1.0), trend(&lg, 1.0));
             let floor = |pts: &[AtValue]| {
                 pts.iter()
                     .map(|p| p.1 .0)
@@ -355,31 +385,26 @@ impl Lengths<'_> {
                     .fold(f64::INFINITY, f64::min)
                     / box_side
             };
-            let reason = |v: Verdict, what: &str| {
-                match v {
-            Verdict::Holds => format!("it {what} by more than two standard errors"),
-            Verdict::DoesNotHold => "it moves against the claim by more than two standard errors".to_string(),
-            Verdict::Inconclusive => format!("the change is within two standard errors: it neither clearly {what} nor the opposite"),
-        }
-            };
             claims.push(Claim::new(
-            format!("9.4 ({pressure} pressure): the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})"),
-            format!(
-                "{tz}; the shortest is {}× the smoothing box ({box_side})",
-                g(floor(&lz))
-            ),
-            vz,
-            reason(vz, "shrinks"),
-        ));
+                format!("9.4 ({pressure} pressure): the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})"),
+                format!(
+                    "{}; the shortest is {}× the smoothing box ({box_side})",
+                    tz.measured,
+                    g(floor(&lz))
+                ),
+                tz.verdict,
+                tz.why,
+            ));
             claims.push(Claim::new(
-            format!("9.4 ({pressure} pressure): the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
-            format!(
-                "{tg}; the shortest is {}× the smoothing box ({box_side})",
-                g(floor(&lg))
-            ),
-            vg,
-            reason(vg, "grows"),
-        ));
+                format!("9.4 ({pressure} pressure): the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
+                format!(
+                    "{}; the shortest is {}× the smoothing box ({box_side})",
+                    tg.measured,
+                    g(floor(&lg))
+                ),
+                tg.verdict,
+                tg.why,
+            ));
         }
         Ok((pz, pg))
     }
@@ -570,8 +595,10 @@ fn net_flow(run: &Path, from: f64) -> Result<(f64, f64, usize), SweepError> {
 
 /// No net flow: the ratios `|⟨U⟩_t| / v_cell` of the runs, against `1/√N`, the size of the mean of
 /// N independent cell velocities at one instant (a time mean of uncorrelated frames would be
-/// smaller still). Holds when mean + 2 s.e. of the ratios lies below `1/√N`; does not hold when
-/// mean − 2 s.e. lies above it; inconclusive otherwise.
+/// smaller still), by the rule of an absence ([`super::rule::Rule::absence`]) with `1/√N` the
+/// smallest net flow that counts: holds when mean + 2 s.e. of the ratios lies below `1/√N`; does
+/// not hold when the mean is resolved (mean − 2 s.e. > 0) and at least `1/√N`; inconclusive
+/// otherwise.
 fn rule_net_flow(ratios: &[f64], cells: usize) -> (Verdict, String) {
     let (m, se) = super::mean_se(ratios);
     if ratios.len() < 2 || cells == 0 || !m.is_finite() {
@@ -581,25 +608,14 @@ fn rule_net_flow(ratios: &[f64], cells: usize) -> (Verdict, String) {
         );
     }
     let bound = 1.0 / (cells as f64).sqrt();
-    let what = format!(
-        "mean {} ± {} s.e. against 1/√N = {} (N = {cells})",
-        g(m),
-        g(se),
-        g(bound)
+    let rule = super::rule::Rule::absence(
+        format!(
+            "|⟨U⟩_t| / v_cell, against 1/√N (N = {cells}), the mean of N independent velocities"
+        ),
+        bound,
     );
-    if m + 2.0 * se < bound {
-        (
-            Verdict::Holds,
-            format!("{what}: below the mean of N independent velocities"),
-        )
-    } else if m - 2.0 * se > bound {
-        (
-            Verdict::DoesNotHold,
-            format!("{what}: a net flow above what independent cells give"),
-        )
-    } else {
-        (Verdict::Inconclusive, what)
-    }
+    let o = rule.decide(m, se);
+    (o.verdict, o.why)
 }
 
 #[cfg(test)]
@@ -620,16 +636,25 @@ mod tests {
         assert_eq!(rule_net_flow(&[0.01], 240).0, Verdict::Inconclusive);
     }
 
-    /// A change of more than two standard errors in the claimed direction holds, against it
-    /// does not, and within them is inconclusive.
+    /// A change resolved by two standard errors and at least 10 % in the claimed direction
+    /// holds; one resolved below 10 % (or against the claim) does not; the rest is
+    /// inconclusive.
     #[test]
     fn trends_are_judged_by_their_standard_error() {
         // std 0.3 over 9 seeds: standard error 0.1 at each end, 0.14 for the change.
+        // The smallest change that counts is 10 % of the first value, 1.
         let pts = |d: f64| vec![(0.0, (10.0, 0.3), 9), (1.0, (10.0 + d, 0.3), 9)];
-        assert_eq!(trend(&pts(-0.5), -1.0).0, Verdict::Holds);
-        assert_eq!(trend(&pts(0.5), -1.0).0, Verdict::DoesNotHold);
-        assert_eq!(trend(&pts(0.2), -1.0).0, Verdict::Inconclusive);
-        assert_eq!(trend(&pts(0.5), 1.0).0, Verdict::Holds);
-        assert_eq!(trend(&[(0.0, (1.0, 0.1), 3)], 1.0).0, Verdict::Inconclusive);
+        assert_eq!(trend(&pts(-1.5), -1.0).verdict, Verdict::Holds);
+        assert_eq!(trend(&pts(1.5), 1.0).verdict, Verdict::Holds);
+        // Against the claim, resolved: does not hold.
+        assert_eq!(trend(&pts(0.5), -1.0).verdict, Verdict::DoesNotHold);
+        // Resolved, but smaller than 10 % by two standard errors: does not hold.
+        assert_eq!(trend(&pts(-0.5), -1.0).verdict, Verdict::DoesNotHold);
+        // Neither: a change of 10 % within two standard errors.
+        assert_eq!(trend(&pts(-0.9), -1.0).verdict, Verdict::Inconclusive);
+        assert_eq!(
+            trend(&[(0.0, (1.0, 0.1), 3)], 1.0).verdict,
+            Verdict::Inconclusive
+        );
     }
 }

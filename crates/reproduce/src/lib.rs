@@ -21,6 +21,7 @@ mod jamming;
 mod lengths;
 mod pipeline;
 mod rotation;
+mod rule;
 mod rules;
 mod run_length;
 mod scaling;
