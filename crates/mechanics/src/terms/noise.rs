@@ -6,7 +6,7 @@
 //! The generator is Philox4x32-10 (Salmon, Moraes, Dror & Shaw, "Parallel random numbers:
 //! as easy as 1, 2, 3", SC 2011; the generator of cuRAND and Random123), which needs only
 //! 32-bit integer arithmetic: the GPU backend draws the same numbers with the same function
-//! in WGSL (`gpu`'s `step.wgsl`), so that both backends give a cell the same noise. It maps a
+//! in WGSL (`gpu`'s `wgsl/polarity.wgsl`), so that both backends give a cell the same noise. It maps a
 //! 128-bit counter and a 64-bit key to four 32-bit words through ten rounds of two 32 × 32 →
 //! 64-bit products, and passes the BigCrush battery on every one of its outputs.
 //!
