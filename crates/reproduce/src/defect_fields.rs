@@ -464,11 +464,13 @@ fn settings(p: &ReproduceParams, t: f64, from: f64) -> String {
 }
 
 /// The verdict on "a +½ defect self-propels along its axis, towards its head" from each run's
-/// mean core velocity along the axis `vu` (positive towards the tail, `∇·Q`) and across it `vv`.
-/// Holds when `vu` is negative by more than two standard errors over runs and its mean is more
-/// than 3× the mean `|vv|`; does not hold when it is positive by more than two s.e. (towards the
-/// tail: contractile behaviour), or when it is clear of 0 but not 3× the crossing speed
-/// (the motion is not along the axis); inconclusive otherwise, and with fewer than two runs.
+/// mean core velocity along the axis `vu` (positive towards the tail, `∇·Q`) and across it `vv`,
+/// by the rule of an effect ([`super::rule::Rule::effect`]): the effect is the mean core speed
+/// towards the head, `−⟨vu⟩` over runs, and the smallest that counts is 3× the mean speed
+/// across the axis, `3 |⟨vv⟩|` (motion along the axis). Holds when the effect is resolved by two
+/// standard errors and at least that; does not hold when it is below that by two standard
+/// errors (towards the tail, as a contractile defect, or not along the axis); inconclusive
+/// otherwise, and with fewer than two runs.
 fn propulsion(vu: &[f64], vv: &[f64]) -> (Verdict, String) {
     if vu.len() < 2 {
         return (
@@ -478,21 +480,12 @@ fn propulsion(vu: &[f64], vv: &[f64]) -> (Verdict, String) {
     }
     let (mu, se) = mean_se(vu);
     let (mv, _) = mean_std(vv);
-    let clear = mu.abs() > 2.0 * se;
-    let along = mu.abs() > 3.0 * mv.abs();
-    let (v, why) = if clear && mu > 0.0 {
-        (Verdict::DoesNotHold, "the core moves towards the tail (+∇·Q) by more than two standard errors, as a contractile defect would")
-    } else if clear && !along {
-        (Verdict::DoesNotHold, "the core velocity along the axis is clear of 0 but not 3× the one across it: the motion is not along the axis")
-    } else if clear {
-        (Verdict::Holds, "the core moves towards the head (−∇·Q) by more than two standard errors over runs, more than 3× faster than across the axis")
-    } else {
-        (
-            Verdict::Inconclusive,
-            "the core velocity along the axis is within two standard errors of 0",
-        )
-    };
-    (v, why.to_string())
+    let rule = super::rule::Rule::effect(
+        "the core speed towards the head, −⟨v_u⟩ over runs, against 3× the speed across the axis",
+        (3.0 * mv.abs()).max(f64::MIN_POSITIVE),
+    );
+    let o = rule.decide(-mu, se);
+    (o.verdict, o.why)
 }
 
 /// The vorticity `∂_u v_v − ∂_v v_u` of a crop at `(u, v)`, by central differences two nodes
@@ -503,9 +496,11 @@ fn vorticity_at(vu: &[f64], vv: &[f64], u: f64, v: f64) -> f64 {
 }
 
 /// No drift of the −½ core: per-run core velocities `du` (along an arm) and `dv` (across), against
-/// the +½ core speed `plus`. Holds when both components are within two s.e. of 0 and the mean
-/// −½ core speed is under a quarter of `plus`; does not hold when a component is clear of 0 by
-/// two s.e. and the speed exceeds a quarter of `plus`; inconclusive otherwise.
+/// the +½ core speed `plus`, by the rule of an absence ([`super::rule::Rule::absence`]): the
+/// effect is the mean core speed `|(⟨du⟩, ⟨dv⟩)|` with its standard error (propagated from the
+/// two components'), and the smallest drift that counts is a quarter of `plus`. Holds when the
+/// speed is below that by two standard errors; does not hold when it is resolved and at least
+/// that; inconclusive otherwise, and with fewer than two runs.
 fn no_drift(du: &[f64], dv: &[f64], plus: f64) -> (Verdict, String) {
     if du.len() < 2 {
         return (
@@ -516,26 +511,25 @@ fn no_drift(du: &[f64], dv: &[f64], plus: f64) -> (Verdict, String) {
     let (mu, su) = mean_se(du);
     let (mv, sv) = mean_se(dv);
     let speed = mu.hypot(mv);
-    let clear = mu.abs() > 2.0 * su || mv.abs() > 2.0 * sv;
-    let what = format!(
-        "mean core velocity ({} ± {}, {} ± {}) s.e., speed {} = {} of the +1/2 core speed",
-        g(mu),
-        g(su),
-        g(mv),
-        g(sv),
-        g(speed),
-        g(speed / plus)
-    );
-    if !clear && speed < 0.25 * plus {
-        (Verdict::Holds, format!("{what}: no drift within two s.e."))
-    } else if clear && speed > 0.25 * plus {
-        (
-            Verdict::DoesNotHold,
-            format!("{what}: a drift clear of 0, more than a quarter of the +1/2 speed"),
-        )
+    // The error of |(mu, mv)| to first order; at zero speed, the larger component error.
+    let s = if speed > 0.0 {
+        (mu * su).hypot(mv * sv) / speed
     } else {
-        (Verdict::Inconclusive, what)
-    }
+        su.max(sv)
+    };
+    let rule = super::rule::Rule::absence(
+        format!(
+            "the −1/2 core speed, from ({} ± {}, {} ± {}) s.e. ({} of the +1/2 core speed)",
+            g(mu),
+            g(su),
+            g(mv),
+            g(sv),
+            g(speed / plus)
+        ),
+        0.25 * plus,
+    );
+    let o = rule.decide(speed, s);
+    (o.verdict, o.why)
 }
 
 /// The verdict on a sign claim measured once per run (`d` > 0 claimed): holds when every run
