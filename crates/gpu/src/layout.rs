@@ -13,7 +13,7 @@ use crate::kernels::Buffers;
 use crate::memory::Sizes;
 use crate::shader::Variant;
 use crate::shared::Chunk;
-use crate::step::WG;
+use crate::shared::WG;
 
 /// Workgroups along one dimension of a dispatch (Vulkan's guaranteed minimum).
 const MAX_GROUPS: u32 = 65_535;
@@ -41,24 +41,6 @@ pub(crate) fn chunks(n: usize, per: usize) -> Vec<(usize, usize)> {
     (0..n.div_ceil(per).max(1))
         .map(|k| (k * per, per.min(n - (k * per).min(n))))
         .collect()
-}
-
-/// The bins of patch origins for the gather: `(number of bins, cells per bin)`. A bin is at
-/// least a patch wide, so the patches over a node have their origins in the node's bin or the
-/// one before it, in each direction.
-pub(crate) fn bins(lattice: Lattice, shape: &PatchShape, n_cells: usize) -> (u32, u32) {
-    let (nbx, nby) = bin_grid(lattice, shape);
-    let nb = nbx * nby;
-    let per_bin = n_cells.div_ceil(nb as usize) as u32;
-    let cap = (8 * per_bin).max(32).min(n_cells.max(1) as u32);
-    (nb, cap)
-}
-
-pub(crate) fn bin_grid(lattice: Lattice, shape: &PatchShape) -> (u32, u32) {
-    (
-        (lattice.lx / shape.nx).max(1) as u32,
-        (lattice.ly / shape.ny).max(1) as u32,
-    )
 }
 
 /// A grid of workgroups for `n` of them: `(x, y)` with `x ≤ 65535`.

@@ -5,9 +5,9 @@ use phasefield::{Lattice, PatchShape};
 
 use crate::bindings::Slot;
 use crate::features::{self, Dims, On};
-use crate::layout::bins;
+
 use crate::shared::{Kinds, Params};
-use crate::step::{CELL_STRIDE, WG};
+use crate::shared::{CELL_STRIDE, WG};
 
 /// The smallest buffer: what stands in for one a state does not need.
 pub(crate) const PLACEHOLDER: u64 = 16;
@@ -141,4 +141,22 @@ impl GpuMemory {
             self.total as f64 / 1e9
         )
     }
+}
+
+/// The bins of patch origins for the gather: `(number of bins, cells per bin)`. A bin is at
+/// least a patch wide, so the patches over a node have their origins in the node's bin or the
+/// one before it, in each direction.
+pub(crate) fn bins(lattice: Lattice, shape: &PatchShape, n_cells: usize) -> (u32, u32) {
+    let (nbx, nby) = bin_grid(lattice, shape);
+    let nb = nbx * nby;
+    let per_bin = n_cells.div_ceil(nb as usize) as u32;
+    let cap = (8 * per_bin).max(32).min(n_cells.max(1) as u32);
+    (nb, cap)
+}
+
+pub(crate) fn bin_grid(lattice: Lattice, shape: &PatchShape) -> (u32, u32) {
+    (
+        (lattice.lx / shape.nx).max(1) as u32,
+        (lattice.ly / shape.ny).max(1) as u32,
+    )
 }

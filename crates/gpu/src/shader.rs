@@ -5,8 +5,7 @@
 use mechanics::PressureKind;
 use phasefield::PatchShape;
 
-use crate::shared::{Chunk, Kind, Params, MAX_KINDS};
-use crate::step::WG;
+use crate::shared::{Chunk, Kind, Params, MAX_KINDS, WG};
 
 /// The stages' files of `wgsl/`, in the order they are joined (WGSL's module-scope
 /// declarations may come in any order; this one reads from the general to the particular);

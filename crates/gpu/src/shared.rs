@@ -1,7 +1,13 @@
 //! The structures the host and the kernels share ([`Params`], [`Kind`], [`Chunk`]), each
-//! written once: [`shared_struct!`] gives the Rust definition and its WGSL declaration.
+//! written once: [`shared_struct!`] gives the Rust definition and its WGSL declaration; and the
+//! constants both sides use (`WG`, `CELL_STRIDE`).
 
 use bytemuck::{Pod, Zeroable};
+
+/// Invocations per workgroup (the shader's `WG`).
+pub(crate) const WG: u32 = 256;
+/// Floats per cell in the cell buffer (the shader's `CELL_STRIDE`).
+pub(crate) const CELL_STRIDE: usize = 12;
 
 /// A structure shared by the host and the kernels, written once: the Rust definition
 /// (`#[repr(C)]`, `Pod`) and its WGSL declaration (`WGSL`, which [`shader_source`] prepends

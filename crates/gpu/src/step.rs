@@ -14,15 +14,11 @@ use crate::bindings::{used_slots, Slot};
 use crate::device::{Device, GpuError};
 use crate::features::{self, Feature, Hook, Host, On, View};
 use crate::kernels::{Buffers, Builder, Kernels, Role};
-use crate::layout::{allocate, bin_grid, bins, grid, GpuOptions, Layout};
-use crate::memory::{GpuMemory, Sizes};
+use crate::layout::{allocate, grid, GpuOptions, Layout};
+use crate::memory::{bin_grid, bins, GpuMemory, Sizes};
 use crate::shader::shader_source_split;
-use crate::shared::{Chunk, Kind, Kinds, Params, MAX_KINDS};
+use crate::shared::{Chunk, Kind, Kinds, Params, CELL_STRIDE, MAX_KINDS, WG};
 
-/// Invocations per workgroup (the shader's `WG`).
-pub(crate) const WG: u32 = 256;
-/// Floats per cell in the cell buffer (the shader's `CELL_STRIDE`).
-pub(crate) const CELL_STRIDE: usize = 12;
 /// Steps recorded before they are submitted.
 const BATCH: usize = 16;
 
