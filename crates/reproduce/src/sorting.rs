@@ -86,18 +86,16 @@ impl State {
 
 /// A point's state from its seeds' late demixing: its mean `m` and standard error `e` over
 /// seeds, against the shuffled-label null, whose mean is 0 by the construction of the
-/// demixing parameter. Sorts when `m − 2e > 0` and `m > MATERIAL`; mixed when
-/// `m + 2e < MATERIAL`; not established otherwise (and with fewer than two seeds).
+/// demixing parameter, by the rule of an effect ([`super::rule::Rule::effect`]) with
+/// [`MATERIAL`] the smallest demixing that counts: sorts when `m − 2e > 0` and `m ≥ MATERIAL`;
+/// mixed when `m + 2e < MATERIAL`; not established otherwise (and with fewer than two seeds).
 pub(crate) fn classify(point: &[f64]) -> (State, f64, f64) {
     let (m, e) = mean_se(point);
-    let state = if !e.is_finite() {
-        State::NotEstablished
-    } else if m - 2.0 * e > 0.0 && m > MATERIAL {
-        State::Sorts
-    } else if m + 2.0 * e < MATERIAL {
-        State::Mixed
-    } else {
-        State::NotEstablished
+    let rule = super::rule::Rule::effect("the late demixing beyond shuffled labels", MATERIAL);
+    let state = match rule.decide(m, e).verdict {
+        Verdict::Holds => State::Sorts,
+        Verdict::DoesNotHold => State::Mixed,
+        Verdict::Inconclusive => State::NotEstablished,
     };
     (state, m, e)
 }
