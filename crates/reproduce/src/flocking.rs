@@ -148,6 +148,17 @@ pub(crate) fn verdict(stats: &[(f64, f64)], dc: Option<f64>, dc_err: f64) -> (Ve
     }
 }
 
+/// The control (issue 54): the claim that the cells flock, at one noise alone, by the rule of an
+/// effect ([`super::rule::Rule::effect`]) on the order above ½, of which 0.05 counts: holds
+/// when the order less two standard errors is above ½ and the order at least 0.55; does not hold
+/// when the order plus two standard errors is below 0.55. At a noise far above the transition,
+/// where no flock can form, it must read "does not hold".
+pub(crate) fn control(order: (f64, f64)) -> (Verdict, String) {
+    let rule = super::rule::Rule::effect("the polar order above ½, |⟨p⟩| − ½", 0.05);
+    let o = rule.decide(order.0 - HALF, order.1);
+    (o.verdict, o.why)
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (noises, t) = settings(p.scale);
     let relax = 100.0;
@@ -274,11 +285,25 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         v,
         why,
     )];
+    let mut claims = claims;
+    if let (Some(&top), Some(name)) = (stats.last(), noises.last()) {
+        let (cv, cwhy) = control(top);
+        let times = dc.map_or(String::new(), |dc| {
+            format!(", {}× D_c", g(d[d.len() - 1] / dc))
+        });
+        claims.push(Claim::new(
+            format!("control (issue 54): the cells flock at D_r = {name}{times}, noise far above the transition, where no flock can form (must not hold)"),
+            format!("order {} (random orientations: {})", super::pm(top), g(null)),
+            cv,
+            cwhy,
+        ));
+    }
     let settings = format!(
         "- `scenes/polar.toml`'s tissue: 80 polar cells (R = 8) in a periodic 120² box, ζ = 0, α = 0.04, alignment to the velocity at J = 1 (a free cell's alignment rate J α/ξ = {}), D_r ∈ {{{}}}; seeds {}.\n\
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: the polar order |⟨p_i⟩| of each frame (`polar_order` of `analysis/observables.csv`), its time mean over the second half of the active phase per run, mean ± standard error over seeds. D_c: where the seed mean first falls below ½, linear in ln D_r; error: jackknife over seeds (the interpolation's own error is not in it: the scanned noises that bracket D_c are given beside it). Random orientations give √(π/4N) = {}.\n\
          - Rule: holds when the lowest noise is ordered and the highest disordered by two standard errors each way from ½ and D_c has an error; does not hold when the lowest noise is already disordered; inconclusive otherwise.\n\
+         - Control (issue 54): the claim that the cells flock, at the highest noise alone, by the rule of an effect on the order above ½; far above the transition it must read \"does not hold\".\n\
          - Data: `flocking_runs.csv`, `flocking.csv`; plots `flocking.png`, `flocking_in_time.png`.",
         g(align_rate),
         noises.join(", "),
@@ -314,6 +339,15 @@ mod tests {
         (0..order[0].len())
             .map(|k| mean_se(&order.iter().map(|o| o[k]).collect::<Vec<_>>()))
             .collect()
+    }
+
+    /// The control reads each outcome: a disordered point does not hold, an ordered one holds
+    /// (so the control can fail), one that straddles ½ is inconclusive.
+    #[test]
+    fn the_control_can_come_out_either_way() {
+        assert_eq!(control((0.12, 0.02)).0, Verdict::DoesNotHold);
+        assert_eq!(control((0.9, 0.02)).0, Verdict::Holds);
+        assert_eq!(control((0.5, 0.1)).0, Verdict::Inconclusive);
     }
 
     #[test]
