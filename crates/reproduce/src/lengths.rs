@@ -386,7 +386,7 @@ impl Lengths<'_> {
                     / box_side
             };
             claims.push(Claim::new(
-                format!("9.4 ({pressure} pressure): the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})"),
+                length_claim(pressure, name, true),
                 format!(
                     "{}; the shortest is {}× the smoothing box ({box_side})",
                     tz.measured,
@@ -396,7 +396,7 @@ impl Lengths<'_> {
                 tz.why,
             ));
             claims.push(Claim::new(
-                format!("9.4 ({pressure} pressure): the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"),
+                length_claim(pressure, name, false),
                 format!(
                     "{}; the shortest is {}× the smoothing box ({box_side})",
                     tg.measured,
@@ -450,7 +450,7 @@ fn net_flows(
         }
         let (v, why) = rule_net_flow(&ratios, cells);
         claims.push(Claim::new(
-            format!("No net flow of the whole tissue ({pressure} pressure, γ = 0.01, ζ ≥ {ACTIVE}; the paper's periodic tissue has none)"),
+            net_flow_claim(pressure),
             format!(
                 "|⟨U⟩_t| / v_cell over {} runs: {}",
                 ratios.len(),
@@ -548,6 +548,72 @@ fn settings(p: &ReproduceParams, box_side: f64) -> String {
     )
 }
 
+/// The claim of a length's trend against ζ (`against_zeta`) or against γ.
+fn length_claim(pressure: &str, name: &str, against_zeta: bool) -> String {
+    if against_zeta {
+        format!("9.4 ({pressure} pressure): the {name} length shrinks as ζ grows (γ = 0.01, ζ ≥ {ACTIVE})")
+    } else {
+        format!(
+            "9.4 ({pressure} pressure): the {name} length grows with γ (ζ = {ZETA_OF_GAMMA_SWEEP})"
+        )
+    }
+}
+
+/// The claim of no net flow.
+fn net_flow_claim(pressure: &str) -> String {
+    format!("No net flow of the whole tissue ({pressure} pressure, γ = 0.01, ζ ≥ {ACTIVE}; the paper's periodic tissue has none)")
+}
+
+/// The figure's verdicts from its own tables in `dir` (`lengths_vs_zeta.csv`,
+/// `lengths_vs_gamma.csv`, `net_flow.csv`, as [`make`] writes them), by the rules [`make`]
+/// applies: each claim with its verdict, in [`make`]'s order. What a doc says of the figure is
+/// checked against these (issue 54: no stale label stays in docs/reproduction.md).
+///
+/// # Errors
+/// A table that is missing or lacks a column.
+#[cfg(test)]
+pub(crate) fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let read = |name: &str| super::Table::read(&dir.join(name));
+    let (tz, tg, nf) = (
+        read("lengths_vs_zeta.csv")?,
+        read("lengths_vs_gamma.csv")?,
+        read("net_flow.csv")?,
+    );
+    // The points of one pressure form and field of a lengths table, over its axis `axis`.
+    let points = |t: &super::Table, axis: &str, pressure: &str, field: &str| {
+        let (p, f) = (t.strs("pressure")?, t.strs("field")?);
+        let (x, m, s, n) = (
+            t.f64s(axis)?,
+            t.f64s("length")?,
+            t.f64s("length_std")?,
+            t.f64s("seeds")?,
+        );
+        Ok::<Vec<AtValue>, SweepError>(
+            (0..p.len())
+                .filter(|&k| p[k] == pressure && f[k] == field)
+                .map(|k| (x[k], (m[k], s[k]), n[k] as usize))
+                .collect(),
+        )
+    };
+    let mut out = Vec::new();
+    for pressure in PRESSURES {
+        for (name, _) in FIELDS {
+            let lz = points(&tz, "zeta", pressure, name)?;
+            let lg = points(&tg, "gamma", pressure, name)?;
+            out.push((length_claim(pressure, name, true), trend(&lz, -1.0).verdict));
+            out.push((length_claim(pressure, name, false), trend(&lg, 1.0).verdict));
+        }
+    }
+    let (p, ratio, cells) = (nf.strs("pressure")?, nf.f64s("ratio")?, nf.f64s("cells")?);
+    for pressure in PRESSURES {
+        let rows: Vec<usize> = (0..p.len()).filter(|&k| p[k] == pressure).collect();
+        let ratios: Vec<f64> = rows.iter().map(|&k| ratio[k]).collect();
+        let n = rows.last().map_or(0, |&k| cells[k] as usize);
+        out.push((net_flow_claim(pressure), rule_net_flow(&ratios, n).0));
+    }
+    Ok(out)
+}
+
 /// The net flow of a run: `|⟨U⟩_t|`, the time mean over the frames at `t ≥ from` of the mean
 /// cell velocity `U = ⟨v_i⟩_i`, the rms cell speed over the same frames, and the number of
 /// cells.
@@ -621,6 +687,26 @@ fn rule_net_flow(ratios: &[f64], cells: usize) -> (Verdict, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lengths section of docs/reproduction.md states the verdicts that the figure's rules
+    /// give on the figure's own tables, kept in `docs/data/lengths/` (the quick scale, as the
+    /// section shows): a rule changed without its docs, or docs edited by hand, fail here.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let want = verdicts_from_tables(&root.join("docs/data/lengths")).unwrap();
+        let doc = std::fs::read_to_string(root.join("docs/reproduction.md")).unwrap();
+        let rows = crate::doc_verdicts(&doc, "lengths", "**Verdicts (quick):**");
+        assert_eq!(rows.len(), want.len(), "{rows:?}");
+        for ((claim, verdict), (doc_claim, doc_verdict)) in want.iter().zip(&rows) {
+            assert_eq!(claim, doc_claim);
+            assert_eq!(
+                &verdict.to_string(),
+                doc_verdict,
+                "{claim}: the docs say {doc_verdict}, the stored tables give {verdict}"
+            );
+        }
+    }
 
     #[test]
     fn the_net_flow_rule_gives_each_outcome() {

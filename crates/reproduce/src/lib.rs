@@ -711,6 +711,47 @@ pub(crate) fn column_stats(
         .collect())
 }
 
+/// The rows of a figure's verdict table in a doc, as `(claim, verdict)`: the table after the
+/// line `heading` in the section headed ``## `FIGURE` ``, its first and third cells (the
+/// verdict without its bold), with escaped pipes (`\|`) kept inside their cells. Empty when the
+/// section, the heading or the table is missing. For the tests that compare docs with the
+/// verdicts of stored tables (issue 54).
+#[cfg(test)]
+pub(crate) fn doc_verdicts(doc: &str, figure: &str, heading: &str) -> Vec<(String, String)> {
+    let lines: Vec<&str> = doc.lines().collect();
+    let Some(sec) = lines.iter().position(|l| *l == format!("## `{figure}`")) else {
+        return Vec::new();
+    };
+    let end = (sec + 1..lines.len())
+        .find(|&k| lines[k].starts_with("## "))
+        .unwrap_or(lines.len());
+    let Some(head) = (sec..end).find(|&k| lines[k].trim() == heading) else {
+        return Vec::new();
+    };
+    let cells = |line: &str| -> Vec<String> {
+        let (mut out, mut cur, mut escaped) = (Vec::new(), String::new(), false);
+        for c in line.trim().trim_matches('|').chars() {
+            if c == '|' && !escaped {
+                out.push(cur.trim().to_string());
+                cur.clear();
+            } else {
+                cur.push(c);
+            }
+            escaped = c == '\\';
+        }
+        out.push(cur.trim().to_string());
+        out
+    };
+    (head..end)
+        .skip_while(|&k| !lines[k].starts_with('|'))
+        .skip(2)
+        .take_while(|&k| lines[k].starts_with('|'))
+        .map(|k| cells(lines[k]))
+        .filter(|c| c.len() >= 3)
+        .map(|c| (c[0].clone(), c[2].trim_matches('*').to_string()))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
