@@ -12,6 +12,9 @@
 //! statistic of a run is the mean over its extrusions of `d₊ − d₊,random` (and of
 //! `d₋ − d₋,random`); of a rule, the mean and standard error over seeds.
 
+#[cfg(test)]
+use std::path::Path;
+
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
@@ -91,6 +94,43 @@ fn stat(per_seed: &[f64]) -> String {
     )
 }
 
+/// The claim on the extrusions of rule `rule` at the +½ (`plus`) or −½ defects.
+fn claim(rule: &str, plus: bool) -> String {
+    if plus {
+        format!("extrusion (issue 41), {rule} rule: extruded cells are found at +½ defects (Saw et al. 2017)")
+    } else {
+        format!("extrusion, {rule} rule: extruded cells are found at −½ defects")
+    }
+}
+
+/// The figure's verdicts from its own table in `dir` (`extrusion.csv`, as [`make`] writes it),
+/// by [`verdict`]: each claim with its verdict, in [`make`]'s order (issue 54: the docs are
+/// checked against these).
+///
+/// # Errors
+/// A table that is missing or lacks a column.
+#[cfg(test)]
+pub(crate) fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let t = super::Table::read(&dir.join("extrusion.csv"))?;
+    let (rules, plus, minus) = (
+        t.strs("rule")?,
+        t.f64s("d_plus_excess")?,
+        t.f64s("d_minus_excess")?,
+    );
+    let mut out = Vec::new();
+    for (rule, _) in RULES {
+        let of = |v: &[f64]| -> Vec<f64> {
+            (0..rules.len())
+                .filter(|&k| rules[k] == rule)
+                .map(|k| v[k])
+                .collect()
+        };
+        out.push((claim(rule, true), verdict(&of(&plus)).0));
+        out.push((claim(rule, false), verdict(&of(&minus)).0));
+    }
+    Ok(out)
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t = match p.scale {
         Scale::Quick => 1000.0,
@@ -162,13 +202,17 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         let (vm, wm) = verdict(&minus);
         let n = mean_se(&counts);
         claims.push(Claim::new(
-            format!("extrusion (issue 41), {rule} rule: extruded cells are found at +½ defects (Saw et al. 2017)"),
-            format!("{} extrusions per run (mean over seeds); {}", g(n.0), stat(&plus)),
+            claim(rule, true),
+            format!(
+                "{} extrusions per run (mean over seeds); {}",
+                g(n.0),
+                stat(&plus)
+            ),
             vp,
             wp,
         ));
         claims.push(Claim::new(
-            format!("extrusion, {rule} rule: extruded cells are found at −½ defects"),
+            claim(rule, false),
             format!("{} extrusions per run; {}", g(n.0), stat(&minus)),
             vm,
             wm,
@@ -188,6 +232,28 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The extrusion section of docs/reproduction.md states, at both scales, the verdicts
+    /// that [`verdict`] gives on the figure's own tables kept in `docs/data/extrusion/`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let doc = std::fs::read_to_string(root.join("docs/reproduction.md")).unwrap();
+        for scale in ["quick", "paper"] {
+            let want =
+                verdicts_from_tables(&root.join(format!("docs/data/extrusion/{scale}"))).unwrap();
+            let rows = crate::doc_verdicts(&doc, "extrusion", &format!("**Verdicts ({scale}):**"));
+            assert_eq!(rows.len(), want.len(), "{scale}: {rows:?}");
+            for ((claim, verdict), (doc_claim, doc_verdict)) in want.iter().zip(&rows) {
+                assert_eq!(claim, doc_claim);
+                assert_eq!(
+                    &verdict.to_string(),
+                    doc_verdict,
+                    "{scale}, {claim}: the docs say {doc_verdict}, the stored table gives {verdict}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn each_outcome_is_reached() {
