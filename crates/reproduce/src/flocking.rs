@@ -234,27 +234,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             &stats.iter().map(|s| s.1).collect::<Vec<_>>(),
         ),
     );
-    let first_seed = by_noise
-        .first()
-        .and_then(|m| m.seeds.first().copied())
-        .unwrap_or(1);
-    let mut tplot = Plot::new(
-        format!("Polar order in time, seed {first_seed}"),
-        "time (TU)",
-        "|⟨p⟩|",
-    );
-    tplot.zero_y = true;
-    tplot.legend = render::LegendAt::UpperRight;
-    for pt in &points {
-        let Some(r) = pt.runs.first() else { continue };
-        let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-        let (times, pol) = (tab.f64s("time")?, tab.f64s("polar_order")?);
-        tplot.series.push(
-            Series::new(format!("D_r = {}", pt.values[0]))
-                .with_points(&times, &pol, &vec![0.0; times.len()])
-                .line_only(),
-        );
-    }
+    let tplot = order_in_time(&points, &by_noise)?;
     let (v, why) = verdict(&stats, dc, dc_err);
     // The alignment rate of a cell at its free speed, J α/ξ (ξ = 2).
     let align_rate = 1.0 * 0.04 / 2.0;
@@ -316,6 +296,35 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .table("flocking.csv", points_csv)
         .plot("flocking.png", plot)
         .plot("flocking_in_time.png", tplot))
+}
+
+/// The polar order in time of each noise's first run (the first seed's).
+fn order_in_time(
+    points: &[super::pipeline::PointRuns],
+    by_noise: &[PerSeed],
+) -> Result<Plot, SweepError> {
+    let first_seed = by_noise
+        .first()
+        .and_then(|m| m.seeds.first().copied())
+        .unwrap_or(1);
+    let mut tplot = Plot::new(
+        format!("Polar order in time, seed {first_seed}"),
+        "time (TU)",
+        "|⟨p⟩|",
+    );
+    tplot.zero_y = true;
+    tplot.legend = render::LegendAt::UpperRight;
+    for pt in points {
+        let Some(r) = pt.runs.first() else { continue };
+        let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
+        let (times, pol) = (tab.f64s("time")?, tab.f64s("polar_order")?);
+        tplot.series.push(
+            Series::new(format!("D_r = {}", pt.values[0]))
+                .with_points(&times, &pol, &vec![0.0; times.len()])
+                .line_only(),
+        );
+    }
+    Ok(tplot)
 }
 
 #[cfg(test)]

@@ -324,9 +324,57 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         Scale::Quick => 2000.0,
         Scale::Paper => 5000.0,
     };
+    let res = sweep(p, t)?;
+    p.reporter.stage("jamming: tables and plots");
+    let points = res.points(None)?;
+    let alphas: Vec<f64> = ALPHAS
+        .iter()
+        .map(|a| a.parse().expect("a number"))
+        .collect();
+    let gammas: Vec<f64> = GAMMAS
+        .iter()
+        .map(|a| a.parse().expect("a number"))
+        .collect();
+    let runs = PerRun::read(&points, 200.0 + t / 2.0)?;
+    let PerRun {
+        ln_msd,
+        q,
+        lag_l,
+        runs_csv,
+    } = runs;
+    let mut lines = Lines::new(lag_l);
+    for (gi, gamma) in GAMMAS.iter().enumerate() {
+        lines.add(gamma, &alphas, &ln_msd[gi], &q[gi]);
+    }
+    let Lines {
+        points_csv,
+        rows,
+        ac_pts,
+        q_at,
+        plot,
+        qplot,
+        line_text,
+    } = lines;
+    let mut made = Made::new(Vec::new(), String::new())
+        .table("jamming_runs.csv", runs_csv)
+        .table("jamming.csv", points_csv)
+        .plot("jamming_msd.png", plot)
+        .plot("jamming_shape_index.png", qplot);
+    if let Some(lplot) = line_plot(&gammas, &ac_pts) {
+        made = made.plot("jamming_line.png", lplot);
+    }
+    let claims = claims(&rows, &gammas, &ac_pts, &q_at, &line_text);
+    let settings = settings(p.scale, t, lag_l);
+    made.claims = claims;
+    made.settings = settings;
+    Ok(made)
+}
+
+/// The sweep over γ and α at run length `t`.
+fn sweep(p: &ReproduceParams, t: f64) -> Result<super::SweepResult, SweepError> {
     let mut sets = vec![format!("run.time={t}")];
     sets.extend(p.scale.own_dt_set());
-    let res = super::sweep(
+    super::sweep(
         p,
         SweepJob {
             name: format!("jamming-{}", p.scale.name()),
@@ -339,103 +387,149 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             analyze: Some(AnalyzeOptions::default()),
             seeds: None,
         },
-    )?;
-    p.reporter.stage("jamming: tables and plots");
-    let points = res.points(None)?;
-    let n_seeds = points.first().map_or(0, |pt| pt.runs.len());
-    let alphas: Vec<f64> = ALPHAS
-        .iter()
-        .map(|a| a.parse().expect("a number"))
-        .collect();
-    let gammas: Vec<f64> = GAMMAS
-        .iter()
-        .map(|a| a.parse().expect("a number"))
-        .collect();
-    // [γ][seed][α]: ln MSD(τ_L) and the shape index; τ_L per run.
-    let mut ln_msd = vec![vec![vec![f64::NAN; ALPHAS.len()]; n_seeds]; GAMMAS.len()];
-    let mut q = ln_msd.clone();
-    let mut lag_l = f64::NAN;
-    let mut runs_csv = Csv::new(&[
-        "gamma",
-        "alpha",
-        "seed",
-        "lag",
-        "msd",
-        "d_eff",
-        "shape_index",
-    ]);
-    let from = 200.0 + t / 2.0;
-    for (pt, (si, r)) in points
-        .iter()
-        .flat_map(|pt| pt.runs.iter().enumerate().map(move |r| (pt, r)))
-    {
-        let gi = GAMMAS
-            .iter()
-            .position(|v| *v == pt.values[0])
-            .expect("a γ of the sweep");
-        let ai = ALPHAS
-            .iter()
-            .position(|v| *v == pt.values[1])
-            .expect("an α of the sweep");
-        let m = super::Table::read(&r.run.join("analysis/msd.csv"))?;
-        let (lags, msd) = (m.f64s("lag")?, m.f64s("msd")?);
-        let (lag, v) = (
-            lags.last().copied().unwrap_or(f64::NAN),
-            msd.last().copied().unwrap_or(f64::NAN),
-        );
-        lag_l = lag;
-        let qm = super::late_mean(
-            &r.run.join("analysis/observables.csv"),
+    )
+}
+
+/// What each run gives, by `[γ][seed][α]`: `ln MSD(τ_L)` and the late shape index; the lag
+/// `τ_L`; and the table of the runs.
+struct PerRun {
+    ln_msd: Vec<Vec<Vec<f64>>>,
+    q: Vec<Vec<Vec<f64>>>,
+    lag_l: f64,
+    runs_csv: Csv,
+}
+
+impl PerRun {
+    /// Reads every run of `points`, its shape index averaged from `from`.
+    fn read(points: &[super::pipeline::PointRuns], from: f64) -> Result<Self, SweepError> {
+        let n_seeds = points.first().map_or(0, |pt| pt.runs.len());
+        // [γ][seed][α]: ln MSD(τ_L) and the shape index; τ_L per run.
+        let mut ln_msd = vec![vec![vec![f64::NAN; ALPHAS.len()]; n_seeds]; GAMMAS.len()];
+        let mut q = ln_msd.clone();
+        let mut lag_l = f64::NAN;
+        let mut runs_csv = Csv::new(&[
+            "gamma",
+            "alpha",
+            "seed",
+            "lag",
+            "msd",
+            "d_eff",
             "shape_index",
-            from,
-            |v| v,
-        )?;
-        ln_msd[gi][si][ai] = v.ln();
-        q[gi][si][ai] = qm;
-        runs_csv.row([
-            cell(&pt.values[0]),
-            cell(&pt.values[1]),
-            cell(r.seed),
-            cell(lag),
-            sci(v),
-            sci(v / (4.0 * lag)),
-            cell(qm),
         ]);
+        for (pt, (si, r)) in points
+            .iter()
+            .flat_map(|pt| pt.runs.iter().enumerate().map(move |r| (pt, r)))
+        {
+            let gi = GAMMAS
+                .iter()
+                .position(|v| *v == pt.values[0])
+                .expect("a γ of the sweep");
+            let ai = ALPHAS
+                .iter()
+                .position(|v| *v == pt.values[1])
+                .expect("an α of the sweep");
+            let m = super::Table::read(&r.run.join("analysis/msd.csv"))?;
+            let (lags, msd) = (m.f64s("lag")?, m.f64s("msd")?);
+            let (lag, v) = (
+                lags.last().copied().unwrap_or(f64::NAN),
+                msd.last().copied().unwrap_or(f64::NAN),
+            );
+            lag_l = lag;
+            let qm = super::late_mean(
+                &r.run.join("analysis/observables.csv"),
+                "shape_index",
+                from,
+                |v| v,
+            )?;
+            ln_msd[gi][si][ai] = v.ln();
+            q[gi][si][ai] = qm;
+            runs_csv.row([
+                cell(&pt.values[0]),
+                cell(&pt.values[1]),
+                cell(r.seed),
+                cell(lag),
+                sci(v),
+                sci(v / (4.0 * lag)),
+                cell(qm),
+            ]);
+        }
+        Ok(Self {
+            ln_msd,
+            q,
+            lag_l,
+            runs_csv,
+        })
     }
-    let mut points_csv = Csv::new(&[
-        "gamma",
-        "alpha",
-        "ln_msd_mean",
-        "ln_msd_se",
-        "msd_geometric_mean",
-        "shape_index_mean",
-        "shape_index_se",
-        "phase",
-    ]);
-    let mut rows: Vec<(Vec<Phase>, Option<f64>, f64)> = Vec::new();
-    let mut ac_pts: Vec<(f64, f64)> = Vec::new();
-    let mut q_at: Vec<(f64, f64)> = Vec::new();
-    let mut plot = Plot::new(
-        format!("Mean squared displacement at the lag τ_L = {} TU", g(lag_l)),
-        "propulsion α",
-        "MSD(τ_L) / R², geometric mean ± s.e. over seeds",
-    );
-    (plot.log_x, plot.log_y) = (true, true);
-    plot.hlines = vec![(1.0, "a radius: the cage".into())];
-    let mut qplot = Plot::new(
-        "Shape index against propulsion",
-        "propulsion α",
-        "q = P/√A, second half, mean ± s.e. over seeds",
-    );
-    qplot.log_x = true;
-    qplot.hlines = vec![(VERTEX_Q, "3.81: vertex models' transition".into())];
-    let mut line_text = Vec::new();
-    for (gi, gamma) in GAMMAS.iter().enumerate() {
+}
+
+/// The points of each γ's line, and what the figure draws and claims of them.
+struct Lines {
+    points_csv: Csv,
+    rows: Vec<(Vec<Phase>, Option<f64>, f64)>,
+    ac_pts: Vec<(f64, f64)>,
+    q_at: Vec<(f64, f64)>,
+    plot: Plot,
+    qplot: Plot,
+    line_text: Vec<String>,
+}
+
+impl Lines {
+    fn new(lag_l: f64) -> Self {
+        let points_csv = Csv::new(&[
+            "gamma",
+            "alpha",
+            "ln_msd_mean",
+            "ln_msd_se",
+            "msd_geometric_mean",
+            "shape_index_mean",
+            "shape_index_se",
+            "phase",
+        ]);
+        let rows: Vec<(Vec<Phase>, Option<f64>, f64)> = Vec::new();
+        let ac_pts: Vec<(f64, f64)> = Vec::new();
+        let q_at: Vec<(f64, f64)> = Vec::new();
+        let mut plot = Plot::new(
+            format!("Mean squared displacement at the lag τ_L = {} TU", g(lag_l)),
+            "propulsion α",
+            "MSD(τ_L) / R², geometric mean ± s.e. over seeds",
+        );
+        (plot.log_x, plot.log_y) = (true, true);
+        plot.hlines = vec![(1.0, "a radius: the cage".into())];
+        let mut qplot = Plot::new(
+            "Shape index against propulsion",
+            "propulsion α",
+            "q = P/√A, second half, mean ± s.e. over seeds",
+        );
+        qplot.log_x = true;
+        qplot.hlines = vec![(VERTEX_Q, "3.81: vertex models' transition".into())];
+        let line_text = Vec::new();
+        Self {
+            points_csv,
+            rows,
+            ac_pts,
+            q_at,
+            plot,
+            qplot,
+            line_text,
+        }
+    }
+
+    /// Adds the line of `gamma`: its per-seed `ln_msd[seed][α]` and shape indices `q`.
+    fn add(&mut self, gamma: &str, alphas: &[f64], ln_msd: &[Vec<f64>], q: &[Vec<f64>]) {
+        let Self {
+            points_csv,
+            rows,
+            ac_pts,
+            q_at,
+            plot,
+            qplot,
+            line_text,
+        } = self;
         let stats: Vec<(f64, f64)> = (0..ALPHAS.len())
-            .map(|ai| mean_se(&ln_msd[gi].iter().map(|s| s[ai]).collect::<Vec<_>>()))
+            .map(|ai| mean_se(&ln_msd.iter().map(|s| s[ai]).collect::<Vec<_>>()))
             .collect();
         let qstats: Vec<(f64, f64)> = (0..ALPHAS.len())
-            .map(|ai| mean_se(&q[gi].iter().map(|s| s[ai]).collect::<Vec<_>>()))
+            .map(|ai| mean_se(&q.iter().map(|s| s[ai]).collect::<Vec<_>>()))
             .collect();
         let phases: Vec<Phase> = stats.iter().map(|s| phase(*s)).collect();
         for (ai, alpha) in ALPHAS.iter().enumerate() {
@@ -450,7 +544,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 cell(phases[ai].name()),
             ]);
         }
-        let (ac, err) = critical_alpha(&alphas, &ln_msd[gi]);
+        let (ac, err) = critical_alpha(alphas, ln_msd);
         // q at α_c, interpolated as α_c is, with the larger spread of the two points.
         let qa = ac.map_or((f64::NAN, f64::NAN), |a| {
             let k = alphas
@@ -476,7 +570,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         let r2 = RADIUS * RADIUS;
         plot.series.push(
             Series::new(format!("γ = {gamma}")).with_points(
-                &alphas,
+                alphas,
                 &stats.iter().map(|s| s.0.exp() / r2).collect::<Vec<_>>(),
                 // The upper half-width of the band exp(m ± se), for the log axis.
                 &stats
@@ -488,24 +582,11 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         qplot
             .series
             .push(Series::new(format!("γ = {gamma}")).with_points(
-                &alphas,
+                alphas,
                 &qstats.iter().map(|s| s.0).collect::<Vec<_>>(),
                 &qstats.iter().map(|s| s.1).collect::<Vec<_>>(),
             ));
     }
-    let mut made = Made::new(Vec::new(), String::new())
-        .table("jamming_runs.csv", runs_csv)
-        .table("jamming.csv", points_csv)
-        .plot("jamming_msd.png", plot)
-        .plot("jamming_shape_index.png", qplot);
-    if let Some(lplot) = line_plot(&gammas, &ac_pts) {
-        made = made.plot("jamming_line.png", lplot);
-    }
-    let claims = claims(&rows, &gammas, &ac_pts, &q_at, &line_text);
-    let settings = settings(p.scale, t, lag_l);
-    made.claims = claims;
-    made.settings = settings;
-    Ok(made)
 }
 
 #[cfg(test)]
