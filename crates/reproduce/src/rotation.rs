@@ -201,10 +201,36 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (radii, densities, t) = settings(p.scale);
     let relax = 100.0;
     let from = relax + t / 2.0;
+    let (points, series_of_scene) = run_points(p, &radii, &densities, t, from)?;
+    p.reporter.stage("rotation: tables and plots");
+    let (runs_csv, points_csv) = tables(&points);
+    let mut made = Made::new(Vec::new(), String::new())
+        .table("rotation_runs.csv", runs_csv)
+        .table("rotation_points.csv", points_csv);
+    for (name, plot) in plots(&points, &densities, &series_of_scene) {
+        made = made.plot(name, plot);
+    }
+    made.claims = claims(&points, &radii, &densities);
+    made.settings = settings_text(p, &radii, &densities, t);
+    Ok(made)
+}
+
+/// Each Ω(t) of `scenes/disc.toml`'s point: the seed, the times and Ω.
+type SceneSeries = Vec<(u64, Vec<f64>, Vec<f64>)>;
+
+/// Every point of the sweeps (one per disc radius and density), with its runs' statistics
+/// from `from` on, and Ω(t) of `scenes/disc.toml`'s point.
+fn run_points(
+    p: &ReproduceParams,
+    radii: &[f64],
+    densities: &[f64],
+    t: f64,
+    from: f64,
+) -> Result<(Vec<PointResult>, SceneSeries), SweepError> {
     let mut points: Vec<PointResult> = Vec::new();
-    let mut series_of_scene: Vec<(u64, Vec<f64>, Vec<f64>)> = Vec::new();
-    for &rk in &radii {
-        for &dens in &densities {
+    let mut series_of_scene: SceneSeries = Vec::new();
+    for &rk in radii {
+        for &dens in densities {
             // The disc's default radius, side/2 − 1, is R_d: the scene as `scenes/disc.toml`
             // writes it.
             let side = (2.0 * rk * RADIUS).round() as usize + 2;
@@ -273,7 +299,11 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             }
         }
     }
-    p.reporter.stage("rotation: tables and plots");
+    Ok((points, series_of_scene))
+}
+
+/// The runs' and the points' tables.
+fn tables(points: &[PointResult]) -> (Csv, Csv) {
     let point_columns = [
         "radius_over_r",
         "area_fraction",
@@ -291,7 +321,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         ]
         .concat(),
     );
-    for pt in &points {
+    for pt in points {
         let point = [
             cell(pt.radius),
             cell(pt.density),
@@ -315,9 +345,16 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             cell(pt.state.name()),
         ]));
     }
-    let mut made = Made::new(Vec::new(), String::new())
-        .table("rotation_runs.csv", runs_csv)
-        .table("rotation_points.csv", points_csv);
+    (runs_csv, points_csv)
+}
+
+/// |Ω̄| against the disc radius for each alignment rule, and Ω(t) of the scene's point.
+fn plots(
+    points: &[PointResult],
+    densities: &[f64],
+    series_of_scene: &SceneSeries,
+) -> Vec<(String, Plot)> {
+    let mut out = Vec::new();
     for rule in RULES {
         let mut plot = Plot::new(
             format!("Rotation in a disc, align = \"{rule}\""),
@@ -331,7 +368,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         ];
         for rate in RATES {
             for alpha in ALPHAS {
-                for &dens in &densities {
+                for &dens in densities {
                     let sel: Vec<&PointResult> = points
                         .iter()
                         .filter(|q| {
@@ -351,7 +388,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 }
             }
         }
-        made = made.plot(format!("rotation_{rule}.png"), plot);
+        out.push((format!("rotation_{rule}.png"), plot));
     }
     let mut tplot = Plot::new(
         format!(
@@ -361,7 +398,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "time (TU)",
         "Ω = ⟨(r × v)/(|r||v|)⟩",
     );
-    for (seed, times, omega) in &series_of_scene {
+    for (seed, times, omega) in series_of_scene {
         tplot.series.push(
             Series::new(format!("seed {seed}"))
                 .with_points(times, omega, &vec![0.0; times.len()])
@@ -369,9 +406,14 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         );
     }
     if !series_of_scene.is_empty() {
-        made = made.plot("rotation_in_time.png", tplot);
+        out.push(("rotation_in_time.png".to_string(), tplot));
     }
 
+    out
+}
+
+/// The two claims: rotation at some point, and its loss with the disc's size.
+fn claims(points: &[PointResult], radii: &[f64], densities: &[f64]) -> Vec<Claim> {
     let states: Vec<State> = points.iter().map(|q| q.state).collect();
     let best = points
         .iter()
@@ -384,7 +426,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     for rule in RULES {
         for rate in RATES {
             for alpha in ALPHAS {
-                for &dens in &densities {
+                for &dens in densities {
                     let at = |rk: f64| {
                         points.iter().find(|q| {
                             q.radius == rk
@@ -409,7 +451,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         }
     }
     let (v2, why2) = verdict_size(&pairs);
-    let claims = vec![
+    vec![
         Claim::new(
             "rotation (issue 41, T1.4 of the extensions): polar cells confined to a disc rotate collectively and persistently for some parameters (Doxzen et al. 2013; Segerer et al. 2015)",
             match best {
@@ -428,8 +470,12 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             v2,
             why2,
         ),
-    ];
-    let settings = format!(
+    ]
+}
+
+/// The figure's settings, for its verdict.
+fn settings_text(p: &ReproduceParams, radii: &[f64], densities: &[f64], t: f64) -> String {
+    format!(
         "- Polar cells (R = 8, docs/model.md §11.1) in a disc of radius R_d ∈ {{{}}}·R (`[walls] kind = \"disc\"` at its default radius, in a square domain of side 2R_d + 2), at area fractions N R²/R_d² ∈ {{{}}}; alignment to the velocity or to the interface force, J ∈ {{{}}}, α ∈ {{{}}}, D_r = 4.5·10⁻⁴, ζ = 0, the interaction pressure; seeds {}.\n\
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩ about the disc's centre at each frame (`rotation` of `analysis/observables.csv`); a run's Ω̄ is its mean over the second half of the active phase, its persistence the share of those frames with the sign of Ω̄. A point rotates when the mean over seeds of |Ω̄| less two standard errors is at least {ROTATES} and the mean persistence at least {PERSISTENT}; it is still when the mean of |Ω̄| plus two standard errors is below {STILL}; otherwise not established. (Undirected motion of N cells gives Ω of spread about 1/√(2N) per frame, less in the time mean.)\n\
@@ -444,10 +490,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         SCENE_POINT.0,
         SCENE_POINT.1,
         SCENE_POINT.2,
-    );
-    made.claims = claims;
-    made.settings = settings;
-    Ok(made)
+    )
 }
 
 /// The alignment rule, rate and propulsion of `scenes/disc.toml`, drawn in time.
