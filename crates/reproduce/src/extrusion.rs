@@ -238,20 +238,10 @@ mod tests {
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let doc = std::fs::read_to_string(root.join("docs/reproduction.md")).unwrap();
         for scale in ["quick", "paper"] {
             let want =
                 verdicts_from_tables(&root.join(format!("docs/data/extrusion/{scale}"))).unwrap();
-            let rows = crate::doc_verdicts(&doc, "extrusion", &format!("**Verdicts ({scale}):**"));
-            assert_eq!(rows.len(), want.len(), "{scale}: {rows:?}");
-            for ((claim, verdict), (doc_claim, doc_verdict)) in want.iter().zip(&rows) {
-                assert_eq!(claim, doc_claim);
-                assert_eq!(
-                    &verdict.to_string(),
-                    doc_verdict,
-                    "{scale}, {claim}: the docs say {doc_verdict}, the stored table gives {verdict}"
-                );
-            }
+            crate::assert_doc_verdicts("extrusion", &format!("**Verdicts ({scale}):**"), &want);
         }
     }
 

@@ -335,13 +335,12 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .iter()
         .map(|a| a.parse().expect("a number"))
         .collect();
-    let runs = PerRun::read(&points, 200.0 + t / 2.0)?;
     let PerRun {
         ln_msd,
         q,
         lag_l,
         runs_csv,
-    } = runs;
+    } = PerRun::read(&points, 200.0 + t / 2.0)?;
     let mut lines = Lines::new(lag_l);
     for (gi, gamma) in GAMMAS.iter().enumerate() {
         lines.add(gamma, &alphas, &ln_msd[gi], &q[gi]);

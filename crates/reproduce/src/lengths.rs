@@ -695,17 +695,7 @@ mod tests {
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         let want = verdicts_from_tables(&root.join("docs/data/lengths")).unwrap();
-        let doc = std::fs::read_to_string(root.join("docs/reproduction.md")).unwrap();
-        let rows = crate::doc_verdicts(&doc, "lengths", "**Verdicts (quick):**");
-        assert_eq!(rows.len(), want.len(), "{rows:?}");
-        for ((claim, verdict), (doc_claim, doc_verdict)) in want.iter().zip(&rows) {
-            assert_eq!(claim, doc_claim);
-            assert_eq!(
-                &verdict.to_string(),
-                doc_verdict,
-                "{claim}: the docs say {doc_verdict}, the stored tables give {verdict}"
-            );
-        }
+        crate::assert_doc_verdicts("lengths", "**Verdicts (quick):**", &want);
     }
 
     #[test]

@@ -711,6 +711,25 @@ pub(crate) fn column_stats(
         .collect())
 }
 
+/// Checks that the verdict table after the line `heading` in the section of `figure` in
+/// docs/reproduction.md states, row by row, the claims and verdicts `want` (what the figure's
+/// rules give on its stored tables, issue 54); panics naming the first claim that differs.
+#[cfg(test)]
+pub(crate) fn assert_doc_verdicts(figure: &str, heading: &str, want: &[(String, Verdict)]) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let doc = std::fs::read_to_string(root.join("docs/reproduction.md")).unwrap();
+    let rows = doc_verdicts(&doc, figure, heading);
+    assert_eq!(rows.len(), want.len(), "{figure}, {heading}: {rows:?}");
+    for ((claim, verdict), (doc_claim, doc_verdict)) in want.iter().zip(&rows) {
+        assert_eq!(claim, doc_claim);
+        assert_eq!(
+            &verdict.to_string(),
+            doc_verdict,
+            "{heading} {claim}: the docs say {doc_verdict}, the stored tables give {verdict}"
+        );
+    }
+}
+
 /// The rows of a figure's verdict table in a doc, as `(claim, verdict)`: the table after the
 /// line `heading` in the section headed ``## `FIGURE` ``, its first and third cells (the
 /// verdict without its bold), with escaped pipes (`\|`) kept inside their cells. Empty when the
