@@ -11,6 +11,7 @@
 //!
 //! The settings of each figure are written at the top of its `verdict.md`.
 
+mod bloch;
 mod channel;
 mod contractile;
 mod defect_fields;
@@ -175,6 +176,8 @@ pub enum Figure {
     Scaling,
     /// The threshold as the linear instability of an ordered rest state.
     Stability,
+    /// The threshold of the infinite ordered tissue by Floquet–Bloch stability (issue 54).
+    Bloch,
     /// The threshold of the random packing against the run length.
     RunLength,
     /// The critical width of flow in a channel against the activity (issue 28).
@@ -193,7 +196,7 @@ pub enum Figure {
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 14] = [
+    pub const ALL: [Figure; 15] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -201,6 +204,7 @@ impl Figure {
         Self::Contractile,
         Self::Scaling,
         Self::Stability,
+        Self::Bloch,
         Self::RunLength,
         Self::Channel,
         Self::Rotation,
@@ -220,6 +224,7 @@ impl Figure {
             Self::Contractile => "contractile",
             Self::Scaling => "scaling",
             Self::Stability => "stability",
+            Self::Bloch => "bloch",
             Self::RunLength => "run-length",
             Self::Channel => "channel",
             Self::Rotation => "rotation",
@@ -241,6 +246,9 @@ impl Figure {
             Self::Scaling => "Cost of subdomains against the full domain (supplement)",
             Self::Stability => {
                 "The threshold as the linear instability of a hexagonal rest state (issue 26)"
+            }
+            Self::Bloch => {
+                "The threshold of the infinite ordered tissue by Floquet–Bloch stability (issue 54)"
             }
             Self::RunLength => {
                 "The threshold of the random packing against the run length (issue 26)"
@@ -470,6 +478,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Contractile => contractile::make(p)?,
         Figure::Scaling => scaling::make(p)?,
         Figure::Stability => stability::make(p, &dir)?,
+        Figure::Bloch => bloch::make(p, &dir)?,
         Figure::RunLength => run_length::make(p)?,
         Figure::Channel => channel::make(p)?,
         Figure::Rotation => rotation::make(p)?,

@@ -300,3 +300,36 @@ mod tests {
         assert_eq!(p.joined(2), "1.00 2.00 3.00");
     }
 }
+
+/// A result kept on disk with the settings that made it.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Kept<T> {
+    /// The settings, as `{:?}` writes them: a result made with others is made again.
+    fingerprint: String,
+    value: T,
+}
+
+/// The value kept in `path` ([`keep`]) when it was made with `fingerprint`.
+pub(crate) fn kept<T: serde::de::DeserializeOwned>(path: &Path, fingerprint: &str) -> Option<T> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let kept = toml::from_str::<Kept<T>>(&text).ok()?;
+    (kept.fingerprint == fingerprint).then_some(kept.value)
+}
+
+/// Keeps `value`, made with `fingerprint`, in `path` (written whole, under a temporary name
+/// first).
+pub(crate) fn keep<T: serde::Serialize>(
+    path: &Path,
+    fingerprint: &str,
+    value: T,
+) -> Result<T, SweepError> {
+    let kept = Kept {
+        fingerprint: fingerprint.to_string(),
+        value,
+    };
+    let text = toml::to_string(&kept).map_err(|e| SweepError::Reproduce {
+        why: format!("cannot keep {}: {e}", path.display()),
+    })?;
+    write_text(path, &text)?;
+    Ok(kept.value)
+}

@@ -19,9 +19,9 @@ use stability::{
     StabilityError, StepMap, Threshold, ThresholdOptions,
 };
 
-use super::pipeline::{cell, sci, Csv, Made, Picture};
+use super::pipeline::{cell, keep, kept, sci, Csv, Made, Picture};
 use super::rules::{rule_agree, rule_box, rule_continuum, rule_linear, rule_proportional};
-use super::{g, write_text, Claim, ReproduceParams, Scale, Verdict};
+use super::{g, Claim, ReproduceParams, Scale, Verdict};
 use study::SweepError;
 
 /// The γ of the study: five values, so that a line and its curvature can be told apart.
@@ -177,35 +177,6 @@ fn failed(config: &Config, e: StabilityError) -> SweepError {
 struct Outcome {
     threshold: Option<Threshold>,
     no_crossing: Option<String>,
-}
-
-/// A result kept on disk with the settings that made it.
-#[derive(serde::Serialize, serde::Deserialize)]
-struct Kept<T> {
-    /// The settings, as `{:?}` writes them: a result made with others is made again.
-    fingerprint: String,
-    value: T,
-}
-
-/// The value kept in `path` ([`keep`]) when it was made with `fingerprint`.
-fn kept<T: serde::de::DeserializeOwned>(path: &Path, fingerprint: &str) -> Option<T> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let kept = toml::from_str::<Kept<T>>(&text).ok()?;
-    (kept.fingerprint == fingerprint).then_some(kept.value)
-}
-
-/// Keeps `value`, made with `fingerprint`, in `path` (written whole, under a temporary name
-/// first).
-fn keep<T: serde::Serialize>(path: &Path, fingerprint: &str, value: T) -> Result<T, SweepError> {
-    let kept = Kept {
-        fingerprint: fingerprint.to_string(),
-        value,
-    };
-    let text = toml::to_string(&kept).map_err(|e| SweepError::Reproduce {
-        why: format!("stability: cannot keep {}: {e}", path.display()),
-    })?;
-    write_text(path, &text)?;
-    Ok(kept.value)
 }
 
 /// One measured threshold.

@@ -21,6 +21,8 @@
 #![warn(missing_docs)]
 
 mod arnoldi;
+mod bands;
+mod bloch;
 pub mod fit;
 mod growth;
 mod map;
@@ -30,6 +32,8 @@ mod tests;
 mod threshold;
 
 pub use arnoldi::{arnoldi, ArnoldiOptions, Ritz, Spectrum};
+pub use bands::{lowest, wave_thresholds, WaveOptions, WavePoint, WaveThreshold};
+pub use bloch::{box_wavevectors, repeat, BlochMap, BlochTiling};
 pub use growth::{growth_rate, random_direction, settle, start_vector, Growth, GrowthOptions};
 pub use map::{dot, max_change, norm, transfer, Operator, StepMap};
 pub use rest::{rest_state, HexBox, Relaxation, RestState};

@@ -1,0 +1,563 @@
+//! `reproduce bloch`: the activity threshold of the infinite ordered tissue, by Floquet–Bloch
+//! stability (issue 54), beside the thresholds of the boxes it explains.
+//!
+//! The stability figure's hexagonal packing (6 × 10 cells on 83 × 120 nodes) repeats every 83
+//! nodes along its rows and every 24 across: its primitive cell holds 6 × 2 cells, and the box
+//! 83k × 120k is k × 5k primitive cells. For each Bloch wave vector `q` of a grid over the
+//! Brillouin zone, `ζ_cr(q)` is where the leading growth rate of the Bloch map crosses zero
+//! (`stability::wave_thresholds`). A box's threshold is the smallest `ζ_cr(q)` over the waves
+//! it allows, and the infinite tissue's the smallest over the zone: the box-size dependence is
+//! which waves fit, and no fit in L is needed.
+
+use std::path::Path;
+
+use mechanics::{ModelParams, PressureKind, StepParams};
+use render::{Plot, Series};
+use stability::{
+    box_wavevectors, lowest, threshold, wave_thresholds, ArnoldiOptions, BlochTiling, HexBox,
+    Method, Relaxation, StabilityError, ThresholdOptions, WaveOptions, WaveThreshold,
+};
+
+use super::pipeline::{cell, keep, kept, sci, Csv, Made};
+use super::rule::Rule;
+use super::{g, Claim, ReproduceParams, Scale};
+use study::SweepError;
+
+/// The paper's density: 60 cells on 100 × 100 nodes.
+const AREA_PER_CELL: f64 = 100.0 * 100.0 / 60.0;
+
+/// γ of the study (the stability figure's box study).
+const GAMMA: f64 = 0.01;
+
+/// The solver's settings, those of the stability figure: τ = 100 steps of 0.5, Krylov 30.
+const ARNOLDI: ArnoldiOptions = ArnoldiOptions {
+    krylov: 30,
+    eps: 1e-5,
+    seed: 1,
+};
+
+/// The primitive cell: 6 × 2 cells on 83 × 24 nodes.
+fn primitive() -> HexBox {
+    HexBox::new(6, 2, AREA_PER_CELL).expect("two rows")
+}
+
+fn pressure_name(p: PressureKind) -> &'static str {
+    match p {
+        PressureKind::Paper => "paper",
+        _ => "interaction",
+    }
+}
+
+/// The two activities every wave starts from, by form: about the stability figure's box
+/// thresholds (paper 3.7–5.7·10⁻⁴, interaction 2.7–3.8·10⁻⁴).
+fn start(p: PressureKind) -> [f64; 2] {
+    match p {
+        PressureKind::Paper => [3e-4, 6e-4],
+        _ => [2e-4, 4e-4],
+    }
+}
+
+/// The grid over the half zone `q_y ∈ [0, ½]` (`±q` have the same rates; on `q_y = 0` and
+/// `q_y = ½`, `q_x ∈ [0, ½]` suffices): `q_x` in steps of `1/(2 nx)`, `q_y` of `1/(2 ny)`.
+/// Quick: q_x ∈ {−¼, 0, ¼, ½}, q_y ∈ {0, 0.1, …, 0.5} (22 waves), which holds every wave of
+/// the boxes k = 1 and 2 (83 × 120, 166 × 240). Paper: twice as fine along each axis (82
+/// waves), which holds those of k = 4 (332 × 480).
+fn grid(scale: Scale) -> Vec<[f64; 2]> {
+    let (nx, ny) = spacing(scale);
+    let mut qs = Vec::new();
+    for b in 0..=ny {
+        for a in -(nx as i64) + 1..=nx as i64 {
+            let q = folded([a as f64 / (2 * nx) as f64, b as f64 / (2 * ny) as f64]);
+            if !qs.contains(&q) {
+                qs.push(q);
+            }
+        }
+    }
+    qs
+}
+
+/// The grid's steps per half reciprocal vector, `(nx, ny)`.
+fn spacing(scale: Scale) -> (usize, usize) {
+    match scale {
+        Scale::Quick => (2, 5),
+        Scale::Paper => (4, 10),
+    }
+}
+
+fn wave_opts(p: PressureKind) -> WaveOptions {
+    WaveOptions {
+        step: StepParams::new(0.5, 1),
+        steps: 100,
+        arnoldi: ARNOLDI,
+        start: start(p),
+        refine: 3,
+        tol: 1e-5,
+    }
+}
+
+fn failed(what: &str, e: StabilityError) -> SweepError {
+    SweepError::Reproduce {
+        why: format!("bloch, {what}: {e}"),
+    }
+}
+
+/// One pressure form's results.
+struct Form {
+    pressure: PressureKind,
+    tiling: BlochTiling,
+    waves: Vec<WaveThreshold>,
+    /// The waves at half the grid's spacing around the lowest one.
+    refined: Vec<WaveThreshold>,
+    /// The 83 × 120 box's threshold by Arnoldi on the whole box (the stability figure's way).
+    whole_box: Option<(f64, f64)>,
+}
+
+impl Form {
+    fn all(&self) -> impl Iterator<Item = &WaveThreshold> {
+        self.waves.iter().chain(&self.refined)
+    }
+
+    /// The threshold of the box of `k × 5k` primitive cells: the lowest of its waves, when the
+    /// grid holds them all.
+    fn box_threshold(&self, k: usize) -> Option<&WaveThreshold> {
+        let want = box_wavevectors([k, 5 * k]);
+        let found: Vec<&WaveThreshold> =
+            want.iter().filter_map(|q| self.wave(folded(*q))).collect();
+        (found.len() == want.len()).then(|| lowest(found)).flatten()
+    }
+
+    fn wave(&self, q: [f64; 2]) -> Option<&WaveThreshold> {
+        self.all()
+            .find(|w| (w.q[0] - q[0]).abs() < 1e-9 && (w.q[1] - q[1]).abs() < 1e-9)
+    }
+}
+
+/// `q` or `−q` in the half zone the grid covers: `q_y ∈ [0, ½]`, and `q_x ∈ [0, ½]` where
+/// `q_y` is 0 or ½ (there `−q` is `q` mirrored in x, modulo a reciprocal vector).
+fn folded(q: [f64; 2]) -> [f64; 2] {
+    let wrap = |x: f64| {
+        let y = x - x.round();
+        // (−½, ½], and whole multiples of 1e-12 snapped so that grid points compare equal.
+        let y = (y * 1e9).round() / 1e9;
+        if y <= -0.5 {
+            y + 1.0
+        } else {
+            y
+        }
+    };
+    let (mut x, mut y) = (wrap(q[0]), wrap(q[1]));
+    if y < 0.0 {
+        x = wrap(-x);
+        y = wrap(-y);
+    }
+    if (y == 0.0 || y == 0.5) && x < 0.0 {
+        x = wrap(-x);
+    }
+    [x, y]
+}
+
+fn params(p: PressureKind) -> ModelParams {
+    let mut m = ModelParams::paper(0.0).with_pressure(p);
+    m.energy.gamma = GAMMA;
+    m
+}
+
+/// The waves of `qs` for one form, each set kept in `dir` as it finishes.
+fn waves_kept(
+    dir: &Path,
+    name: &str,
+    tiling: &BlochTiling,
+    pressure: PressureKind,
+    qs: &[[f64; 2]],
+) -> Result<Vec<WaveThreshold>, SweepError> {
+    let opts = wave_opts(pressure);
+    let file = dir.join(format!("{name}-{}.toml", pressure_name(pressure)));
+    let fingerprint = format!("{qs:?} {opts:?} {:?} {:?}", tiling.primitive, tiling.reps);
+    if let Some(w) = kept::<Vec<WaveThreshold>>(&file, &fingerprint) {
+        return Ok(w);
+    }
+    let w = wave_thresholds(tiling, &params(pressure), qs, &opts)
+        .map_err(|e| failed(pressure_name(pressure), e))?;
+    keep(&file, &fingerprint, w)
+}
+
+/// The grid's four neighbours of `q` at half its spacing, folded into the half zone.
+fn around(q: [f64; 2], scale: Scale) -> Vec<[f64; 2]> {
+    let (nx, ny) = spacing(scale);
+    let (hx, hy) = (0.25 / nx as f64, 0.25 / ny as f64);
+    let mut out: Vec<[f64; 2]> = Vec::new();
+    for d in [[-hx, 0.0], [hx, 0.0], [0.0, -hy], [0.0, hy]] {
+        let n = folded([q[0] + d[0], q[1] + d[1]]);
+        if !out.contains(&n) {
+            out.push(n);
+        }
+    }
+    out
+}
+
+pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> {
+    let done = dir.join("waves");
+    std::fs::create_dir_all(&done).map_err(|e| SweepError::write("bloch", &done, e))?;
+    let qs = grid(p.scale);
+    let mut forms = Vec::new();
+    for pressure in [PressureKind::Paper, PressureKind::Interaction] {
+        let pn = pressure_name(pressure);
+        p.reporter
+            .stage(&format!("bloch, {pn} form: the rest state on 83 × 48"));
+        let tiling = BlochTiling::relax(
+            primitive(),
+            [1, 2],
+            &params(pressure),
+            &Relaxation::default(),
+        )
+        .map_err(|e| failed(pn, e))?;
+        p.reporter
+            .stage(&format!("bloch, {pn} form: ζ_cr(q) of {} waves", qs.len()));
+        let waves = waves_kept(&done, "grid", &tiling, pressure, &qs)?;
+        let best = lowest(&waves).map(|w| w.q).unwrap_or([0.0, 0.0]);
+        p.reporter
+            .stage(&format!("bloch, {pn} form: the waves around the lowest"));
+        let refined = waves_kept(&done, "refined", &tiling, pressure, &around(best, p.scale))?;
+        p.reporter
+            .stage(&format!("bloch, {pn} form: the 83 × 120 box by Arnoldi"));
+        let whole_box = whole_box(&done, &tiling, pressure)?;
+        forms.push(Form {
+            pressure,
+            tiling,
+            waves,
+            refined,
+            whole_box,
+        });
+    }
+    let mut made = Made::new(Vec::new(), String::new());
+    tables(&mut made, &forms);
+    draw(&mut made, &forms);
+    made.claims = claims(&forms);
+    made.settings = settings(p.scale, &forms);
+    Ok(made)
+}
+
+/// The 83 × 120 box's threshold by Arnoldi on the whole box, about the same rest state, by
+/// bisection to ±2·10⁻⁵ (kept).
+fn whole_box(
+    dir: &Path,
+    tiling: &BlochTiling,
+    pressure: PressureKind,
+) -> Result<Option<(f64, f64)>, SweepError> {
+    let pn = pressure_name(pressure);
+    let opts = ThresholdOptions {
+        step: StepParams::new(0.5, 1),
+        steps: 100,
+        lo: 0.0,
+        hi: 0.008,
+        tol: 2e-5,
+        narrow: 1e-4,
+    };
+    let file = dir.join(format!("box-{pn}.toml"));
+    let fingerprint = format!("{opts:?} {ARNOLDI:?} {:?}", tiling.primitive);
+    if let Some(v) = kept::<Option<(f64, f64)>>(&file, &fingerprint) {
+        return Ok(v);
+    }
+    let boxed = tiling
+        .supercell([1, 5], &params(pressure))
+        .map_err(|e| failed(pn, e))?;
+    let v = match threshold(&boxed, &params(pressure), &Method::Arnoldi(ARNOLDI), &opts) {
+        Ok(t) => Some((t.zeta_cr, t.err)),
+        Err(StabilityError::NoCrossing { .. }) => None,
+        Err(e) => return Err(failed(pn, e)),
+    };
+    keep(&file, &fingerprint, v)
+}
+
+fn tables(made: &mut Made, forms: &[Form]) {
+    let mut waves = Csv::new(&[
+        "pressure",
+        "qx",
+        "qy",
+        "supercell_x",
+        "supercell_y",
+        "zeta_cr",
+        "zeta_cr_err",
+        "bracketed",
+        "refined",
+    ]);
+    let mut points = Csv::new(&["pressure", "qx", "qy", "zeta", "sigma", "residual"]);
+    for f in forms {
+        let pn = pressure_name(f.pressure);
+        for (w, refined) in f
+            .waves
+            .iter()
+            .map(|w| (w, false))
+            .chain(f.refined.iter().map(|w| (w, true)))
+        {
+            waves.row([
+                cell(pn),
+                cell(w.q[0]),
+                cell(w.q[1]),
+                cell(w.supercell[0]),
+                cell(w.supercell[1]),
+                sci(w.zeta_cr),
+                sci(w.err),
+                cell(w.bracketed),
+                cell(refined),
+            ]);
+            for pt in &w.points {
+                points.row([
+                    cell(pn),
+                    cell(w.q[0]),
+                    cell(w.q[1]),
+                    sci(pt.zeta),
+                    sci(pt.sigma),
+                    sci(pt.residual),
+                ]);
+            }
+        }
+    }
+    made.add_table("waves.csv", waves);
+    made.add_table("growth_rates.csv", points);
+    let mut th = Csv::new(&[
+        "pressure",
+        "what",
+        "lx",
+        "ly",
+        "qx",
+        "qy",
+        "zeta_cr",
+        "zeta_cr_err",
+    ]);
+    for f in forms {
+        let pn = pressure_name(f.pressure);
+        for k in [1, 2, 4] {
+            if let Some(w) = f.box_threshold(k) {
+                th.row([
+                    cell(pn),
+                    cell(format!("box of {k} × {} primitive cells, Bloch", 5 * k)),
+                    cell(83 * k),
+                    cell(120 * k),
+                    cell(w.q[0]),
+                    cell(w.q[1]),
+                    sci(w.zeta_cr),
+                    sci(w.err),
+                ]);
+            }
+        }
+        if let Some((z, e)) = f.whole_box {
+            th.row([
+                cell(pn),
+                cell("box of 1 × 5 primitive cells, Arnoldi on the whole box"),
+                cell(83),
+                cell(120),
+                cell(f64::NAN),
+                cell(f64::NAN),
+                sci(z),
+                sci(e),
+            ]);
+        }
+        if let Some((w, err)) = infinite(f) {
+            th.row([
+                cell(pn),
+                cell("infinite tissue, Bloch"),
+                cell(f64::INFINITY),
+                cell(f64::INFINITY),
+                cell(w.q[0]),
+                cell(w.q[1]),
+                sci(w.zeta_cr),
+                sci(err),
+            ]);
+        }
+    }
+    made.add_table("thresholds.csv", th);
+}
+
+/// The infinite tissue's threshold: the lowest wave over the grid and its refinement, with an
+/// error that adds the refinement's move (the grid's resolution) to the wave's own.
+fn infinite(f: &Form) -> Option<(&WaveThreshold, f64)> {
+    let grid = lowest(&f.waves)?;
+    let best = lowest(f.all())?;
+    let resolution = grid.zeta_cr - best.zeta_cr;
+    Some((best, best.err.hypot(resolution)))
+}
+
+fn draw(made: &mut Made, forms: &[Form]) {
+    for f in forms {
+        let pn = pressure_name(f.pressure);
+        let mut plot = Plot::new(
+            format!("ζ_cr of each Bloch wave, {pn} form (γ = {GAMMA})"),
+            "q_y (units of 2π/24 nodes)",
+            "ζ_cr(q)",
+        );
+        let mut qxs: Vec<f64> = f.waves.iter().map(|w| w.q[0]).collect();
+        qxs.sort_by(f64::total_cmp);
+        qxs.dedup();
+        for qx in qxs {
+            let line: Vec<&WaveThreshold> = f.waves.iter().filter(|w| w.q[0] == qx).collect();
+            let x: Vec<f64> = line.iter().map(|w| w.q[1]).collect();
+            let y: Vec<f64> = line.iter().map(|w| w.zeta_cr).collect();
+            let e: Vec<f64> = line.iter().map(|w| w.err).collect();
+            plot.series
+                .push(Series::new(format!("q_x = {qx} (units of 2π/83)")).with_points(&x, &y, &e));
+        }
+        if let Some((w, _)) = infinite(f) {
+            plot.hlines
+                .push((w.zeta_cr, format!("infinite tissue: {}", g(w.zeta_cr))));
+        }
+        if let Some(w) = f.box_threshold(1) {
+            plot.hlines
+                .push((w.zeta_cr, format!("83 × 120 box: {}", g(w.zeta_cr))));
+        }
+        made.add_plot(format!("zeta_cr_{pn}.png"), plot);
+        // σ(q) at the upper starting activity.
+        let z = start(f.pressure)[1];
+        let mut sp = Plot::new(
+            format!("growth rate of each Bloch wave at ζ = {}, {pn} form", g(z)),
+            "q_y (units of 2π/24 nodes)",
+            "σ(q) (1/TU)",
+        );
+        let mut qxs: Vec<f64> = f.waves.iter().map(|w| w.q[0]).collect();
+        qxs.sort_by(f64::total_cmp);
+        qxs.dedup();
+        for qx in qxs {
+            let pts: Vec<(f64, f64, f64)> = f
+                .waves
+                .iter()
+                .filter(|w| w.q[0] == qx)
+                .filter_map(|w| {
+                    w.points
+                        .iter()
+                        .find(|p| p.zeta == z)
+                        .map(|p| (w.q[1], p.sigma, p.residual))
+                })
+                .collect();
+            let x: Vec<f64> = pts.iter().map(|p| p.0).collect();
+            let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
+            let e: Vec<f64> = pts.iter().map(|p| p.2).collect();
+            sp.series
+                .push(Series::new(format!("q_x = {qx}")).with_points(&x, &y, &e));
+        }
+        sp.hlines.push((0.0, "σ = 0".into()));
+        made.add_plot(format!("growth_rate_{pn}.png"), sp);
+    }
+}
+
+fn claims(forms: &[Form]) -> Vec<Claim> {
+    let mut out = Vec::new();
+    for f in forms {
+        let pn = pressure_name(f.pressure);
+        // Check: Bloch's threshold of the 83 × 120 box is the whole box's.
+        if let (Some(w), Some((z, e))) = (f.box_threshold(1), f.whole_box) {
+            let rule = Rule::absence(
+                "ζ_cr(83 × 120) by Bloch − by Arnoldi on the whole box",
+                5e-5,
+            );
+            let o = rule.decide(w.zeta_cr - z, w.err.hypot(e) / 2.0);
+            out.push(Claim::new(
+                format!(
+                    "Check ({pn} form): the box's threshold is that of the Bloch waves it allows"
+                ),
+                format!(
+                    "Bloch {} ± {} (q = {:?}), whole box {} ± {}",
+                    g(w.zeta_cr),
+                    g(w.err),
+                    w.q,
+                    g(z),
+                    g(e)
+                ),
+                o.verdict,
+                o.why,
+            ));
+        }
+        // The infinite tissue's threshold is finite.
+        if let Some((w, err)) = infinite(f) {
+            let rule = Rule::effect("ζ_cr of the infinite tissue", 5e-5);
+            let o = rule.decide(w.zeta_cr, err / 2.0);
+            out.push(Claim::new(
+                format!("9.1 ({pn} form): the infinite ordered tissue has a finite threshold"),
+                format!(
+                    "ζ_cr(∞) = {} ± {} at q = {:?}{}",
+                    g(w.zeta_cr),
+                    g(err),
+                    w.q,
+                    if w.bracketed { "" } else { " (extrapolated)" }
+                ),
+                o.verdict,
+                o.why,
+            ));
+            // 9.2b: the box's threshold against the infinite tissue's.
+            if let Some(b) = f.box_threshold(1) {
+                let rule = Rule::absence("ζ_cr(83 × 120) − ζ_cr(∞), relative to ζ_cr(∞)", 0.1);
+                let d = (b.zeta_cr - w.zeta_cr) / w.zeta_cr;
+                let e = b.err.hypot(err) / w.zeta_cr / 2.0;
+                let o = rule.decide(d, e);
+                out.push(Claim::new(
+                    format!("9.2b ({pn} form): ζ_cr does not depend on the box (83 × 120 against the infinite tissue)"),
+                    format!("{} ± {} against {} ± {}", g(b.zeta_cr), g(b.err), g(w.zeta_cr), g(err)),
+                    o.verdict,
+                    o.why,
+                ));
+            }
+        }
+    }
+    out
+}
+
+fn settings(scale: Scale, forms: &[Form]) -> String {
+    let mut s = format!(
+        "Floquet–Bloch stability of the hexagonal packing at γ = {GAMMA}, {} scale: primitive cell 6 × 2 cells on 83 × 24 nodes, rest state relaxed on 83 × 48 (ζ = 0, until max|Δφ|/Δt < 1e-7), then copied; map of 100 Heun steps of dt 0.5 (τ = 50 TU), Arnoldi with Krylov {} and ε = {:e}; each wave's ζ_cr by regula falsi from two activities (up to 3 more evaluations, to 1e-5); grid of {} waves over the half zone, and the four at half its spacing around the lowest. The errors in the claims are the root's last move and the Ritz residual over the slope, halved to a standard error (2 of them resolve).\n",
+        scale.name(),
+        ARNOLDI.krylov,
+        ARNOLDI.eps,
+        grid(scale).len()
+    );
+    for f in forms {
+        s.push_str(&format!(
+            "- {} form: rest state relaxed for {} TU, S_rms = {}, asymmetry between copies {}\n",
+            pressure_name(f.pressure),
+            g(f.tiling.rest.time),
+            g(f.tiling.rest.s_rms),
+            g(f.tiling.asymmetry())
+        ));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The grid lies in the half zone, once each, and holds every wave of the boxes it is said
+    /// to (k = 1, 2 at the quick scale; 1, 2, 4 at the paper scale), but not those of k = 3.
+    #[test]
+    fn the_grid_holds_the_boxes_waves() {
+        for (scale, n, boxes) in [
+            (Scale::Quick, 22, vec![1, 2]),
+            (Scale::Paper, 82, vec![1, 2, 4]),
+        ] {
+            let qs = grid(scale);
+            assert_eq!(qs.len(), n, "{scale:?}");
+            for q in &qs {
+                assert_eq!(folded(*q), *q, "{q:?} is not in the half zone");
+            }
+            for k in boxes {
+                for q in box_wavevectors([k, 5 * k]) {
+                    assert!(qs.contains(&folded(q)), "{scale:?}: k = {k}, {q:?}");
+                }
+            }
+            let k3 = box_wavevectors([3, 15]);
+            assert!(k3.iter().any(|q| !qs.contains(&folded(*q))));
+        }
+    }
+
+    /// `q` and `−q`, and `q` plus a reciprocal vector, fold to the same wave.
+    #[test]
+    fn a_wave_and_its_opposite_fold_together() {
+        for a in -8i32..=8 {
+            for b in -8i32..=8 {
+                let q = [a as f64 / 16.0, b as f64 / 10.0];
+                let f = folded(q);
+                assert_eq!(folded([-q[0], -q[1]]), f, "{q:?}");
+                assert_eq!(folded([q[0] + 1.0, q[1] - 1.0]), f, "{q:?}");
+                assert!((0.0..=0.5).contains(&f[1]) && f[0] > -0.5 && f[0] <= 0.5);
+            }
+        }
+    }
+}

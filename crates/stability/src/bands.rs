@@ -1,0 +1,177 @@
+//! The threshold of every Bloch wave, and from them those of the infinite tissue and of any
+//! box (issue 54).
+//!
+//! For a wave vector `q`, `ζ_cr(q)` is where the leading growth rate of the Bloch map
+//! ([`crate::BlochMap`]) crosses zero. A box of `n × m` primitive cells goes unstable at the
+//! smallest `ζ_cr(q)` over the `q` it allows ([`crate::box_wavevectors`]); the infinite tissue at
+//! the smallest over the Brillouin zone. σ(ζ) of one wave is nearly straight, so each `ζ_cr(q)`
+//! is found by regula falsi from two activities, with rayon over the waves.
+
+use mechanics::{ModelParams, StepParams};
+use rayon::prelude::*;
+
+use crate::{arnoldi, ArnoldiOptions, BlochMap, BlochTiling, StabilityError};
+
+/// How [`wave_thresholds`] looks for each wave's crossing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WaveOptions {
+    /// The time step and the steps per application of the map (τ = steps · dt).
+    pub step: StepParams,
+    /// Steps per application.
+    pub steps: usize,
+    /// Arnoldi's settings for each σ.
+    pub arnoldi: ArnoldiOptions,
+    /// The two activities every wave is evaluated at first.
+    pub start: [f64; 2],
+    /// Regula-falsi steps after them.
+    pub refine: usize,
+    /// Stop refining a wave once its root moves by less than this.
+    pub tol: f64,
+}
+
+/// One σ of one wave.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WavePoint {
+    /// Activity.
+    pub zeta: f64,
+    /// The leading growth rate.
+    pub sigma: f64,
+    /// Its Ritz residual (a rate).
+    pub residual: f64,
+}
+
+/// The threshold of one Bloch wave.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct WaveThreshold {
+    /// The wave vector, in units of the reciprocal vectors.
+    pub q: [f64; 2],
+    /// The supercell it was computed on.
+    pub supercell: [usize; 2],
+    /// Where σ crosses zero: the root of the straight line through the two evaluations nearest
+    /// it on either side (or, without a sign change, through the last two: an extrapolation,
+    /// and `bracketed` is false).
+    pub zeta_cr: f64,
+    /// Its error: the last move of the root, and the Ritz residuals over the slope, whichever
+    /// is larger.
+    pub err: f64,
+    /// Whether evaluations on both sides of zero bracket it.
+    pub bracketed: bool,
+    /// Every evaluation, in the order made.
+    pub points: Vec<WavePoint>,
+}
+
+impl WaveThreshold {
+    fn from_points(q: [f64; 2], supercell: [usize; 2], points: Vec<WavePoint>) -> Self {
+        let (zeta_cr, slope, bracketed) = root(&points);
+        let last_move = if points.len() >= 3 {
+            let (prev, _, _) = root(&points[..points.len() - 1]);
+            (zeta_cr - prev).abs()
+        } else {
+            f64::INFINITY
+        };
+        let residual = points.iter().map(|p| p.residual).fold(0.0, f64::max);
+        let err = last_move.max(residual / slope.abs());
+        Self {
+            q,
+            supercell,
+            zeta_cr,
+            err,
+            bracketed,
+            points,
+        }
+    }
+}
+
+/// The root of σ(ζ) from the evaluations: the line through the nearest points on either side of
+/// zero, or through the last two; with its slope and whether it is bracketed.
+fn root(points: &[WavePoint]) -> (f64, f64, bool) {
+    let below = points
+        .iter()
+        .filter(|p| p.sigma < 0.0)
+        .max_by(|a, b| a.zeta.total_cmp(&b.zeta));
+    let above = points
+        .iter()
+        .filter(|p| p.sigma >= 0.0)
+        .min_by(|a, b| a.zeta.total_cmp(&b.zeta));
+    let (a, b, bracketed) = match (below, above) {
+        (Some(a), Some(b)) => (a, b, true),
+        _ => {
+            let n = points.len();
+            (&points[n - 2], &points[n - 1], false)
+        }
+    };
+    let slope = (b.sigma - a.sigma) / (b.zeta - a.zeta);
+    (a.zeta - a.sigma / slope, slope, bracketed)
+}
+
+fn sigma(
+    tiling: &BlochTiling,
+    params: &ModelParams,
+    opts: &WaveOptions,
+    q: [f64; 2],
+    zeta: f64,
+) -> Result<WavePoint, StabilityError> {
+    let p = params.with_zeta(zeta);
+    let mut map = BlochMap::new(
+        tiling,
+        &p,
+        opts.step,
+        opts.steps,
+        tiling.supercell_for(q),
+        q,
+    )?;
+    let s = arnoldi(&mut map, &opts.arnoldi, None)?;
+    Ok(WavePoint {
+        zeta,
+        sigma: s.sigma(),
+        residual: s.ritz.first().map_or(f64::NAN, |r| r.residual),
+    })
+}
+
+/// `ζ_cr(q)` of every wave in `qs`, about `tiling`'s rest state with the model `params`:
+/// σ at `opts.start`, then up to `opts.refine` regula-falsi steps until the root moves by less
+/// than `opts.tol` (a wave whose line extrapolates below zero, or that never turns, keeps its
+/// extrapolation with `bracketed` false).
+///
+/// # Errors
+/// Whatever a map or Arnoldi fails with.
+pub fn wave_thresholds(
+    tiling: &BlochTiling,
+    params: &ModelParams,
+    qs: &[[f64; 2]],
+    opts: &WaveOptions,
+) -> Result<Vec<WaveThreshold>, StabilityError> {
+    qs.par_iter()
+        .map(|&q| {
+            let mut points = vec![
+                sigma(tiling, params, opts, q, opts.start[0])?,
+                sigma(tiling, params, opts, q, opts.start[1])?,
+            ];
+            for _ in 0..opts.refine {
+                let (z, _, _) = root(&points);
+                let nearest = points
+                    .iter()
+                    .map(|p| (p.zeta - z).abs())
+                    .fold(f64::INFINITY, f64::min);
+                if !z.is_finite() || z <= 0.0 || nearest < opts.tol {
+                    break;
+                }
+                points.push(sigma(tiling, params, opts, q, z)?);
+            }
+            Ok(WaveThreshold::from_points(
+                q,
+                tiling.supercell_for(q),
+                points,
+            ))
+        })
+        .collect()
+}
+
+/// The threshold of a set of waves (a box's, or a grid over the zone): the smallest `ζ_cr(q)`
+/// among them, with its wave.
+pub fn lowest<'a>(waves: impl IntoIterator<Item = &'a WaveThreshold>) -> Option<&'a WaveThreshold> {
+    waves
+        .into_iter()
+        .filter(|w| w.zeta_cr.is_finite())
+        .min_by(|a, b| a.zeta_cr.total_cmp(&b.zeta_cr))
+}
