@@ -950,7 +950,7 @@ fn a_sweep_with_analyze_adds_the_analysis_columns() {
     let summary = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
     assert!(
         summary.lines().next().unwrap().ends_with(
-            ",growth_rate,length_velocity,length_vorticity,length_q,defect_density,creation_rate"
+            ",growth_rate,growth_exponent,length_velocity,length_vorticity,length_q,defect_density,creation_rate"
         ),
         "{summary}"
     );

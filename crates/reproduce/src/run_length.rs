@@ -254,11 +254,41 @@ fn per_seed(rates: &[(f64, u64, f64)], seed: u64) -> Threshold {
     growth_threshold(&points)
 }
 
+/// What a seed's threshold at run length T is read from: where it turns positive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Estimator {
+    /// The growth rate of ln v_rms over [T/2, T] (per TU).
+    Rate,
+    /// The local exponent d ln v_rms / d ln t over [T/2, T] (issue 54): scale-free, so a
+    /// packing that relaxes as a power law keeps a negative exponent at every T, where its
+    /// growth rate tends to zero as ~1/T.
+    Exponent,
+}
+
+impl Estimator {
+    const ALL: [Estimator; 2] = [Estimator::Rate, Estimator::Exponent];
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::Rate => "growth rate",
+            Self::Exponent => "local exponent",
+        }
+    }
+
+    fn of(self, s: &study::summary::RunSummary) -> f64 {
+        match self {
+            Self::Rate => s.growth_rate,
+            Self::Exponent => s.growth_exponent,
+        }
+    }
+}
+
 /// The mean ζ_cr of the runs of `pressure` cut at each run length, with its standard error:
 /// `(T, ζ_cr, s.e.)` where it is measured; each seed's threshold into `csv` and each mean
 /// into `means`.
 fn thresholds_by_length(
     res: &super::SweepResult,
+    estimator: Estimator,
     pressure: &str,
     seeds: &[u64],
     csv: &mut Csv,
@@ -276,7 +306,7 @@ fn thresholds_by_length(
                 (
                     r.values[1].parse().unwrap_or(f64::NAN),
                     r.seed,
-                    r.summary.growth_rate,
+                    estimator.of(&r.summary),
                 )
             })
             .collect();
@@ -297,7 +327,14 @@ fn thresholds_by_length(
                     (String::new(), "above")
                 }
             };
-            csv.row([cell(pressure), cell(t), cell(s), value, cell(censored)]);
+            csv.row([
+                cell(estimator.name()),
+                cell(pressure),
+                cell(t),
+                cell(s),
+                value,
+                cell(censored),
+            ]);
         }
         let mean = if above > 0 {
             None
@@ -306,6 +343,7 @@ fn thresholds_by_length(
         };
         let (m, se) = mean.unwrap_or((f64::NAN, f64::NAN));
         means.row([
+            cell(estimator.name()),
             cell(pressure),
             cell(t),
             sci(m),
@@ -348,8 +386,16 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         let s = seeds_of(p.scale);
         (s.first..=s.last).collect()
     };
-    let mut csv = Csv::new(&["pressure", "run_time", "seed", "zeta_cr", "censored"]);
+    let mut csv = Csv::new(&[
+        "estimator",
+        "pressure",
+        "run_time",
+        "seed",
+        "zeta_cr",
+        "censored",
+    ]);
     let mut means = Csv::new(&[
+        "estimator",
         "pressure",
         "run_time",
         "zeta_cr",
@@ -368,6 +414,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     plot.zero_y = true;
     let mut claims = Vec::new();
     let mut fits = Csv::new(&[
+        "estimator",
         "pressure",
         "zeta_inf",
         "zeta_inf_err",
@@ -382,15 +429,19 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "zero_chi2",
         "zero_dof",
     ]);
-    for pressure in PRESSURES {
-        let pts = thresholds_by_length(&res, pressure, &seeds, &mut csv, &mut means)?;
+    for (estimator, pressure) in Estimator::ALL
+        .into_iter()
+        .flat_map(|e| PRESSURES.map(|p| (e, p)))
+    {
+        let en = estimator.name();
+        let pts = thresholds_by_length(&res, estimator, pressure, &seeds, &mut csv, &mut means)?;
         let (t, y, e): (Vec<f64>, Vec<f64>, Vec<f64>) = (
             pts.iter().map(|p| p.0).collect(),
             pts.iter().map(|p| p.1).collect(),
             pts.iter().map(|p| p.2.max(1e-6)).collect(),
         );
         plot.series
-            .push(Series::new(format!("{pressure} form")).with_points(&t, &y, &e));
+            .push(Series::new(format!("{pressure} form, {en}")).with_points(&t, &y, &e));
         let fit = fit_power(&t, &y, &e);
         let zero = fit_zero(&t, &y, &e);
         let floor = y.iter().copied().fold(f64::INFINITY, f64::min);
@@ -402,6 +453,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 dof: 0,
             });
             fits.row([
+                cell(en),
                 cell(pressure),
                 sci(f.zeta_inf),
                 sci(f.zeta_inf_err),
@@ -421,14 +473,16 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 .collect();
             let yy: Vec<f64> = tt.iter().map(|t| f.zeta_inf + f.a * t.powf(-f.b)).collect();
             plot.series.push(
-                Series::new(format!("{pressure}: ζ_∞ + a T^(−b)"))
+                Series::new(format!("{pressure}, {en}: ζ_∞ + a T^(−b)"))
                     .with_points(&tt, &yy, &vec![0.0; tt.len()])
                     .line_only(),
             );
         }
         let (v, why) = rule_finite(fit.as_ref(), zero.as_ref(), floor);
         claims.push(Claim::new(
-            format!("9.1: the random packing has a finite threshold as T → ∞ ({pressure} form)"),
+            format!(
+                "9.1: the random packing has a finite threshold as T → ∞ ({pressure} form, by the {en})"
+            ),
             pts.iter()
                 .map(|p| format!("T = {}: {} ± {}", p.0, g(p.1), g(p.2)))
                 .collect::<Vec<_>>()
@@ -440,7 +494,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
 
     let settings = format!(
         "- The paper's scene (L = 100, 60 cells, γ = 0.01, random packing relaxed 200 TU at ζ = 0), {}, both pressure forms, ζ ∈ {{{ZETAS}}}, seeds {}–{}, each run {t_max} TU of activity.\n\
-         - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] first turns positive (linear interpolation between the activities around the crossing); seeds whose crossing lies below the lowest ζ are censored, not dropped: each lies in [0, lowest ζ], and the mean puts them at the middle with the half-width of the mean's range added to its standard error in quadrature; a run length where a seed's crossing lies above the grid is left out (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
+         - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] (per TU), or its local exponent d ln v_rms / d ln t over [T/2, T] (t from the start of the activity; issue 54: scale-free, so a power-law relaxation keeps a negative exponent at every T where its rate tends to zero as ~1/T), first turns positive (linear interpolation between the activities around the crossing); seeds whose crossing lies below the lowest ζ are censored, not dropped: each lies in [0, lowest ζ], and the mean puts them at the middle with the half-width of the mean's range added to its standard error in quadrature; a run length where a seed's crossing lies above the grid is left out (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
          - Fit: `ζ_cr(T) = ζ_∞ + a T^(−b)`, weighted by the standard errors, b on a grid over (0, 3]; the error of ζ_∞ is the widest reach of ζ_∞ ± its standard error over the b within Δχ² ≤ 1 (`fit.csv`). Also fitted: the limit zero, `ζ_cr(T) = a T^(−b)`. Verdict: inconclusive when the free fit's χ² exceeds its 99 % point; holds when ζ_∞ − 2 err > 0 and the zero-limit fit is worse by Δχ² ≥ 4; does not hold (the limit is zero) when ζ_∞ + 2 err ≤ 0, or when the zero-limit fit passes its goodness of fit, improves on the free fit by less than Δχ² = 1 and the free fit bounds ζ_∞ below half the smallest threshold measured; inconclusive otherwise.\n\
          - Files: `zeta_cr_vs_run_length.png`, the CSVs above.",
         p.scale.integrator_name(),

@@ -841,6 +841,7 @@ mod tests {
                                 s_rms: 1.0 + 50.0 * zeta,
                                 area_mean: 200.0,
                                 growth_rate: rate,
+                                growth_exponent: f64::NAN,
                             },
                         });
                     }

@@ -6,7 +6,8 @@ use std::path::Path;
 use crate::SweepError;
 
 /// The columns of a run's summary, after the varied keys and `seed`.
-pub const SUMMARY_COLUMNS: &str = "window_start,window_end,rows,v_rms,s_rms,area_mean,growth_rate";
+pub const SUMMARY_COLUMNS: &str =
+    "window_start,window_end,rows,v_rms,s_rms,area_mean,growth_rate,growth_exponent";
 
 /// A run's summary over its window.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -26,20 +27,27 @@ pub struct RunSummary {
     /// Least-squares slope of `ln v_rms` against time over the window, per TU: positive where
     /// the flow grows, negative where it decays.
     pub growth_rate: f64,
+    /// Least-squares slope of `ln v_rms` against `ln(t − t₀)` over the window, `t₀` the start
+    /// of the active phase (`2·window_start − window_end`, the window being its second half):
+    /// the local exponent of `v_rms ∝ (t − t₀)^p`. Scale-free where the growth rate is not: a
+    /// passive packing that relaxes as a power law has a growth rate that tends to 0 from
+    /// below as ~1/T whatever the physics, and a constant negative exponent.
+    pub growth_exponent: f64,
 }
 
 impl RunSummary {
     /// The row, in the order of [`SUMMARY_COLUMNS`].
     pub fn csv(&self) -> String {
         format!(
-            "{},{},{},{:e},{:e},{},{:e}",
+            "{},{},{},{:e},{:e},{},{:e},{:e}",
             self.window_start,
             self.window_end,
             self.rows,
             self.v_rms,
             self.s_rms,
             self.area_mean,
-            self.growth_rate
+            self.growth_rate,
+            self.growth_exponent
         )
     }
 }
@@ -96,7 +104,8 @@ pub fn summarise(run_dir: &Path, window: (f64, f64)) -> Result<RunSummary, Sweep
         col("s_rms")?,
         col("area_mean")?,
     );
-    let (mut t, mut ln_v) = (Vec::new(), Vec::new());
+    let (mut t, mut ln_v, mut ln_t) = (Vec::new(), Vec::new(), Vec::new());
+    let t0 = 2.0 * window.0 - window.1;
     let (mut sv, mut ss, mut sa) = (0.0, 0.0, 0.0);
     for (k, line) in lines.enumerate() {
         let f: Vec<&str> = line.split(',').collect();
@@ -112,6 +121,7 @@ pub fn summarise(run_dir: &Path, window: (f64, f64)) -> Result<RunSummary, Sweep
         let (v, s, a) = (num(cv)?, num(cs)?, num(ca)?);
         t.push(time);
         ln_v.push(v.ln());
+        ln_t.push((time - t0).ln());
         sv += v;
         ss += s;
         sa += a;
@@ -131,6 +141,7 @@ pub fn summarise(run_dir: &Path, window: (f64, f64)) -> Result<RunSummary, Sweep
         s_rms: ss / n,
         area_mean: sa / n,
         growth_rate: slope(&t, &ln_v),
+        growth_exponent: slope(&ln_t, &ln_v),
     })
 }
 
@@ -199,6 +210,32 @@ pub fn analysis_columns(run_dir: &Path) -> Result<String, SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On a synthetic power law `v = v0 (t − t₀)^p` (a passive packing relaxing) the local
+    /// exponent is `p` to round-off at every window, while the growth rate tends to 0 from
+    /// below as the window moves out (`p/t` for a window at t): the rate's zero is a matter of
+    /// the run length, the exponent's is not.
+    #[test]
+    fn the_exponent_of_a_synthetic_power_law_is_its_power() {
+        let dir = tempfile::tempdir().unwrap();
+        let (t0, p) = (20.0, -0.7);
+        let mut text = String::from("step,time,zeta,v_rms,s_rms,area_mean\n");
+        for k in 0..=3200 {
+            let t = t0 + k as f64;
+            let v = if k == 0 { 1.0 } else { 1e-2 * (t - t0).powf(p) };
+            text += &format!("{k},{t},0,{v:e},1.5,160\n");
+        }
+        std::fs::write(dir.path().join("series.csv"), text).unwrap();
+        let mut rates = Vec::new();
+        for time in [200.0, 800.0, 3200.0] {
+            let s = summarise(dir.path(), window(t0, time)).unwrap();
+            assert!((s.growth_exponent - p).abs() < 1e-9, "{}", s.growth_exponent);
+            assert!(s.growth_rate < 0.0);
+            rates.push(s.growth_rate);
+        }
+        assert!(rates[0] < rates[1] && rates[1] < rates[2], "{rates:?}");
+        assert!(rates[2].abs() < 0.1 * rates[0].abs(), "{rates:?}");
+    }
 
     /// On a synthetic exponential `v = v0 e^{r t}` the growth rate is `r` to round-off, the
     /// averages are the exact means of the rows, and rows outside the window are left out.

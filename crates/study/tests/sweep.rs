@@ -70,7 +70,7 @@ fn the_summary_is_the_same_for_any_number_of_jobs() {
     let lines: Vec<&str> = sum_a.lines().collect();
     assert_eq!(
         lines[0],
-        "model.zeta,model.gamma,seed,window_start,window_end,rows,v_rms,s_rms,area_mean,growth_rate"
+        "model.zeta,model.gamma,seed,window_start,window_end,rows,v_rms,s_rms,area_mean,growth_rate,growth_exponent"
     );
     assert_eq!(lines.len(), 9);
     assert!(lines[1].starts_with("0,0.01,1,10,15,6,"), "{}", lines[1]);
