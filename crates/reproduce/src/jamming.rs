@@ -5,13 +5,18 @@
 //! deformability (Loewe, Chiang, Marenduzzo & Marchetti, Phys. Rev. Lett. 2020).
 //!
 //! One sweep over the propulsion α and the interface stiffness γ of the paper's tissue with
-//! persistent random propulsion (`align = "none"`). The statistic of a run is its mean squared
-//! displacement at the longest lag τ_L (half the active phase), with the tissue's drift
-//! removed (`analysis/msd.csv`); of a point, the mean and standard error over seeds of its
-//! logarithm. A cell that has moved by more than its radius relative to the tissue in τ_L has
-//! left its cage: a point is fluid when `ln MSD(τ_L) − 2 se > ln R²`, solid when
-//! `ln MSD(τ_L) + 2 se < ln R²`. The transition α_c(γ) is where the seed mean crosses `ln R²`,
-//! linear in `ln α`, its error the jackknife over seeds.
+//! persistent random propulsion (`align = "none"`). Arrest is decided by caging (issue 54): the
+//! statistic of a run is the exponent β of its mean squared displacement at long lags, the
+//! least-squares slope of `ln MSD` against `ln τ` over `[τ_L/4, τ_L]` (τ_L the longest lag, half
+//! the active phase), with the tissue's drift removed (`analysis/msd.csv`); a caged cell's MSD
+//! levels off (β → 0), a free or fluid one's grows linearly (β → 1). A point is solid when the
+//! seed mean of β is below ½ by two standard errors, fluid when above ½ by two; the transition
+//! α_c(γ) is where the seed mean crosses ½, linear in `ln α`, its error the jackknife over
+//! seeds. Beside it, `D_eff/D_free = MSD(τ_L)/MSD_free(τ_L)`, the MSD against that of a lone
+//! cell with the same propulsion (`2 v₀² τ_p [t − τ_p (1 − e^{−t/τ_p})]`, `v₀ = α/ξ`,
+//! `τ_p = 1/D_r`). The earlier criterion, `MSD(τ_L) < R²`, called a slow free cell arrested: a
+//! control of a dilute gas of four cells that seldom touch (`cells.count = 4`) must read fluid
+//! at every α, and the old criterion's verdict on it is reported beside.
 
 use render::{Plot, Series};
 use study::analyze::AnalyzeOptions;
@@ -50,8 +55,19 @@ output_every = 20.0
 series_every = 20.0
 ";
 
-/// The cell radius: the cage criterion is `MSD(τ_L) = R²`.
+/// The cell radius: the earlier criterion was `MSD(τ_L) = R²`.
 const RADIUS: f64 = 8.0;
+
+/// The long-lag MSD exponent halfway between a cage's plateau (0) and diffusion (1): solid
+/// below it by two standard errors, fluid above.
+pub(crate) const CAGE_EXPONENT: f64 = 0.5;
+
+/// Friction ξ and rotational diffusion D_r of the scene (the free cell's MSD).
+const XI: f64 = 2.0;
+const D_R: f64 = 0.01;
+
+/// Cells of the gas control.
+const GAS_CELLS: usize = 4;
 
 /// The shape index of the vertex and Voronoi models' transition (Bi et al. 2015, 2016).
 pub(crate) const VERTEX_Q: f64 = 3.81;
@@ -80,9 +96,9 @@ impl Phase {
     }
 }
 
-/// A point's phase from the mean and standard error of `ln MSD(τ_L)` over seeds.
+/// A point's phase from the mean and standard error over seeds of the long-lag MSD exponent.
 pub(crate) fn phase((m, se): (f64, f64)) -> Phase {
-    let cage = (RADIUS * RADIUS).ln();
+    let cage = CAGE_EXPONENT;
     if !se.is_finite() {
         Phase::NotEstablished
     } else if m - 2.0 * se > cage {
@@ -94,11 +110,11 @@ pub(crate) fn phase((m, se): (f64, f64)) -> Phase {
     }
 }
 
-/// The propulsion where `ln MSD` (by seed, at the increasing `alphas`) first crosses `ln R²`
-/// upward, linear in `ln α`, from the seed mean; and its jackknife error over seeds (NaN with
-/// fewer than three seeds or where a jackknife sample has no crossing).
+/// The propulsion where the MSD exponent (by seed, at the increasing `alphas`) first crosses
+/// [`CAGE_EXPONENT`] upward, linear in `ln α`, from the seed mean; and its jackknife error over
+/// seeds (NaN with fewer than three seeds or where a jackknife sample has no crossing).
 pub(crate) fn critical_alpha(alphas: &[f64], ln_msd: &[Vec<f64>]) -> (Option<f64>, f64) {
-    let cage = (RADIUS * RADIUS).ln();
+    let cage = CAGE_EXPONENT;
     let crossing = |seeds: &[usize]| -> Option<f64> {
         let m = super::seed_mean(ln_msd, seeds);
         let k = m.iter().position(|&v| v > cage)?;
@@ -308,9 +324,10 @@ fn settings(scale: Scale, t: f64, lag_l: f64) -> String {
     format!(
         "- The paper's tissue (60 cells, R = 8, periodic 100², ζ = 0) with persistent random propulsion: `[polarity] align = \"none\"`, D_r = 0.01 (persistence time 100 TU); γ ∈ {{{}}}, α ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
-         - Statistic: the mean squared displacement at the longest lag τ_L = {} TU (half the active phase) with the tissue's drift removed (`analysis/msd.csv`), its logarithm's mean ± standard error over seeds; D_eff = MSD/(4τ_L) in `jamming_runs.csv`. Fluid when ln MSD − 2 se > ln R², solid when ln MSD + 2 se < ln R² (a cell that moved its radius relative to the tissue in τ_L has left its cage; a finite-time criterion: longer runs can only move the line to lower α). α_c: where the seed mean crosses ln R², linear in ln α; error: jackknife over seeds. The shape index q = P/√A (`shape_index` of `analysis/observables.csv`), mean over the second half.\n\
+         - Statistic (issue 54: arrest by caging): the exponent β of the mean squared displacement at long lags, the least-squares slope of ln MSD against ln τ over [τ_L/4, τ_L], τ_L = {} TU (half the active phase), with the tissue's drift removed (`analysis/msd.csv`); its mean ± standard error over seeds. Solid when β + 2 se < ½ (the MSD levels off: a cage), fluid when β − 2 se > ½ (it grows towards diffusion, β = 1). α_c: where the seed mean of β crosses ½, linear in ln α; error: jackknife over seeds. Beside it, D_eff/D_free = MSD(τ_L) / MSD_free(τ_L), against a lone cell with the same propulsion (2 v₀² τ_p [t − τ_p(1 − e^(−t/τ_p))], v₀ = α/ξ, τ_p = 1/D_r), and D_eff = MSD/(4τ_L) in `jamming_runs.csv`. The earlier criterion (solid when MSD(τ_L) < R²) is kept in the tables (`ln_msd_*`) and in the control's line. The shape index q = P/√A (`shape_index` of `analysis/observables.csv`), mean over the second half.\n\
+         - Control: the same scene with {GAS_CELLS} cells (area fraction 8 %: they seldom touch), γ = {GAS_GAMMA}, every α (`jamming_gas*.csv`); the line's rule on it must read \"does not hold\" (every point fluid).\n\
          - Rules: claim 1 holds when at every γ the weakest α is solid, the strongest fluid and α_c has an error, does not hold when every point is on one side. Claim 2: the weighted slope of ln α_c against ln γ, positive or negative by two standard errors. Claim 3: every q(α_c) within 0.05 of 3.81 (errors counted) holds; one more than 0.1 and two errors away does not hold.\n\
-         - Data: `jamming_runs.csv`, `jamming.csv`; plots `jamming_msd.png`, `jamming_shape_index.png`, `jamming_line.png`.",
+         - Data: `jamming_runs.csv`, `jamming.csv`, `jamming_gas_runs.csv`, `jamming_gas.csv`; plots `jamming_exponent.png`, `jamming_msd.png`, `jamming_shape_index.png`, `jamming_line.png`.",
         GAMMAS.join(", "),
         ALPHAS.join(", "),
         scale.seeds(),
@@ -335,16 +352,22 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .iter()
         .map(|a| a.parse().expect("a number"))
         .collect();
-    let PerRun {
-        ln_msd,
-        q,
-        lag_l,
-        runs_csv,
-    } = PerRun::read(&points, 200.0 + t / 2.0)?;
-    let mut lines = Lines::new(lag_l);
+    let runs = PerRun::read(&points, 200.0 + t / 2.0)?;
+    let mut lines = Lines::new(runs.lag_l);
     for (gi, gamma) in GAMMAS.iter().enumerate() {
-        lines.add(gamma, &alphas, &ln_msd[gi], &q[gi]);
+        lines.add(gamma, &alphas, &runs, gi);
     }
+    p.reporter
+        .stage("jamming: the control, a dilute gas of cells");
+    let gas_points = sweep_gas(p, t)?.points(None)?;
+    let gas = PerRun::read(&gas_points, 200.0 + t / 2.0)?;
+    let gas_gi = GAMMAS
+        .iter()
+        .position(|v| *v == GAS_GAMMA)
+        .expect("the gas's γ is one of the sweep's");
+    let mut gas_lines = Lines::new(gas.lag_l);
+    gas_lines.add(GAS_GAMMA, &alphas, &gas, gas_gi);
+    let gas_claim = gas_claim(&gas_lines.rows, &gas, gas_gi);
     let Lines {
         points_csv,
         rows,
@@ -352,17 +375,23 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         q_at,
         plot,
         qplot,
+        bplot,
         line_text,
     } = lines;
     let mut made = Made::new(Vec::new(), String::new())
-        .table("jamming_runs.csv", runs_csv)
+        .table("jamming_runs.csv", runs.runs_csv)
         .table("jamming.csv", points_csv)
+        .table("jamming_gas_runs.csv", gas.runs_csv)
+        .table("jamming_gas.csv", gas_lines.points_csv)
         .plot("jamming_msd.png", plot)
+        .plot("jamming_exponent.png", bplot)
         .plot("jamming_shape_index.png", qplot);
     if let Some(lplot) = line_plot(&gammas, &ac_pts) {
         made = made.plot("jamming_line.png", lplot);
     }
-    let claims = claims(&rows, &gammas, &ac_pts, &q_at, &line_text);
+    let mut claims = claims(&rows, &gammas, &ac_pts, &q_at, &line_text);
+    claims.push(gas_claim);
+    let lag_l = runs.lag_l;
     let settings = settings(p.scale, t, lag_l);
     made.claims = claims;
     made.settings = settings;
@@ -389,9 +418,85 @@ fn sweep(p: &ReproduceParams, t: f64) -> Result<super::SweepResult, SweepError> 
     )
 }
 
-/// What each run gives, by `[γ][seed][α]`: `ln MSD(τ_L)` and the late shape index; the lag
-/// `τ_L`; and the table of the runs.
+/// The exponent of `MSD ∝ τ^β` at long lags: the least-squares slope of `ln MSD` against
+/// `ln τ` over `[τ_L/4, τ_L]`, `τ_L` the longest lag (NaN with fewer than two lags there).
+pub(crate) fn long_lag_exponent(lags: &[f64], msd: &[f64]) -> f64 {
+    let top = lags.iter().copied().fold(f64::NAN, f64::max);
+    let (x, y): (Vec<f64>, Vec<f64>) = lags
+        .iter()
+        .zip(msd)
+        .filter(|(l, m)| **l >= top / 4.0 && **l > 0.0 && **m > 0.0)
+        .map(|(l, m)| (l.ln(), m.ln()))
+        .unzip();
+    study::summary::slope(&x, &y)
+}
+
+/// The MSD of a lone cell with propulsion `alpha` at lag `t`: a persistent random walk,
+/// `2 v₀² τ_p [t − τ_p (1 − e^{−t/τ_p})]` with `v₀ = α/ξ` and `τ_p = 1/D_r`.
+pub(crate) fn free_msd(alpha: f64, t: f64) -> f64 {
+    let (v0, tp) = (alpha / XI, 1.0 / D_R);
+    2.0 * v0 * v0 * tp * (t - tp * (1.0 - (-t / tp).exp()))
+}
+
+/// γ of the gas control.
+const GAS_GAMMA: &str = "0.01";
+
+/// The control: [`GAS_CELLS`] cells in the same box (area fraction 8 %), γ = [`GAS_GAMMA`],
+/// every α.
+fn sweep_gas(p: &ReproduceParams, t: f64) -> Result<super::SweepResult, SweepError> {
+    let mut sets = vec![format!("run.time={t}"), format!("cells.count={GAS_CELLS}")];
+    sets.extend(p.scale.own_dt_set());
+    super::sweep(
+        p,
+        SweepJob {
+            name: format!("jamming-gas-{}", p.scale.name()),
+            scene: JAMMING_SCENE,
+            sets,
+            varies: vec![
+                format!("model.gamma={GAS_GAMMA}"),
+                format!("polarity.alpha={}", ALPHAS.join(",")),
+            ],
+            analyze: Some(AnalyzeOptions::default()),
+            seeds: None,
+        },
+    )
+}
+
+/// The control's claim: "a dilute gas of cells is arrested at some propulsion", by the rule of
+/// the line (`verdict_line` on its phases), which must read "does not hold"; with the earlier
+/// criterion's count of gas points it called solid (`MSD(τ_L) < R²`).
+fn gas_claim(rows: &[(Vec<Phase>, Option<f64>, f64)], gas: &PerRun, gi: usize) -> Claim {
+    let (v, why) = verdict_line(rows);
+    let r2 = (RADIUS * RADIUS).ln();
+    let n_alpha = ALPHAS.len();
+    let old_solid = (0..n_alpha)
+        .filter(|&ai| {
+            let (m, se) = mean_se(&gas.ln_msd[gi].iter().map(|s| s[ai]).collect::<Vec<_>>());
+            m + 2.0 * se < r2
+        })
+        .count();
+    let betas: Vec<String> = (0..n_alpha)
+        .map(|ai| {
+            let (m, se) = mean_se(&gas.beta[gi].iter().map(|s| s[ai]).collect::<Vec<_>>());
+            let (r, _) = mean_se(&gas.ratio[gi].iter().map(|s| s[ai]).collect::<Vec<_>>());
+            format!("α = {}: β = {} ± {}, D_eff/D_free = {}", ALPHAS[ai], g(m), g(se), g(r))
+        })
+        .collect();
+    Claim::new(
+        format!("Control (jamming): a dilute gas of {GAS_CELLS} cells that seldom touch is arrested at some propulsion (must not hold)"),
+        betas.join("; "),
+        v,
+        format!(
+            "{why}; the earlier criterion MSD(τ_L) < R² called {old_solid} of its {n_alpha} propulsions solid"
+        ),
+    )
+}
+
+/// What each run gives, by `[γ][seed][α]`: the long-lag MSD exponent, `ln MSD(τ_L)`,
+/// `D_eff/D_free` and the late shape index; the lag `τ_L`; and the table of the runs.
 struct PerRun {
+    beta: Vec<Vec<Vec<f64>>>,
+    ratio: Vec<Vec<Vec<f64>>>,
     ln_msd: Vec<Vec<Vec<f64>>>,
     q: Vec<Vec<Vec<f64>>>,
     lag_l: f64,
@@ -399,12 +504,15 @@ struct PerRun {
 }
 
 impl PerRun {
-    /// Reads every run of `points`, its shape index averaged from `from`.
+    /// Reads every run of `points` (whose values are γ and α), its shape index averaged from
+    /// `from`.
     fn read(points: &[super::pipeline::PointRuns], from: f64) -> Result<Self, SweepError> {
         let n_seeds = points.first().map_or(0, |pt| pt.runs.len());
-        // [γ][seed][α]: ln MSD(τ_L) and the shape index; τ_L per run.
+        // [γ][seed][α]: the exponent, ln MSD(τ_L), D_eff/D_free and the shape index.
         let mut ln_msd = vec![vec![vec![f64::NAN; ALPHAS.len()]; n_seeds]; GAMMAS.len()];
         let mut q = ln_msd.clone();
+        let mut beta = ln_msd.clone();
+        let mut ratio = ln_msd.clone();
         let mut lag_l = f64::NAN;
         let mut runs_csv = Csv::new(&[
             "gamma",
@@ -413,6 +521,8 @@ impl PerRun {
             "lag",
             "msd",
             "d_eff",
+            "d_eff_over_d_free",
+            "msd_exponent",
             "shape_index",
         ]);
         for (pt, (si, r)) in points
@@ -434,6 +544,9 @@ impl PerRun {
                 msd.last().copied().unwrap_or(f64::NAN),
             );
             lag_l = lag;
+            let alpha: f64 = pt.values[1].parse().unwrap_or(f64::NAN);
+            let b = long_lag_exponent(&lags, &msd);
+            let r_free = v / free_msd(alpha, lag);
             let qm = super::late_mean(
                 &r.run.join("analysis/observables.csv"),
                 "shape_index",
@@ -442,6 +555,8 @@ impl PerRun {
             )?;
             ln_msd[gi][si][ai] = v.ln();
             q[gi][si][ai] = qm;
+            beta[gi][si][ai] = b;
+            ratio[gi][si][ai] = r_free;
             runs_csv.row([
                 cell(&pt.values[0]),
                 cell(&pt.values[1]),
@@ -449,10 +564,14 @@ impl PerRun {
                 cell(lag),
                 sci(v),
                 sci(v / (4.0 * lag)),
+                sci(r_free),
+                cell(b),
                 cell(qm),
             ]);
         }
         Ok(Self {
+            beta,
+            ratio,
             ln_msd,
             q,
             lag_l,
@@ -469,6 +588,7 @@ struct Lines {
     q_at: Vec<(f64, f64)>,
     plot: Plot,
     qplot: Plot,
+    bplot: Plot,
     line_text: Vec<String>,
 }
 
@@ -477,6 +597,10 @@ impl Lines {
         let points_csv = Csv::new(&[
             "gamma",
             "alpha",
+            "msd_exponent_mean",
+            "msd_exponent_se",
+            "d_eff_over_d_free_mean",
+            "d_eff_over_d_free_se",
             "ln_msd_mean",
             "ln_msd_se",
             "msd_geometric_mean",
@@ -493,7 +617,17 @@ impl Lines {
             "MSD(τ_L) / R², geometric mean ± s.e. over seeds",
         );
         (plot.log_x, plot.log_y) = (true, true);
-        plot.hlines = vec![(1.0, "a radius: the cage".into())];
+        plot.hlines = vec![(1.0, "a radius: the earlier criterion".into())];
+        let mut bplot = Plot::new(
+            "Long-lag exponent of the MSD, over [τ_L/4, τ_L]",
+            "propulsion α",
+            "β (MSD ∝ τ^β), mean ± s.e. over seeds",
+        );
+        bplot.log_x = true;
+        bplot.hlines = vec![
+            (CAGE_EXPONENT, "½: solid below, fluid above".into()),
+            (1.0, "diffusion".into()),
+        ];
         let mut qplot = Plot::new(
             "Shape index against propulsion",
             "propulsion α",
@@ -509,12 +643,14 @@ impl Lines {
             q_at,
             plot,
             qplot,
+            bplot,
             line_text,
         }
     }
 
-    /// Adds the line of `gamma`: its per-seed `ln_msd[seed][α]` and shape indices `q`.
-    fn add(&mut self, gamma: &str, alphas: &[f64], ln_msd: &[Vec<f64>], q: &[Vec<f64>]) {
+    /// Adds the line of `gamma` from the runs' `[gi]` (by seed and α): phases and α_c from
+    /// the MSD exponent, the MSD and the shape index drawn.
+    fn add(&mut self, gamma: &str, alphas: &[f64], runs: &PerRun, gi: usize) {
         let Self {
             points_csv,
             rows,
@@ -522,19 +658,26 @@ impl Lines {
             q_at,
             plot,
             qplot,
+            bplot,
             line_text,
         } = self;
-        let stats: Vec<(f64, f64)> = (0..ALPHAS.len())
-            .map(|ai| mean_se(&ln_msd.iter().map(|s| s[ai]).collect::<Vec<_>>()))
-            .collect();
-        let qstats: Vec<(f64, f64)> = (0..ALPHAS.len())
-            .map(|ai| mean_se(&q.iter().map(|s| s[ai]).collect::<Vec<_>>()))
-            .collect();
-        let phases: Vec<Phase> = stats.iter().map(|s| phase(*s)).collect();
+        let (beta, ln_msd, q) = (&runs.beta[gi], &runs.ln_msd[gi], &runs.q[gi]);
+        let over = |v: &[Vec<f64>]| -> Vec<(f64, f64)> {
+            (0..ALPHAS.len())
+                .map(|ai| mean_se(&v.iter().map(|s| s[ai]).collect::<Vec<_>>()))
+                .collect()
+        };
+        let (stats, qstats) = (over(ln_msd), over(q));
+        let (bstats, rstats) = (over(beta), over(&runs.ratio[gi]));
+        let phases: Vec<Phase> = bstats.iter().map(|s| phase(*s)).collect();
         for (ai, alpha) in ALPHAS.iter().enumerate() {
             points_csv.row([
                 cell(gamma),
                 cell(alpha),
+                cell(bstats[ai].0),
+                cell(bstats[ai].1),
+                sci(rstats[ai].0),
+                sci(rstats[ai].1),
                 sci(stats[ai].0),
                 sci(stats[ai].1),
                 sci(stats[ai].0.exp()),
@@ -543,7 +686,7 @@ impl Lines {
                 cell(phases[ai].name()),
             ]);
         }
-        let (ac, err) = critical_alpha(alphas, ln_msd);
+        let (ac, err) = critical_alpha(alphas, beta);
         // q at α_c, interpolated as α_c is, with the larger spread of the two points.
         let qa = ac.map_or((f64::NAN, f64::NAN), |a| {
             let k = alphas
@@ -578,6 +721,13 @@ impl Lines {
                     .collect::<Vec<_>>(),
             ),
         );
+        bplot
+            .series
+            .push(Series::new(format!("γ = {gamma}")).with_points(
+                alphas,
+                &bstats.iter().map(|s| s.0).collect::<Vec<_>>(),
+                &bstats.iter().map(|s| s.1).collect::<Vec<_>>(),
+            ));
         qplot
             .series
             .push(Series::new(format!("γ = {gamma}")).with_points(
@@ -592,16 +742,16 @@ impl Lines {
 mod tests {
     use super::*;
 
-    /// Synthetic seeds: ln MSD = ln R² + 3 ln(α/α_c) with a seed's scatter.
+    /// Synthetic seeds: β = ½ + 0.3 ln(α/α_c) with a seed's scatter.
     fn synthetic(ac: f64, scatter: f64) -> (Vec<f64>, Vec<Vec<f64>>) {
         let alphas: Vec<f64> = ALPHAS.iter().map(|a| a.parse().unwrap()).collect();
-        let cage = (RADIUS * RADIUS).ln();
+        let cage = CAGE_EXPONENT;
         let runs = (0..4)
             .map(|s| {
                 let off = scatter * (s as f64 - 1.5);
                 alphas
                     .iter()
-                    .map(|a| cage + 3.0 * (a / ac).ln() + off)
+                    .map(|a| cage + 0.3 * (a / ac).ln() + off)
                     .collect()
             })
             .collect();
@@ -614,9 +764,30 @@ mod tests {
             .collect()
     }
 
+    /// The exponent of an exact power law is its power; a cage's plateau reads 0 and a lone
+    /// persistent walker's MSD reads diffusion at lags far beyond its persistence time, and
+    /// ballistic motion far below it.
+    #[test]
+    fn the_long_lag_exponent_tells_a_cage_from_a_free_walk() {
+        let lags: Vec<f64> = (1..=50).map(|k| 20.0 * k as f64).collect();
+        for p in [0.0, 0.4, 1.0] {
+            let msd: Vec<f64> = lags.iter().map(|l| 3.0 * l.powf(p)).collect();
+            assert!((long_lag_exponent(&lags, &msd) - p).abs() < 1e-12, "{p}");
+        }
+        let free: Vec<f64> = lags.iter().map(|l| free_msd(0.05, *l)).collect();
+        // It approaches 1 from above (t/(t − τ_p) at long lags): 1.23 over [250, 1000].
+        let b = long_lag_exponent(&lags, &free);
+        assert!(b > 1.0 && b < 1.3, "{b}");
+        // Limits: v₀² t² for t ≪ τ_p, 4 (v₀² τ_p / 2) t for t ≫ τ_p.
+        let v0 = 0.05 / XI;
+        assert!((free_msd(0.05, 0.01) / (v0 * v0 * 1e-4) - 1.0).abs() < 1e-3);
+        let long = 1e6;
+        assert!((free_msd(0.05, long) / (2.0 * v0 * v0 / D_R * long) - 1.0).abs() < 1e-3);
+    }
+
     #[test]
     fn the_critical_propulsion_is_recovered_with_an_error() {
-        let (a, runs) = synthetic(0.1, 0.1);
+        let (a, runs) = synthetic(0.1, 0.01);
         let (ac, err) = critical_alpha(&a, &runs);
         let ac = ac.unwrap();
         assert!((ac / 0.1 - 1.0).abs() < 0.05, "{ac}");
@@ -629,7 +800,7 @@ mod tests {
     #[test]
     fn each_outcome_of_each_claim_is_reached() {
         let row = |ac: f64| {
-            let (a, runs) = synthetic(ac, 0.1);
+            let (a, runs) = synthetic(ac, 0.01);
             let (c, e) = critical_alpha(&a, &runs);
             (phases(&runs), c, e)
         };
