@@ -71,7 +71,7 @@ enum Command {
     /// OUT/sweeps/), its data as CSV, its plots as PNG and OUT/FIGURE/verdict.md, a verdict
     /// on each claim of the paper that it tests.
     Reproduce {
-        /// threshold, lengths, defects, defect-fields, contractile, scaling, stability,
+        /// threshold, lengths, defects, defect-fields, contractile, scaling, stability, bloch,
         /// run-length, channel, rotation, flocking, sorting, jamming, extrusion, or all.
         figure: String,
         /// The output directory (created if missing; a second call resumes).

@@ -624,6 +624,7 @@ impl Lines {
             "β (MSD ∝ τ^β), mean ± s.e. over seeds",
         );
         bplot.log_x = true;
+        bplot.legend = render::LegendAt::LowerRight;
         bplot.hlines = vec![
             (CAGE_EXPONENT, "½: solid below, fluid above".into()),
             (1.0, "diffusion".into()),

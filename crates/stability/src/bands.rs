@@ -51,8 +51,8 @@ pub struct WaveThreshold {
     /// it on either side (or, without a sign change, through the last two: an extrapolation,
     /// and `bracketed` is false).
     pub zeta_cr: f64,
-    /// Its error: the last move of the root, and the Ritz residuals over the slope, whichever
-    /// is larger.
+    /// Its error: the last move of the root, and the larger Ritz residual of the two
+    /// evaluations the root is drawn through over the slope, whichever is larger.
     pub err: f64,
     /// Whether evaluations on both sides of zero bracket it.
     pub bracketed: bool,
@@ -61,15 +61,24 @@ pub struct WaveThreshold {
 }
 
 impl WaveThreshold {
-    fn from_points(q: [f64; 2], supercell: [usize; 2], points: Vec<WavePoint>) -> Self {
-        let (zeta_cr, slope, bracketed) = root(&points);
+    /// Whether the wave grows at ζ = 0 by more than two Ritz residuals: the rest state itself
+    /// is unstable to it.
+    pub fn unstable_at_rest(&self) -> bool {
+        self.points
+            .iter()
+            .any(|p| p.zeta == 0.0 && p.sigma - 2.0 * p.residual > 0.0)
+    }
+
+    /// The threshold of wave `q` from its evaluations (as [`wave_thresholds`] makes it; a kept
+    /// result is rebuilt from its points by this).
+    pub fn from_points(q: [f64; 2], supercell: [usize; 2], points: Vec<WavePoint>) -> Self {
+        let (zeta_cr, slope, bracketed, residual) = root(&points);
         let last_move = if points.len() >= 3 {
-            let (prev, _, _) = root(&points[..points.len() - 1]);
+            let (prev, _, _, _) = root(&points[..points.len() - 1]);
             (zeta_cr - prev).abs()
         } else {
             f64::INFINITY
         };
-        let residual = points.iter().map(|p| p.residual).fold(0.0, f64::max);
         let err = last_move.max(residual / slope.abs());
         Self {
             q,
@@ -83,8 +92,9 @@ impl WaveThreshold {
 }
 
 /// The root of σ(ζ) from the evaluations: the line through the nearest points on either side of
-/// zero, or through the last two; with its slope and whether it is bracketed.
-fn root(points: &[WavePoint]) -> (f64, f64, bool) {
+/// zero, or through the last two; with its slope, whether it is bracketed, and the larger Ritz
+/// residual of the two points.
+fn root(points: &[WavePoint]) -> (f64, f64, bool, f64) {
     let below = points
         .iter()
         .filter(|p| p.sigma < 0.0)
@@ -101,7 +111,12 @@ fn root(points: &[WavePoint]) -> (f64, f64, bool) {
         }
     };
     let slope = (b.sigma - a.sigma) / (b.zeta - a.zeta);
-    (a.zeta - a.sigma / slope, slope, bracketed)
+    (
+        a.zeta - a.sigma / slope,
+        slope,
+        bracketed,
+        a.residual.max(b.residual),
+    )
 }
 
 fn sigma(
@@ -129,9 +144,7 @@ fn sigma(
 }
 
 /// `ζ_cr(q)` of every wave in `qs`, about `tiling`'s rest state with the model `params`:
-/// σ at `opts.start`, then up to `opts.refine` regula-falsi steps until the root moves by less
-/// than `opts.tol` (a wave whose line extrapolates below zero, or that never turns, keeps its
-/// extrapolation with `bracketed` false).
+/// σ at `opts.start`, then [`refine_waves`].
 ///
 /// # Errors
 /// Whatever a map or Arnoldi fails with.
@@ -141,28 +154,52 @@ pub fn wave_thresholds(
     qs: &[[f64; 2]],
     opts: &WaveOptions,
 ) -> Result<Vec<WaveThreshold>, StabilityError> {
-    qs.par_iter()
+    let started: Vec<WaveThreshold> = qs
+        .par_iter()
         .map(|&q| {
-            let mut points = vec![
+            let points = vec![
                 sigma(tiling, params, opts, q, opts.start[0])?,
                 sigma(tiling, params, opts, q, opts.start[1])?,
             ];
-            for _ in 0..opts.refine {
-                let (z, _, _) = root(&points);
+            Ok(WaveThreshold::from_points(q, tiling.supercell_for(q), points))
+        })
+        .collect::<Result<_, StabilityError>>()?;
+    refine_waves(tiling, params, started, opts)
+}
+
+/// Up to `opts.refine` regula-falsi steps on each wave, from the evaluations it has, until its
+/// root moves by less than `opts.tol`. A root below zero is evaluated at ζ = 0 instead: a wave
+/// that grows there is unstable at rest ([`WaveThreshold::unstable_at_rest`]) and is left so.
+/// A wave already refined is returned as it is, so that kept waves are completed, not redone.
+///
+/// # Errors
+/// Whatever a map or Arnoldi fails with.
+pub fn refine_waves(
+    tiling: &BlochTiling,
+    params: &ModelParams,
+    waves: Vec<WaveThreshold>,
+    opts: &WaveOptions,
+) -> Result<Vec<WaveThreshold>, StabilityError> {
+    waves
+        .into_par_iter()
+        .map(|w| {
+            let mut points = w.points;
+            while points.len() < 2 + opts.refine {
+                let (z, _, _, _) = root(&points);
+                if !z.is_finite() {
+                    break;
+                }
+                let z = z.max(0.0);
                 let nearest = points
                     .iter()
                     .map(|p| (p.zeta - z).abs())
                     .fold(f64::INFINITY, f64::min);
-                if !z.is_finite() || z <= 0.0 || nearest < opts.tol {
+                if nearest < opts.tol {
                     break;
                 }
-                points.push(sigma(tiling, params, opts, q, z)?);
+                points.push(sigma(tiling, params, opts, w.q, z)?);
             }
-            Ok(WaveThreshold::from_points(
-                q,
-                tiling.supercell_for(q),
-                points,
-            ))
+            Ok(WaveThreshold::from_points(w.q, w.supercell, points))
         })
         .collect()
 }
@@ -174,4 +211,42 @@ pub fn lowest<'a>(waves: impl IntoIterator<Item = &'a WaveThreshold>) -> Option<
         .into_iter()
         .filter(|w| w.zeta_cr.is_finite())
         .min_by(|a, b| a.zeta_cr.total_cmp(&b.zeta_cr))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(zeta: f64, f: impl Fn(f64) -> f64, residual: f64) -> WavePoint {
+        WavePoint {
+            zeta,
+            sigma: f(zeta),
+            residual,
+        }
+    }
+
+    /// On a straight σ(ζ) the root is exact and bracketed; its error is the residual over the
+    /// slope; a line that does not turn within the evaluations is extrapolated and says so.
+    #[test]
+    fn a_wave_s_threshold_is_the_root_of_its_line() {
+        let line = |z: f64| 0.5 * (z - 4e-4);
+        let w = WaveThreshold::from_points(
+            [0.0, 0.1],
+            [1, 5],
+            vec![at(3e-4, line, 1e-7), at(6e-4, line, 1e-6), at(4e-4, line, 2e-7)],
+        );
+        assert!((w.zeta_cr - 4e-4).abs() < 1e-15, "{}", w.zeta_cr);
+        assert!(w.bracketed);
+        // The root is drawn through 3e-4 and 4e-4 (σ = 0 counts as above): residual 2e-7.
+        assert!((w.err - 4e-7).abs() < 1e-12, "{}", w.err);
+        let far = WaveThreshold::from_points(
+            [0.0, 0.1],
+            [1, 5],
+            vec![at(1e-4, line, 1e-7), at(2e-4, line, 1e-7)],
+        );
+        assert!(!far.bracketed && (far.zeta_cr - 4e-4).abs() < 1e-15);
+        assert!(far.err.is_infinite(), "two points give no move to judge by");
+        let waves = [w, far];
+        assert_eq!(lowest(&waves).map(|w| w.q), Some([0.0, 0.1]));
+    }
 }

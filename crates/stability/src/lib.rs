@@ -32,7 +32,7 @@ mod tests;
 mod threshold;
 
 pub use arnoldi::{arnoldi, ArnoldiOptions, Ritz, Spectrum};
-pub use bands::{lowest, wave_thresholds, WaveOptions, WavePoint, WaveThreshold};
+pub use bands::{lowest, refine_waves, wave_thresholds, WaveOptions, WavePoint, WaveThreshold};
 pub use bloch::{box_wavevectors, repeat, BlochMap, BlochTiling};
 pub use growth::{growth_rate, random_direction, settle, start_vector, Growth, GrowthOptions};
 pub use map::{dot, max_change, norm, transfer, Operator, StepMap};
