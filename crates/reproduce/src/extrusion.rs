@@ -103,6 +103,12 @@ fn claim(rule: &str, plus: bool) -> String {
     }
 }
 
+/// The control of a rule (issue 54): the same statistic against decoys, as many random nodes
+/// of the tissue as there are +½ defects in each frame, in place of them.
+fn control(rule: &str) -> String {
+    format!("Control (extrusion, {rule} rule): extruded cells are found at random points in place of the +½ defects (must not hold)")
+}
+
 /// The figure's verdicts from its own table in `dir` (`extrusion.csv`, as [`make`] writes it),
 /// by [`verdict`]: each claim with its verdict, in [`make`]'s order (issue 54: the docs are
 /// checked against these).
@@ -117,6 +123,8 @@ pub(crate) fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>,
         t.f64s("d_plus_excess")?,
         t.f64s("d_minus_excess")?,
     );
+    // The control's column (issue 54) is absent from tables made before it.
+    let decoy = t.f64s("d_plus_decoy_excess").ok();
     let mut out = Vec::new();
     for (rule, _) in RULES {
         let of = |v: &[f64]| -> Vec<f64> {
@@ -127,6 +135,9 @@ pub(crate) fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>,
         };
         out.push((claim(rule, true), verdict(&of(&plus)).0));
         out.push((claim(rule, false), verdict(&of(&minus)).0));
+        if let Some(d) = &decoy {
+            out.push((control(rule), verdict(&of(d)).0));
+        }
     }
     Ok(out)
 }
@@ -144,6 +155,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "divisions",
         "d_plus_excess",
         "d_minus_excess",
+        "d_plus_decoy_excess",
         "cells_end",
     ]);
     for (rule, key) in RULES {
@@ -161,11 +173,19 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             },
         )?;
         let (mut plus, mut minus, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+        let mut decoy = Vec::new();
         for r in res.records(None)? {
             let ev = super::Table::read(&r.run.join("analysis/cell_events.csv"))?;
             let kind = ev.strs("kind")?;
-            let cols = ["d_plus", "d_plus_random", "d_minus", "d_minus_random"]
-                .map(|c| ev.f64s(c))
+            let cols = [
+                "d_plus",
+                "d_plus_random",
+                "d_minus",
+                "d_minus_random",
+                "d_plus_decoy",
+                "d_plus_decoy_random",
+            ]
+            .map(|c| ev.f64s(c))
                 .into_iter()
                 .collect::<Result<Vec<_>, _>>()?;
             let excess = |a: usize, b: usize| -> f64 {
@@ -178,10 +198,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             };
             let n_ext = kind.iter().filter(|k| *k == "extrusion").count();
             let n_div = kind.iter().filter(|k| *k == "division").count();
-            let (dp, dm) = if n_ext == 0 {
-                (f64::NAN, f64::NAN)
+            let (dp, dm, dd) = if n_ext == 0 {
+                (f64::NAN, f64::NAN, f64::NAN)
             } else {
-                (excess(0, 1), excess(2, 3))
+                (excess(0, 1), excess(2, 3), excess(4, 5))
             };
             let series = super::Table::read(&r.run.join("series.csv"))?;
             let cells_end = series.f64s("cells")?.last().copied().unwrap_or(f64::NAN);
@@ -192,8 +212,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 cell(n_div),
                 sci(dp),
                 sci(dm),
+                sci(dd),
                 cell(cells_end),
             ]);
+            decoy.push(dd);
             plus.push(dp);
             minus.push(dm);
             counts.push(n_ext as f64);
@@ -217,12 +239,20 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             vm,
             wm,
         ));
+        let (vd, wd) = verdict(&decoy);
+        claims.push(Claim::new(
+            control(rule),
+            format!("{} extrusions per run; {}", g(n.0), stat(&decoy)),
+            vd,
+            wd,
+        ));
     }
     let settings = format!(
         "- The paper's tissue (60 cells, R = 8, periodic 100², γ = 0.01, paper form) at ζ = 0.01 (active turbulence), with `[division] cycle_time = 300`, `growth_time = 50` and an extrusion rule: the stress-based rule `extrusion_pressure = 0.04` (a cell whose pressure p_i = Σφ_i P/Σφ_i, the isotropic stress at the cell, rises above it; the relaxed tissue's pressures are 0.005–0.013) or the area rule `extrusion = 0.3` (a cell below 30 % of its target area); seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; dt = {}; frames every 10 TU, analysed; at these settings the cell count holds at about 53 (pressure rule) and 86 (area rule) instead of growing to the cap.\n\
          - Statistic: for each extrusion, `d₊ − d₊,random` (and `d₋ − d₋,random`): its distance to the nearest +½ (−½) defect of the frame nearest in time, less the mean distance of a point of that frame's tissue (`analysis/cell_events.csv`); its mean over a run's extrusions, then mean ± standard error over seeds. Rule (issue 54's rule of an effect): the effect is how much closer than random the extrusions are, `−(d − d_random)`, and the smallest that counts is {MATERIAL} nodes (a quarter radius); holds when it is resolved by two standard errors and at least that, does not hold when it is below that by two standard errors, inconclusive otherwise.\n\
-         - Data: `extrusion.csv` (each run: extrusions, divisions, the two excesses, the final cell count).",
+         - Control: the same statistic against decoys, as many nodes of the frame's tissue drawn at random (a hash of the frame's step) as it has +½ defects, in place of them (`d_plus_decoy`, `d_plus_decoy_random` of `cell_events.csv`); nothing draws extrusions to them, so its rule must read \"does not hold\".\n\
+         - Data: `extrusion.csv` (each run: extrusions, divisions, the two excesses and the decoys', the final cell count).",
         seeds(p.scale),
         p.scale.own_dt(),
     );

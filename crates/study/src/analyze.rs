@@ -406,12 +406,21 @@ impl Accumulator {
             };
             let (plus, minus) = (at(0.5), at(-0.5));
             let stride = (radius / 2.0).max(1.0) as usize;
+            let decoys = [
+                decoys(lattice, mask, plus.len(), step, 1),
+                decoys(lattice, mask, minus.len(), step, 2),
+            ];
             near.push(FrameDefects {
                 time,
                 random: [
                     mean_nearest_over(lattice, mask, &plus, stride),
                     mean_nearest_over(lattice, mask, &minus, stride),
                 ],
+                decoy_random: [
+                    mean_nearest_over(lattice, mask, &decoys[0], stride),
+                    mean_nearest_over(lattice, mask, &decoys[1], stride),
+                ],
+                decoys,
                 plus,
                 minus,
             });
@@ -566,12 +575,39 @@ fn write_defect_rows(
 }
 
 /// One analysed frame's ±½ defects, and the mean distance of a random point of its tissue
-/// to the nearest of each.
+/// to the nearest of each; and the control of issue 54: as many *decoys* of each charge as
+/// there are defects, nodes of the tissue drawn at random in place of them, with the mean
+/// distance of a random point to the nearest decoy. Events are no nearer decoys than random
+/// points are, whatever draws them to defects.
 struct FrameDefects {
     time: f64,
     plus: Vec<[f64; 2]>,
     minus: Vec<[f64; 2]>,
     random: [f64; 2],
+    decoys: [Vec<[f64; 2]>; 2],
+    decoy_random: [f64; 2],
+}
+
+/// `count` nodes where `mask` holds (index `x * ly + y`), drawn by a hash of `(step, salt,
+/// k)` (SplitMix64), so that the same frame draws the same decoys in any run of the analysis.
+fn decoys(lattice: Lattice, mask: &[bool], count: usize, step: u64, salt: u64) -> Vec<[f64; 2]> {
+    let nodes: Vec<usize> = (0..mask.len()).filter(|&k| mask[k]).collect();
+    if nodes.is_empty() {
+        return Vec::new();
+    }
+    let mix = |mut z: u64| {
+        z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    };
+    (0..count as u64)
+        .map(|k| {
+            let h = mix(mix(step ^ salt.rotate_left(32)) ^ k);
+            let node = nodes[(h % nodes.len() as u64) as usize];
+            [(node / lattice.ly) as f64, (node % lattice.ly) as f64]
+        })
+        .collect()
 }
 
 /// Writes `cell_events.csv` (every division, extrusion and death of `lineage.csv` within the
@@ -587,7 +623,7 @@ fn write_cell_events(
     let mut csv = String::new();
     row!(
         csv,
-        "time,kind,id,x,y,frame_time,d_plus,d_minus,d_plus_random,d_minus_random"
+        "time,kind,id,x,y,frame_time,d_plus,d_minus,d_plus_random,d_minus_random,d_plus_decoy,d_minus_decoy,d_plus_decoy_random,d_minus_decoy_random"
     );
     let (Some(first), Some(last)) = (frames.first(), frames.last()) else {
         return Ok(0);
@@ -613,6 +649,10 @@ fn write_cell_events(
             nearest(lattice, r.place, &f.plus),
             nearest(lattice, r.place, &f.minus),
         ];
+        let dd = [
+            nearest(lattice, r.place, &f.decoys[0]),
+            nearest(lattice, r.place, &f.decoys[1]),
+        ];
         let shown = |v: f64| {
             if v.is_finite() {
                 format!("{v:e}")
@@ -622,7 +662,7 @@ fn write_cell_events(
         };
         row!(
             csv,
-            "{t},{},{},{},{},{},{},{},{},{}",
+            "{t},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             why.name(),
             r.id,
             r.place[0],
@@ -631,7 +671,11 @@ fn write_cell_events(
             shown(d[0]),
             shown(d[1]),
             shown(f.random[0]),
-            shown(f.random[1])
+            shown(f.random[1]),
+            shown(dd[0]),
+            shown(dd[1]),
+            shown(f.decoy_random[0]),
+            shown(f.decoy_random[1])
         );
         let e = sums.entry(why.name()).or_default();
         if [d[0], d[1], f.random[0], f.random[1]]
