@@ -51,8 +51,9 @@ pub struct WaveThreshold {
     /// it on either side (or, without a sign change, through the last two: an extrapolation,
     /// and `bracketed` is false).
     pub zeta_cr: f64,
-    /// Its error: the last move of the root, and the larger Ritz residual of the two
-    /// evaluations the root is drawn through over the slope, whichever is larger.
+    /// Its error: the last move of the root (with two evaluations, its distance to the nearer),
+    /// and the larger Ritz residual of the two evaluations the root is drawn through over the
+    /// slope, whichever is larger.
     pub err: f64,
     /// Whether evaluations on both sides of zero bracket it.
     pub bracketed: bool,
@@ -73,11 +74,16 @@ impl WaveThreshold {
     /// result is rebuilt from its points by this).
     pub fn from_points(q: [f64; 2], supercell: [usize; 2], points: Vec<WavePoint>) -> Self {
         let (zeta_cr, slope, bracketed, residual) = root(&points);
+        // How far the line is trusted: the root's last move, or with two evaluations (the
+        // root fell within the tolerance of one of them) its distance to the nearest.
         let last_move = if points.len() >= 3 {
             let (prev, _, _, _) = root(&points[..points.len() - 1]);
             (zeta_cr - prev).abs()
         } else {
-            f64::INFINITY
+            points
+                .iter()
+                .map(|p| (p.zeta - zeta_cr).abs())
+                .fold(f64::INFINITY, f64::min)
         };
         let err = last_move.max(residual / slope.abs());
         Self {
@@ -245,7 +251,7 @@ mod tests {
             vec![at(1e-4, line, 1e-7), at(2e-4, line, 1e-7)],
         );
         assert!(!far.bracketed && (far.zeta_cr - 4e-4).abs() < 1e-15);
-        assert!(far.err.is_infinite(), "two points give no move to judge by");
+        assert!((far.err - 2e-4).abs() < 1e-15, "the distance to the nearer: {}", far.err);
         let waves = [w, far];
         assert_eq!(lowest(&waves).map(|w| w.q), Some([0.0, 0.1]));
     }
