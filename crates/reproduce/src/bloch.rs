@@ -106,7 +106,8 @@ struct Form {
     pressure: PressureKind,
     tiling: BlochTiling,
     waves: Vec<WaveThreshold>,
-    /// The waves at half the grid's spacing around the lowest one.
+    /// The waves at half the grid's spacing around the lowest one, and the longest waves along
+    /// each axis.
     refined: Vec<WaveThreshold>,
     /// The 83 × 120 box's threshold by Arnoldi on the whole box (the stability figure's way).
     whole_box: Option<(f64, f64)>,
@@ -183,6 +184,14 @@ fn waves_kept(
     keep(&file, &fingerprint, w)
 }
 
+/// The longest waves along each axis, at half the grid's spacing from q = 0: where the
+/// waves are nearly uniform translations, whose rates the lattice's pinning sets (the whole
+/// tissue's translation along y grows at rest in the paper form at γ = 0.01, docs/model.md §10).
+fn longest(scale: Scale) -> Vec<[f64; 2]> {
+    let (nx, ny) = spacing(scale);
+    vec![[0.25 / nx as f64, 0.0], [0.0, 0.25 / ny as f64]]
+}
+
 /// The grid's four neighbours of `q` at half its spacing, folded into the half zone.
 fn around(q: [f64; 2], scale: Scale) -> Vec<[f64; 2]> {
     let (nx, ny) = spacing(scale);
@@ -219,7 +228,15 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> 
         let best = lowest(&waves).map(|w| w.q).unwrap_or([0.0, 0.0]);
         p.reporter
             .stage(&format!("bloch, {pn} form: the waves around the lowest"));
-        let refined = waves_kept(&done, "refined", &tiling, pressure, &around(best, p.scale))?;
+        let mut refined =
+            waves_kept(&done, "refined", &tiling, pressure, &around(best, p.scale))?;
+        p.reporter
+            .stage(&format!("bloch, {pn} form: the longest waves along each axis"));
+        let long: Vec<[f64; 2]> = longest(p.scale)
+            .into_iter()
+            .filter(|q| !refined.iter().any(|w| w.q == *q))
+            .collect();
+        refined.extend(waves_kept(&done, "long", &tiling, pressure, &long)?);
         p.reporter
             .stage(&format!("bloch, {pn} form: the 83 × 120 box by Arnoldi"));
         let whole_box = whole_box(&done, &tiling, pressure)?;
@@ -337,38 +354,41 @@ fn tables(made: &mut Made, forms: &[Form]) {
             if let Some(w) = f.box_threshold(k) {
                 th.row([
                     cell(pn),
-                    cell(format!("box of {k} × {} primitive cells, Bloch", 5 * k)),
+                    cell(format!("box of {k} × {} primitive cells by Bloch", 5 * k)),
                     cell(83 * k),
                     cell(120 * k),
                     cell(w.q[0]),
                     cell(w.q[1]),
                     sci(w.zeta_cr),
                     sci(w.err),
+                    cell(w.unstable_at_rest()),
                 ]);
             }
         }
         if let Some((z, e)) = f.whole_box {
             th.row([
                 cell(pn),
-                cell("box of 1 × 5 primitive cells, Arnoldi on the whole box"),
+                cell("box of 1 × 5 primitive cells by Arnoldi on the whole box"),
                 cell(83),
                 cell(120),
                 cell(f64::NAN),
                 cell(f64::NAN),
                 sci(z),
                 sci(e),
+                cell(false),
             ]);
         }
         if let Some((w, err)) = infinite(f) {
             th.row([
                 cell(pn),
-                cell("infinite tissue, Bloch"),
+                cell("infinite tissue by Bloch"),
                 cell(f64::INFINITY),
                 cell(f64::INFINITY),
                 cell(w.q[0]),
                 cell(w.q[1]),
                 sci(w.zeta_cr),
                 sci(err),
+                cell(f.all().any(WaveThreshold::unstable_at_rest)),
             ]);
         }
     }
@@ -549,7 +569,7 @@ fn claims(forms: &[Form]) -> Vec<Claim> {
 
 fn settings(scale: Scale, forms: &[Form]) -> String {
     let mut s = format!(
-        "Floquet–Bloch stability of the hexagonal packing at γ = {GAMMA}, {} scale: primitive cell 6 × 2 cells on 83 × 24 nodes, rest state relaxed on 83 × 48 (ζ = 0, until max|Δφ|/Δt < 1e-7), then copied; map of 100 Heun steps of dt 0.5 (τ = 50 TU), Arnoldi with Krylov {} and ε = {:e}; each wave's ζ_cr by regula falsi from two activities (up to 3 more evaluations, to 1e-5); grid of {} waves over the half zone, and the four at half its spacing around the lowest. The errors in the claims are the root's last move and the Ritz residual over the slope, halved to a standard error (2 of them resolve).\n",
+        "Floquet–Bloch stability of the hexagonal packing at γ = {GAMMA}, {} scale: primitive cell 6 × 2 cells on 83 × 24 nodes, rest state relaxed on 83 × 48 (ζ = 0, until max|Δφ|/Δt < 1e-7), then copied; map of 100 Heun steps of dt 0.5 (τ = 50 TU), Arnoldi with Krylov {} and ε = {:e}; each wave's ζ_cr by regula falsi from two activities (up to 3 more evaluations, to 1e-5); grid of {} waves over the half zone, the four at half its spacing around the lowest, and the longest along each axis at half the spacing from q = 0. A wave whose line crosses zero below ζ = 0 is evaluated at ζ = 0: one that grows there (by two Ritz residuals) is unstable at rest, and the infinite tissue has no positive threshold. The errors in the claims are the root's last move and the Ritz residual over the slope, halved to a standard error (2 of them resolve).\n",
         scale.name(),
         ARNOLDI.krylov,
         ARNOLDI.eps,
