@@ -409,7 +409,7 @@ fn draw(made: &mut Made, forms: &[Form]) {
         let pn = pressure_name(f.pressure);
         let mut plot = Plot::new(
             format!("ζ_cr of each Bloch wave, {pn} form (γ = {GAMMA})"),
-            "q_y (units of 2π/24 nodes)",
+            "q_y (× 2π/24 nodes)",
             "ζ_cr(q)",
         );
         let mut qxs: Vec<f64> = f.waves.iter().map(|w| w.q[0]).collect();
@@ -421,9 +421,20 @@ fn draw(made: &mut Made, forms: &[Form]) {
             let y: Vec<f64> = line.iter().map(|w| w.zeta_cr).collect();
             let e: Vec<f64> = line.iter().map(|w| w.err).collect();
             plot.series
-                .push(Series::new(format!("q_x = {qx} (units of 2π/83)")).with_points(&x, &y, &e));
+                .push(Series::new(format!("q_x = {qx} × 2π/83")).with_points(&x, &y, &e));
         }
-        if let Some((w, _)) = infinite(f) {
+        if let Some(u) = f.all().find(|w| w.unstable_at_rest()) {
+            plot.hlines.push((
+                0.0,
+                format!("infinite tissue: 0 (q = {:?} grows at rest)", u.q),
+            ));
+            if let Some(w) = lowest(f.all().filter(|w| !w.unstable_at_rest())) {
+                plot.hlines.push((
+                    w.zeta_cr,
+                    format!("lowest wave stable at rest: {}", g(w.zeta_cr)),
+                ));
+            }
+        } else if let Some((w, _)) = infinite(f) {
             plot.hlines
                 .push((w.zeta_cr, format!("infinite tissue: {}", g(w.zeta_cr))));
         }
@@ -436,7 +447,7 @@ fn draw(made: &mut Made, forms: &[Form]) {
         let z = start(f.pressure)[1];
         let mut sp = Plot::new(
             format!("growth rate of each Bloch wave at ζ = {}, {pn} form", g(z)),
-            "q_y (units of 2π/24 nodes)",
+            "q_y (× 2π/24 nodes)",
             "σ(q) (1/TU)",
         );
         let mut qxs: Vec<f64> = f.waves.iter().map(|w| w.q[0]).collect();
@@ -458,7 +469,7 @@ fn draw(made: &mut Made, forms: &[Form]) {
             let y: Vec<f64> = pts.iter().map(|p| p.1).collect();
             let e: Vec<f64> = pts.iter().map(|p| p.2).collect();
             sp.series
-                .push(Series::new(format!("q_x = {qx}")).with_points(&x, &y, &e));
+                .push(Series::new(format!("q_x = {qx} × 2π/83")).with_points(&x, &y, &e));
         }
         sp.hlines.push((0.0, "σ = 0".into()));
         made.add_plot(format!("growth_rate_{pn}.png"), sp);
