@@ -14,8 +14,8 @@ use std::path::Path;
 use mechanics::{ModelParams, PressureKind, StepParams};
 use render::{Plot, Series};
 use stability::{
-    box_wavevectors, lowest, refine_waves, threshold, wave_thresholds, ArnoldiOptions, BlochTiling, HexBox,
-    Method, Relaxation, StabilityError, ThresholdOptions, WaveOptions, WaveThreshold,
+    box_wavevectors, lowest, refine_waves, threshold, wave_thresholds, ArnoldiOptions, BlochTiling,
+    HexBox, Method, Relaxation, StabilityError, ThresholdOptions, WaveOptions, WaveThreshold,
 };
 
 use super::pipeline::{cell, keep, kept, sci, Csv, Made};
@@ -228,10 +228,10 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> 
         let best = lowest(&waves).map(|w| w.q).unwrap_or([0.0, 0.0]);
         p.reporter
             .stage(&format!("bloch, {pn} form: the waves around the lowest"));
-        let mut refined =
-            waves_kept(&done, "refined", &tiling, pressure, &around(best, p.scale))?;
-        p.reporter
-            .stage(&format!("bloch, {pn} form: the longest waves along each axis"));
+        let mut refined = waves_kept(&done, "refined", &tiling, pressure, &around(best, p.scale))?;
+        p.reporter.stage(&format!(
+            "bloch, {pn} form: the longest waves along each axis"
+        ));
         let long: Vec<[f64; 2]> = longest(p.scale)
             .into_iter()
             .filter(|q| !refined.iter().any(|w| w.q == *q))
@@ -347,6 +347,7 @@ fn tables(made: &mut Made, forms: &[Form]) {
         "qy",
         "zeta_cr",
         "zeta_cr_err",
+        "unstable_at_rest",
     ]);
     for f in forms {
         let pn = pressure_name(f.pressure);
@@ -513,10 +514,13 @@ fn claims(forms: &[Form]) -> Vec<Claim> {
         // The infinite tissue's threshold is finite: not where a wave grows at rest.
         if let Some((w, err)) = infinite(f) {
             let rule = Rule::effect("ζ_cr of the infinite tissue", 5e-5);
-            let at_rest: Vec<&WaveThreshold> =
-                f.all().filter(|w| w.unstable_at_rest()).collect();
+            let at_rest: Vec<&WaveThreshold> = f.all().filter(|w| w.unstable_at_rest()).collect();
             let (o, measured) = if let Some(u) = at_rest.first() {
-                let s0 = u.points.iter().find(|p| p.zeta == 0.0).map_or(f64::NAN, |p| p.sigma);
+                let s0 = u
+                    .points
+                    .iter()
+                    .find(|p| p.zeta == 0.0)
+                    .map_or(f64::NAN, |p| p.sigma);
                 let mut o = rule.decide(0.0, 0.0);
                 o.why = format!(
                     "{}; {} wave(s) grow at ζ = 0, so the threshold is 0 or below",

@@ -186,8 +186,8 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 "d_plus_decoy_random",
             ]
             .map(|c| ev.f64s(c))
-                .into_iter()
-                .collect::<Result<Vec<_>, _>>()?;
+            .into_iter()
+            .collect::<Result<Vec<_>, _>>()?;
             let excess = |a: usize, b: usize| -> f64 {
                 let v: Vec<f64> = (0..kind.len())
                     .filter(|&k| kind[k] == "extrusion")

@@ -479,7 +479,13 @@ fn gas_claim(rows: &[(Vec<Phase>, Option<f64>, f64)], gas: &PerRun, gi: usize) -
         .map(|ai| {
             let (m, se) = mean_se(&gas.beta[gi].iter().map(|s| s[ai]).collect::<Vec<_>>());
             let (r, _) = mean_se(&gas.ratio[gi].iter().map(|s| s[ai]).collect::<Vec<_>>());
-            format!("α = {}: β = {} ± {}, D_eff/D_free = {}", ALPHAS[ai], g(m), g(se), g(r))
+            format!(
+                "α = {}: β = {} ± {}, D_eff/D_free = {}",
+                ALPHAS[ai],
+                g(m),
+                g(se),
+                g(r)
+            )
         })
         .collect();
     Claim::new(

@@ -167,7 +167,11 @@ pub fn wave_thresholds(
                 sigma(tiling, params, opts, q, opts.start[0])?,
                 sigma(tiling, params, opts, q, opts.start[1])?,
             ];
-            Ok(WaveThreshold::from_points(q, tiling.supercell_for(q), points))
+            Ok(WaveThreshold::from_points(
+                q,
+                tiling.supercell_for(q),
+                points,
+            ))
         })
         .collect::<Result<_, StabilityError>>()?;
     refine_waves(tiling, params, started, opts)
@@ -239,7 +243,11 @@ mod tests {
         let w = WaveThreshold::from_points(
             [0.0, 0.1],
             [1, 5],
-            vec![at(3e-4, line, 1e-7), at(6e-4, line, 1e-6), at(4e-4, line, 2e-7)],
+            vec![
+                at(3e-4, line, 1e-7),
+                at(6e-4, line, 1e-6),
+                at(4e-4, line, 2e-7),
+            ],
         );
         assert!((w.zeta_cr - 4e-4).abs() < 1e-15, "{}", w.zeta_cr);
         assert!(w.bracketed);
@@ -251,7 +259,11 @@ mod tests {
             vec![at(1e-4, line, 1e-7), at(2e-4, line, 1e-7)],
         );
         assert!(!far.bracketed && (far.zeta_cr - 4e-4).abs() < 1e-15);
-        assert!((far.err - 2e-4).abs() < 1e-15, "the distance to the nearer: {}", far.err);
+        assert!(
+            (far.err - 2e-4).abs() < 1e-15,
+            "the distance to the nearer: {}",
+            far.err
+        );
         let waves = [w, far];
         assert_eq!(lowest(&waves).map(|w| w.q), Some([0.0, 0.1]));
     }

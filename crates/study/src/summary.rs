@@ -229,7 +229,11 @@ mod tests {
         let mut rates = Vec::new();
         for time in [200.0, 800.0, 3200.0] {
             let s = summarise(dir.path(), window(t0, time)).unwrap();
-            assert!((s.growth_exponent - p).abs() < 1e-9, "{}", s.growth_exponent);
+            assert!(
+                (s.growth_exponent - p).abs() < 1e-9,
+                "{}",
+                s.growth_exponent
+            );
             assert!(s.growth_rate < 0.0);
             rates.push(s.growth_rate);
         }
