@@ -183,6 +183,7 @@ pub(crate) fn verdict_size(pairs: &[(State, State)]) -> (Verdict, String) {
 }
 
 /// One point of the scan and what its seeds did.
+#[derive(Clone)]
 struct PointResult {
     radius: f64,
     density: f64,
@@ -202,17 +203,79 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let relax = 100.0;
     let from = relax + t / 2.0;
     let (points, series_of_scene) = run_points(p, &radii, &densities, t, from)?;
+    p.reporter
+        .stage("rotation: the null, the same discs with alignment off");
+    let nulls = null_points(p, &radii, &densities, t, from)?;
     p.reporter.stage("rotation: tables and plots");
-    let (runs_csv, points_csv) = tables(&points);
+    let all: Vec<PointResult> = points.iter().chain(&nulls).cloned().collect();
+    let (runs_csv, points_csv) = tables(&all);
     let mut made = Made::new(Vec::new(), String::new())
         .table("rotation_runs.csv", runs_csv)
         .table("rotation_points.csv", points_csv);
     for (name, plot) in plots(&points, &densities, &series_of_scene) {
         made = made.plot(name, plot);
     }
-    made.claims = claims(&points, &radii, &densities);
+    made.claims = claims(&points, &nulls, &radii, &densities);
     made.settings = settings_text(p, &radii, &densities, t);
     Ok(made)
+}
+
+/// The rule name of the null points: alignment off.
+const NULL: &str = "none";
+
+/// The square domain's side (the disc's default radius, side/2 − 1, is R_d: the scene as
+/// `scenes/disc.toml` writes it) and the cell count of a disc of `rk` cell radii at area
+/// fraction `dens`.
+fn disc(rk: f64, dens: f64) -> (usize, usize) {
+    let side = (2.0 * rk * RADIUS).round() as usize + 2;
+    let cells = ((dens * rk * rk).round() as usize).max(1);
+    (side, cells)
+}
+
+/// Each run's `(seed, Ω̄, persistence)` from `from` on; `seen` gets each run's Ω(t).
+fn statistics(
+    pt: &super::pipeline::PointRuns,
+    from: f64,
+    seen: &mut dyn FnMut(u64, &[f64], &[f64]),
+) -> Result<Vec<(u64, f64, f64)>, SweepError> {
+    let mut runs = Vec::new();
+    for r in &pt.runs {
+        let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
+        let (times, omega) = (tab.f64s("time")?, tab.f64s("rotation")?);
+        let (o, per) = run_statistic(&times, &omega, from);
+        runs.push((r.seed, o, per));
+        seen(r.seed, &times, &omega);
+    }
+    Ok(runs)
+}
+
+impl PointResult {
+    fn new(
+        radius: f64,
+        density: f64,
+        cells: usize,
+        rule: &str,
+        rate: &str,
+        alpha: &str,
+        runs: Vec<(u64, f64, f64)>,
+    ) -> Self {
+        let (state, abs, persistence) = classify(
+            &runs.iter().map(|r| r.1).collect::<Vec<_>>(),
+            &runs.iter().map(|r| r.2).collect::<Vec<_>>(),
+        );
+        Self {
+            radius,
+            density,
+            cells,
+            rule: rule.into(),
+            rate: rate.into(),
+            alpha: alpha.into(),
+            runs,
+            state,
+            abs,
+            persistence,
+        }
+    }
 }
 
 /// Each Ω(t) of `scenes/disc.toml`'s point: the seed, the times and Ω.
@@ -231,10 +294,7 @@ fn run_points(
     let mut series_of_scene: SceneSeries = Vec::new();
     for &rk in radii {
         for &dens in densities {
-            // The disc's default radius, side/2 − 1, is R_d: the scene as `scenes/disc.toml`
-            // writes it.
-            let side = (2.0 * rk * RADIUS).round() as usize + 2;
-            let cells = ((dens * rk * rk).round() as usize).max(1);
+            let (side, cells) = disc(rk, dens);
             let mut sets = vec![
                 format!("domain.lx={side}"),
                 format!("domain.ly={side}"),
@@ -267,39 +327,60 @@ fn run_points(
                     pt.values[1].as_str(),
                     pt.values[2].as_str(),
                 );
-                let mut runs = Vec::new();
-                for r in &pt.runs {
-                    let tab = super::Table::read(&r.run.join("analysis/observables.csv"))?;
-                    let (times, omega) = (tab.f64s("time")?, tab.f64s("rotation")?);
-                    let (o, per) = run_statistic(&times, &omega, from);
-                    runs.push((r.seed, o, per));
-                    if (rule, rate, alpha) == SCENE_POINT
-                        && rk == SCENE_RADIUS
-                        && dens == SCENE_DENSITY
-                    {
-                        series_of_scene.push((r.seed, times, omega));
+                let scene_point = (rule, rate, alpha) == SCENE_POINT
+                    && rk == SCENE_RADIUS
+                    && dens == SCENE_DENSITY;
+                let runs = statistics(&pt, from, &mut |seed, times, omega| {
+                    if scene_point {
+                        series_of_scene.push((seed, times.to_vec(), omega.to_vec()));
                     }
-                }
-                let (state, abs, persistence) = classify(
-                    &runs.iter().map(|r| r.1).collect::<Vec<_>>(),
-                    &runs.iter().map(|r| r.2).collect::<Vec<_>>(),
-                );
-                points.push(PointResult {
-                    radius: rk,
-                    density: dens,
-                    cells,
-                    rule: rule.into(),
-                    rate: rate.into(),
-                    alpha: alpha.into(),
-                    runs,
-                    state,
-                    abs,
-                    persistence,
-                });
+                })?;
+                points.push(PointResult::new(rk, dens, cells, rule, rate, alpha, runs));
             }
         }
     }
     Ok((points, series_of_scene))
+}
+
+/// The null of each disc (issue 54): the same cells with alignment off (`align = "none"`), at
+/// each α: what |Ω̄| N cells reach by chance.
+fn null_points(
+    p: &ReproduceParams,
+    radii: &[f64],
+    densities: &[f64],
+    t: f64,
+    from: f64,
+) -> Result<Vec<PointResult>, SweepError> {
+    let mut points: Vec<PointResult> = Vec::new();
+    for &rk in radii {
+        for &dens in densities {
+            let (side, cells) = disc(rk, dens);
+            let mut sets = vec![
+                format!("domain.lx={side}"),
+                format!("domain.ly={side}"),
+                format!("cells.count={cells}"),
+                format!("run.time={t}"),
+                "polarity.align=\"none\"".to_string(),
+            ];
+            sets.extend(p.scale.own_dt_set());
+            let res = super::sweep(
+                p,
+                SweepJob {
+                    name: format!("rotation-null-r{rk}-d{dens}-{}", p.scale.name()),
+                    scene: DISC_SCENE,
+                    sets,
+                    varies: vec![format!("polarity.alpha={}", ALPHAS.join(","))],
+                    analyze: Some(AnalyzeOptions::default()),
+                    seeds: Some(seeds(p.scale)),
+                },
+            )?;
+            for pt in res.points(None)? {
+                let runs = statistics(&pt, from, &mut |_, _, _| {})?;
+                points.push(PointResult::new(rk, dens, cells, NULL, "–", &pt.values[0], runs));
+            }
+        }
+    }
+    Ok(points)
 }
 
 /// The runs' and the points' tables.
@@ -412,8 +493,29 @@ fn plots(
     out
 }
 
-/// The two claims: rotation at some point, and its loss with the disc's size.
-fn claims(points: &[PointResult], radii: &[f64], densities: &[f64]) -> Vec<Claim> {
+/// The state of a point in the largest disc against its null (issue 54): the effect is how
+/// far its `|Ω̄|` lies above that of the same disc and α with alignment off, and the smallest
+/// that counts is [`STILL`]: rotating when that holds ([`Rule::effect`]), still when it does
+/// not, not established otherwise.
+pub(crate) fn against_null(point: (f64, f64), null: (f64, f64)) -> (State, String) {
+    let rule = super::rule::Rule::effect("|Ω̄| − |Ω̄| with alignment off", STILL);
+    let o = rule.decide(point.0 - null.0, point.1.hypot(null.1));
+    let state = match o.verdict {
+        Verdict::Holds => State::Rotates,
+        Verdict::DoesNotHold => State::Still,
+        _ => State::NotEstablished,
+    };
+    (state, o.why)
+}
+
+/// The claims: rotation at some point, its loss with the disc's size (in the largest disc,
+/// against the null of the same N), and the control: with alignment off, no point rotates.
+fn claims(
+    points: &[PointResult],
+    nulls: &[PointResult],
+    radii: &[f64],
+    densities: &[f64],
+) -> Vec<Claim> {
     let states: Vec<State> = points.iter().map(|q| q.state).collect();
     let best = points
         .iter()
@@ -436,13 +538,21 @@ fn claims(points: &[PointResult], radii: &[f64], densities: &[f64]) -> Vec<Claim
                                 && q.density == dens
                         })
                     };
-                    if let (Some(a), Some(b)) = (at(rmin), at(rmax)) {
-                        pairs.push((a.state, b.state));
+                    let null = nulls
+                        .iter()
+                        .find(|q| q.radius == rmax && q.alpha == alpha && q.density == dens);
+                    if let (Some(a), Some(b), Some(n)) = (at(rmin), at(rmax), null) {
+                        let (large, _) = against_null(b.abs, n.abs);
+                        pairs.push((a.state, large));
                         if a.state == State::Rotates {
                             pair_text.push(format!(
-                                "{rule}, J = {rate}, α = {alpha}, {dens}: {} → {}",
+                                "{rule}, J = {rate}, α = {alpha}, {dens}: {} → {} ± {} against the null's {} ± {}: {}",
                                 g(a.abs.0),
-                                b.state.name()
+                                g(b.abs.0),
+                                g(b.abs.1),
+                                g(n.abs.0),
+                                g(n.abs.1),
+                                large.name()
                             ));
                         }
                     }
@@ -451,6 +561,13 @@ fn claims(points: &[PointResult], radii: &[f64], densities: &[f64]) -> Vec<Claim
         }
     }
     let (v2, why2) = verdict_size(&pairs);
+    let null_states: Vec<State> = nulls.iter().map(|q| q.state).collect();
+    let (v3, why3) = verdict_rotates(&null_states);
+    let null_text = nulls
+        .iter()
+        .map(|q| format!("R_d = {}R, {}, α = {}: {} ± {}", q.radius, q.density, q.alpha, g(q.abs.0), g(q.abs.1)))
+        .collect::<Vec<_>>()
+        .join("; ");
     vec![
         Claim::new(
             "rotation (issue 41, T1.4 of the extensions): polar cells confined to a disc rotate collectively and persistently for some parameters (Doxzen et al. 2013; Segerer et al. 2015)",
@@ -465,10 +582,16 @@ fn claims(points: &[PointResult], radii: &[f64], densities: &[f64]) -> Vec<Claim
             why1,
         ),
         Claim::new(
-            format!("rotation: coherent rotation is lost as the disc grows (from R_d = {rmin}R to {rmax}R)"),
+            format!("rotation: coherent rotation is lost as the disc grows (from R_d = {rmin}R to {rmax}R, the largest against the null of the same N)"),
             if pair_text.is_empty() { "no combination rotates in the smallest disc".into() } else { pair_text.join("; ") },
             v2,
             why2,
+        ),
+        Claim::new(
+            "Control (rotation): polar cells in a disc with alignment off rotate collectively (must not hold)",
+            format!("|Ω̄|: {null_text}"),
+            v3,
+            why3,
         ),
     ]
 }
@@ -480,6 +603,7 @@ fn settings_text(p: &ReproduceParams, radii: &[f64], densities: &[f64], t: f64) 
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩ about the disc's centre at each frame (`rotation` of `analysis/observables.csv`); a run's Ω̄ is its mean over the second half of the active phase, its persistence the share of those frames with the sign of Ω̄. A point rotates when the mean over seeds of |Ω̄| less two standard errors is at least {ROTATES} and the mean persistence at least {PERSISTENT}; it is still when the mean of |Ω̄| plus two standard errors is below {STILL}; otherwise not established. (Undirected motion of N cells gives Ω of spread about 1/√(2N) per frame, less in the time mean.)\n\
          - Claim 1 holds when a point rotates, does not hold when every point is still. Claim 2 holds when a combination rotating in the smallest disc is still in the largest, does not hold when every such combination also rotates in the largest.\n\
+         - Null and control (issue 54): the same discs and α with alignment off (`align = \"none\"`, rule `none` in the tables): what |Ω̄| N cells reach by chance. \"Lost with size\" compares each combination in the largest disc with its null: |Ω̄| − |Ω̄|_null, by the rule of an effect with {STILL} the smallest that counts (rotating when it holds, still when it does not hold). The control, that the null points rotate, must not hold.\n\
          - Data: `rotation_runs.csv` (every run), `rotation_points.csv` (every point and its state); plots `rotation_velocity.png`, `rotation_force.png` (|Ω̄| against R_d), `rotation_in_time.png` (Ω(t) of each seed at R_d = {SCENE_RADIUS}R, area fraction {SCENE_DENSITY}, align = \"{}\", J = {}, α = {}: `scenes/disc.toml`'s settings).",
         radii.iter().map(|r| g(*r)).collect::<Vec<_>>().join(", "),
         densities.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", "),
@@ -503,6 +627,15 @@ const SCENE_DENSITY: f64 = 0.85;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Against the null: well above it rotates, within it is still, a wide spread decides
+    /// neither.
+    #[test]
+    fn a_large_disc_is_judged_against_its_null() {
+        assert_eq!(against_null((0.8, 0.03), (0.1, 0.02)).0, State::Rotates);
+        assert_eq!(against_null((0.15, 0.02), (0.1, 0.02)).0, State::Still);
+        assert_eq!(against_null((0.4, 0.2), (0.1, 0.02)).0, State::NotEstablished);
+    }
 
     #[test]
     fn a_run_is_its_time_mean_and_the_persistence_of_its_sign() {
