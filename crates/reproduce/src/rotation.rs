@@ -361,6 +361,7 @@ fn null_points(
                 format!("cells.count={cells}"),
                 format!("run.time={t}"),
                 "polarity.align=\"none\"".to_string(),
+                "polarity.align_rate=0".to_string(),
             ];
             sets.extend(p.scale.own_dt_set());
             let res = super::sweep(
@@ -376,7 +377,15 @@ fn null_points(
             )?;
             for pt in res.points(None)? {
                 let runs = statistics(&pt, from, &mut |_, _, _| {})?;
-                points.push(PointResult::new(rk, dens, cells, NULL, "–", &pt.values[0], runs));
+                points.push(PointResult::new(
+                    rk,
+                    dens,
+                    cells,
+                    NULL,
+                    "–",
+                    &pt.values[0],
+                    runs,
+                ));
             }
         }
     }
@@ -565,7 +574,16 @@ fn claims(
     let (v3, why3) = verdict_rotates(&null_states);
     let null_text = nulls
         .iter()
-        .map(|q| format!("R_d = {}R, {}, α = {}: {} ± {}", q.radius, q.density, q.alpha, g(q.abs.0), g(q.abs.1)))
+        .map(|q| {
+            format!(
+                "R_d = {}R, {}, α = {}: {} ± {}",
+                q.radius,
+                q.density,
+                q.alpha,
+                g(q.abs.0),
+                g(q.abs.1)
+            )
+        })
         .collect::<Vec<_>>()
         .join("; ");
     vec![
@@ -634,7 +652,10 @@ mod tests {
     fn a_large_disc_is_judged_against_its_null() {
         assert_eq!(against_null((0.8, 0.03), (0.1, 0.02)).0, State::Rotates);
         assert_eq!(against_null((0.15, 0.02), (0.1, 0.02)).0, State::Still);
-        assert_eq!(against_null((0.4, 0.2), (0.1, 0.02)).0, State::NotEstablished);
+        assert_eq!(
+            against_null((0.4, 0.2), (0.1, 0.02)).0,
+            State::NotEstablished
+        );
     }
 
     #[test]
