@@ -232,11 +232,14 @@ fn disc(rk: f64, dens: f64) -> (usize, usize) {
     (side, cells)
 }
 
+/// Told each run's seed, frame times and Ω(t).
+type Seen<'a> = dyn FnMut(u64, &[f64], &[f64]) + 'a;
+
 /// Each run's `(seed, Ω̄, persistence)` from `from` on; `seen` gets each run's Ω(t).
 fn statistics(
     pt: &super::pipeline::PointRuns,
     from: f64,
-    seen: &mut dyn FnMut(u64, &[f64], &[f64]),
+    seen: &mut Seen,
 ) -> Result<Vec<(u64, f64, f64)>, SweepError> {
     let mut runs = Vec::new();
     for r in &pt.runs {
