@@ -520,18 +520,33 @@ pub(crate) fn against_null(point: (f64, f64), null: (f64, f64)) -> (State, Strin
     (state, o.why)
 }
 
-/// The claims: rotation at some point, its loss with the disc's size (in the largest disc,
-/// against the null of the same N), and the control: with alignment off, no point rotates.
+/// The claims: rotation at some point (a point that rotates must also lie above its null by
+/// [`against_null`]), its loss with the disc's size (the largest disc against the null of the
+/// same N), and the control: with alignment off, no point rotates.
 fn claims(
     points: &[PointResult],
     nulls: &[PointResult],
     radii: &[f64],
     densities: &[f64],
 ) -> Vec<Claim> {
-    let states: Vec<State> = points.iter().map(|q| q.state).collect();
+    // Each point's state beyond chance: a point that rotates must also lie above the null of
+    // its disc and α (issue 54); one that does not is not established.
+    let null_of = |q: &PointResult| {
+        nulls
+            .iter()
+            .find(|n| n.radius == q.radius && n.density == q.density && n.alpha == q.alpha)
+    };
+    let beyond = |q: &PointResult| match (q.state, null_of(q)) {
+        (State::Rotates, Some(n)) if against_null(q.abs, n.abs).0 == State::Rotates => {
+            State::Rotates
+        }
+        (State::Rotates, _) => State::NotEstablished,
+        (s, _) => s,
+    };
+    let states: Vec<State> = points.iter().map(beyond).collect();
     let best = points
         .iter()
-        .filter(|q| q.state == State::Rotates)
+        .filter(|q| beyond(q) == State::Rotates)
         .max_by(|a, b| a.abs.0.total_cmp(&b.abs.0));
     let (v1, why1) = verdict_rotates(&states);
     let (rmin, rmax) = (radii[0], *radii.last().expect("radii"));
@@ -555,8 +570,9 @@ fn claims(
                         .find(|q| q.radius == rmax && q.alpha == alpha && q.density == dens);
                     if let (Some(a), Some(b), Some(n)) = (at(rmin), at(rmax), null) {
                         let (large, _) = against_null(b.abs, n.abs);
-                        pairs.push((a.state, large));
-                        if a.state == State::Rotates {
+                        let small = beyond(a);
+                        pairs.push((small, large));
+                        if small == State::Rotates {
                             pair_text.push(format!(
                                 "{rule}, J = {rate}, α = {alpha}, {dens}: {} → {} ± {} against the null's {} ± {}: {}",
                                 g(a.abs.0),
