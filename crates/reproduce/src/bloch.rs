@@ -629,6 +629,84 @@ mod tests {
         }
     }
 
+    /// A form with synthetic waves on straight lines σ = s (ζ − z(q)): every box's wave and
+    /// the longest along the rows, one of which (if `at_rest`) grows at ζ = 0.
+    fn form(pressure: PressureKind, at_rest: bool) -> Form {
+        let relax = Relaxation {
+            margin: 11,
+            ..Relaxation::default()
+        };
+        let tiling = BlochTiling::relax(
+            HexBox::new(2, 2, AREA_PER_CELL).unwrap(),
+            [1, 1],
+            &ModelParams::paper(0.0),
+            &relax,
+        )
+        .unwrap();
+        let wave = |q: [f64; 2], z: f64, s: f64| {
+            let at = |zeta: f64| stability::WavePoint {
+                zeta,
+                sigma: s * (zeta - z),
+                residual: 1e-8,
+            };
+            let first = if z < 0.0 { 0.0 } else { 2e-4 };
+            WaveThreshold::from_points(q, [1, 5], vec![at(first), at(6e-4), at(z.max(0.0))])
+        };
+        let waves: Vec<WaveThreshold> = grid(Scale::Quick)
+            .into_iter()
+            .map(|q| wave(q, 4e-4 + 1e-3 * q[1] + 1e-4 * q[0].abs(), 0.5))
+            .collect();
+        let refined = vec![wave(
+            [0.125, 0.0],
+            if at_rest { -5e-4 } else { 3.5e-4 },
+            0.03,
+        )];
+        Form {
+            pressure,
+            tiling,
+            waves,
+            refined,
+            whole_box: Some((6e-4, 1e-5)),
+        }
+    }
+
+    /// The tables have a cell for every column, the pictures draw, and the claims read as
+    /// their rules say: the box's waves against the whole box, a wave that grows at rest
+    /// makes the infinite tissue's threshold "does not hold", and otherwise the lowest wave
+    /// holds.
+    #[test]
+    fn the_figure_s_tables_and_claims_follow_its_waves() {
+        let forms = [
+            form(PressureKind::Paper, true),
+            form(PressureKind::Interaction, false),
+        ];
+        assert!(forms[0].refined[0].unstable_at_rest());
+        let mut made = Made::new(Vec::new(), String::new());
+        tables(&mut made, &forms);
+        draw(&mut made, &forms);
+        assert_eq!(made.tables.len(), 3);
+        assert_eq!(made.plots.len(), 4);
+        let claims = claims(&forms);
+        let verdict = |what: &str, form: &str| {
+            claims
+                .iter()
+                .find(|c| c.claim.starts_with(what) && c.claim.contains(form))
+                .map(|c| c.verdict)
+                .unwrap()
+        };
+        use crate::Verdict;
+        // The box 83 × 120 has the waves (0, 0), (0, 0.2), (0, 0.4): its lowest, 4e-4 at
+        // q = 0, is 2e-4 from the whole box's 6e-4, resolved and above the 5e-5 that counts.
+        assert_eq!(verdict("Check", "paper"), Verdict::DoesNotHold);
+        assert_eq!(verdict("9.1", "paper"), Verdict::DoesNotHold);
+        assert_eq!(verdict("9.1", "interaction"), Verdict::Holds);
+        let inf = infinite(&forms[1]).unwrap().0;
+        assert_eq!(inf.q, [0.125, 0.0]);
+        assert!((inf.zeta_cr - 3.5e-4).abs() < 1e-12, "{}", inf.zeta_cr);
+        // Both boxes have q = 0, their lowest wave here: the same threshold, so no box effect.
+        assert_eq!(verdict("9.2b", "paper"), Verdict::Holds);
+    }
+
     /// `q` and `−q`, and `q` plus a reciprocal vector, fold to the same wave.
     #[test]
     fn a_wave_and_its_opposite_fold_together() {
