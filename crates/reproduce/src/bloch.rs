@@ -15,7 +15,7 @@ use mechanics::{ModelParams, PressureKind, StepParams};
 use render::{Plot, Series};
 use stability::{
     box_wavevectors, lowest, refine_waves, threshold, wave_thresholds, ArnoldiOptions, BlochTiling,
-    HexBox, Method, Relaxation, StabilityError, ThresholdOptions, WaveOptions, WaveThreshold,
+    HexBox, Method, Relaxation, StabilityError, WaveOptions, WaveThreshold,
 };
 
 use super::pipeline::{cell, keep, kept, sci, Csv, Made};
@@ -30,11 +30,7 @@ const AREA_PER_CELL: f64 = 100.0 * 100.0 / 60.0;
 const GAMMA: f64 = 0.01;
 
 /// The solver's settings, those of the stability figure: τ = 100 steps of 0.5, Krylov 30.
-const ARNOLDI: ArnoldiOptions = ArnoldiOptions {
-    krylov: 30,
-    eps: 1e-5,
-    seed: 1,
-};
+const ARNOLDI: ArnoldiOptions = super::stability::ARNOLDI;
 
 /// The primitive cell: 6 × 2 cells on 83 × 24 nodes.
 fn primitive() -> HexBox {
@@ -277,14 +273,8 @@ fn whole_box(
     pressure: PressureKind,
 ) -> Result<Option<(f64, f64)>, SweepError> {
     let pn = pressure_name(pressure);
-    let opts = ThresholdOptions {
-        step: StepParams::new(0.5, 1),
-        steps: 100,
-        lo: 0.0,
-        hi: 0.008,
-        tol: 2e-5,
-        narrow: 1e-4,
-    };
+    // The stability figure's bisection, so that its whole-box threshold is comparable.
+    let opts = super::stability::threshold_opts(super::stability::TOL_ARNOLDI);
     let file = dir.join(format!("box-{pn}.toml"));
     let fingerprint = format!("{opts:?} {ARNOLDI:?} {:?}", tiling.primitive);
     if let Some(v) = kept::<Option<(f64, f64)>>(&file, &fingerprint) {

@@ -223,13 +223,20 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
 /// The rule name of the null points: alignment off.
 const NULL: &str = "none";
 
-/// The square domain's side (the disc's default radius, side/2 − 1, is R_d: the scene as
-/// `scenes/disc.toml` writes it) and the cell count of a disc of `rk` cell radii at area
-/// fraction `dens`.
-fn disc(rk: f64, dens: f64) -> (usize, usize) {
+/// The overrides of [`DISC_SCENE`] for a disc of `rk` cell radii at area fraction `dens`, run
+/// for `t` TU at `scale` (the square domain's side is 2R_d + 2: the disc's default radius,
+/// side/2 − 1, is R_d, as `scenes/disc.toml` writes it), and its cell count.
+fn disc(rk: f64, dens: f64, t: f64, scale: Scale) -> (Vec<String>, usize) {
     let side = (2.0 * rk * RADIUS).round() as usize + 2;
     let cells = ((dens * rk * rk).round() as usize).max(1);
-    (side, cells)
+    let mut sets = vec![
+        format!("domain.lx={side}"),
+        format!("domain.ly={side}"),
+        format!("cells.count={cells}"),
+        format!("run.time={t}"),
+    ];
+    sets.extend(scale.own_dt_set());
+    (sets, cells)
 }
 
 /// Told each run's seed, frame times and Ω(t).
@@ -297,14 +304,7 @@ fn run_points(
     let mut series_of_scene: SceneSeries = Vec::new();
     for &rk in radii {
         for &dens in densities {
-            let (side, cells) = disc(rk, dens);
-            let mut sets = vec![
-                format!("domain.lx={side}"),
-                format!("domain.ly={side}"),
-                format!("cells.count={cells}"),
-                format!("run.time={t}"),
-            ];
-            sets.extend(p.scale.own_dt_set());
+            let (sets, cells) = disc(rk, dens, t, p.scale);
             let res = super::sweep(
                 p,
                 SweepJob {
@@ -357,16 +357,11 @@ fn null_points(
     let mut points: Vec<PointResult> = Vec::new();
     for &rk in radii {
         for &dens in densities {
-            let (side, cells) = disc(rk, dens);
-            let mut sets = vec![
-                format!("domain.lx={side}"),
-                format!("domain.ly={side}"),
-                format!("cells.count={cells}"),
-                format!("run.time={t}"),
+            let (mut sets, cells) = disc(rk, dens, t, p.scale);
+            sets.extend([
                 "polarity.align=\"none\"".to_string(),
                 "polarity.align_rate=0".to_string(),
-            ];
-            sets.extend(p.scale.own_dt_set());
+            ]);
             let res = super::sweep(
                 p,
                 SweepJob {

@@ -40,7 +40,7 @@ const DT: f64 = 0.5;
 const STEPS: usize = 100;
 
 /// Half the final bisection bracket, by method.
-const TOL_ARNOLDI: f64 = 2e-5;
+pub(super) const TOL_ARNOLDI: f64 = 2e-5;
 const TOL_GROWTH: f64 = 5e-5;
 
 /// The bracket: σ < 0 at ζ = 0 (a relaxed state is stable) and σ > 0 at ζ = 0.008 (the top of
@@ -92,7 +92,7 @@ struct Plan {
 }
 
 /// The solvers' settings, the same at both scales (the scales differ in what they measure).
-const ARNOLDI: ArnoldiOptions = ArnoldiOptions {
+pub(super) const ARNOLDI: ArnoldiOptions = ArnoldiOptions {
     krylov: 30,
     eps: 1e-5,
     seed: 1,
@@ -155,7 +155,7 @@ fn plan(scale: Scale) -> Plan {
     }
 }
 
-fn threshold_opts(tol: f64) -> ThresholdOptions {
+pub(super) fn threshold_opts(tol: f64) -> ThresholdOptions {
     ThresholdOptions {
         step: StepParams::new(DT, 1),
         steps: STEPS,

@@ -38,7 +38,7 @@
 use mechanics::{ModelParams, StepParams, Tissue};
 use phasefield::Cells;
 
-use crate::map::{dot, norm, Operator, StepMap};
+use crate::map::{dot, norm, translations_of, Operator, StepMap};
 use crate::rest::{rest_state, HexBox, Relaxation, RestState};
 use crate::StabilityError;
 
@@ -319,7 +319,9 @@ impl BlochMap {
                 (index(prim, cols, p, r), r)
             })
             .collect();
-        let translations = (q == [0.0, 0.0]).then(|| primitive_translations(base.cells(), &read));
+        let copies: Vec<usize> = read.iter().map(|r| r.0).collect();
+        // At k = 0 the uniform translation of the primitive cell's cells is neutral.
+        let translations = (q == [0.0, 0.0]).then(|| translations_of(base.cells(), &copies));
         let len = base.cells().phi().len();
         Ok(Self {
             one_step,
@@ -440,31 +442,4 @@ impl Operator for BlochMap {
         let p = self.one_step.base().cells().phi()[j * n + k % n];
         (4.0 * p * (1.0 - p)).max(0.0)
     }
-}
-
-/// The uniform translations on the primitive cell's cells (`∂_x φ`, `∂_y φ` of the copies
-/// read, orthonormalised), the directions that are neutral at `k = 0`.
-fn primitive_translations(cells: &Cells<f64>, read: &[(usize, [usize; 2])]) -> [Vec<f64>; 2] {
-    let shape = cells.shape();
-    let (nx, ny, n) = (shape.nx, shape.ny, shape.len());
-    let phi = cells.phi();
-    let mut gx = vec![0.0; read.len() * n];
-    let mut gy = vec![0.0; read.len() * n];
-    for (p, &(i, _)) in read.iter().enumerate() {
-        let f = &phi[i * n..(i + 1) * n];
-        for a in 0..nx {
-            for b in 0..ny {
-                let k = p * n + a * ny + b;
-                gx[k] = 0.5 * (f[shape.xp[a] * ny + b] - f[shape.xm[a] * ny + b]);
-                gy[k] = 0.5 * (f[a * ny + (b + 1) % ny] - f[a * ny + (b + ny - 1) % ny]);
-            }
-        }
-    }
-    let size = norm(&gx);
-    gx.iter_mut().for_each(|x| *x /= size);
-    let c = dot(&gx, &gy);
-    gy.iter_mut().zip(&gx).for_each(|(y, x)| *y -= c * x);
-    let size = norm(&gy);
-    gy.iter_mut().for_each(|y| *y /= size);
-    [gx, gy]
 }

@@ -328,26 +328,33 @@ impl StepMap {
 /// The generators of the two uniform translations, `∂_x φ_i` and `∂_y φ_i` of every cell
 /// (central differences on the patch), orthonormalised.
 fn translation_modes(cells: &Cells<f64>) -> [Vec<f64>; 2] {
+    let all: Vec<usize> = (0..cells.n_cells()).collect();
+    translations_of(cells, &all)
+}
+
+/// The same generators restricted to the cells `which`, in that order (one patch each): the
+/// uniform translation of those cells together, orthonormalised.
+pub(crate) fn translations_of(cells: &Cells<f64>, which: &[usize]) -> [Vec<f64>; 2] {
     let shape = cells.shape();
     let (nx, ny, n) = (shape.nx, shape.ny, shape.len());
     let phi = cells.phi();
-    let mut gx = vec![0.0; phi.len()];
-    let mut gy = vec![0.0; phi.len()];
-    for i in 0..cells.n_cells() {
-        let p = &phi[i * n..(i + 1) * n];
+    let mut gx = vec![0.0; which.len() * n];
+    let mut gy = vec![0.0; which.len() * n];
+    for (p, &i) in which.iter().enumerate() {
+        let f = &phi[i * n..(i + 1) * n];
         for a in 0..nx {
             for b in 0..ny {
-                let k = i * n + a * ny + b;
-                gx[k] = 0.5 * (p[shape.xp[a] * ny + b] - p[shape.xm[a] * ny + b]);
-                gy[k] = 0.5 * (p[a * ny + (b + 1) % ny] - p[a * ny + (b + ny - 1) % ny]);
+                let k = p * n + a * ny + b;
+                gx[k] = 0.5 * (f[shape.xp[a] * ny + b] - f[shape.xm[a] * ny + b]);
+                gy[k] = 0.5 * (f[a * ny + (b + 1) % ny] - f[a * ny + (b + ny - 1) % ny]);
             }
         }
     }
-    let nx_ = norm(&gx);
-    gx.iter_mut().for_each(|x| *x /= nx_);
+    let size = norm(&gx);
+    gx.iter_mut().for_each(|x| *x /= size);
     let c = dot(&gx, &gy);
     gy.iter_mut().zip(&gx).for_each(|(y, x)| *y -= c * x);
-    let ny_ = norm(&gy);
-    gy.iter_mut().for_each(|y| *y /= ny_);
+    let size = norm(&gy);
+    gy.iter_mut().for_each(|y| *y /= size);
     [gx, gy]
 }
