@@ -1,5 +1,5 @@
 //! Observables of confined tissues: how much of a region the cells cover (a wound's gap),
-//! the flow profile across a channel, and the rotation of cells about a disc's centre.
+//! the flow profile across a channel and its shear, and the rotation of cells about a disc's centre.
 
 /// The share of the nodes of `region` (a mask, index `x * ly + y`) where the cells' total
 /// `s1 = Σ_i φ_i` is below ½: the open part of a wound. NaN for an empty region.
@@ -41,6 +41,24 @@ pub fn mean_over_x(field: &[f64], lx: usize, ly: usize) -> Vec<f64> {
     out
 }
 
+/// The shear across a channel along x from its profile `⟨v_x⟩(y)` (`ly` rows,
+/// [`mean_over_x`]): half the difference of the mean over the rows above the middle line
+/// `y = (ly − 1)/2` and the mean over the rows below it (the middle row of an odd `ly` is
+/// left out). The antisymmetric part of the profile: zero for a plug flow and for any
+/// profile symmetric about the middle; for a linear shear `v_x = s (y − (ly − 1)/2)` it is
+/// `s·ly/4` (even `ly`) or `s·(ly + 1)/4` (odd): the mean speed of each half. Its sign is
+/// that of `∂v_x/∂y`. NaN for fewer than two rows.
+pub fn shear_across(profile: &[f64]) -> f64 {
+    let ly = profile.len();
+    let half = ly / 2;
+    if half == 0 {
+        return f64::NAN;
+    }
+    let lower: f64 = profile[..half].iter().sum::<f64>() / half as f64;
+    let upper: f64 = profile[ly - half..].iter().sum::<f64>() / half as f64;
+    0.5 * (upper - lower)
+}
+
 /// The angular order parameter of cells about `centre`:
 /// `Ω = ⟨(r_i × v_i) / (|r_i| |v_i|)⟩` over the cells, `r_i` the cell's position from the
 /// centre and `v_i` its velocity. `Ω = ±1` when every cell moves along its circle
@@ -71,6 +89,27 @@ pub fn angular_order(centres: &[[f64; 2]], velocities: &[[f64; 2]], centre: [f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The shear of a linear profile is the mean speed of each half, exactly; a plug flow and
+    /// a profile symmetric about the middle have none; reversing the profile reverses it.
+    #[test]
+    fn the_shear_is_the_antisymmetric_part_of_the_profile() {
+        for ly in [8usize, 9, 30, 31] {
+            let mid = (ly as f64 - 1.0) / 2.0;
+            let s = 0.013;
+            let linear: Vec<f64> = (0..ly).map(|y| s * (y as f64 - mid) + 0.2).collect();
+            let want = s * (ly + ly % 2) as f64 / 4.0;
+            assert!((shear_across(&linear) - want).abs() < 1e-15, "{ly}");
+            let reversed: Vec<f64> = linear.iter().rev().copied().collect();
+            assert!((shear_across(&reversed) + want).abs() < 1e-15);
+            let poiseuille: Vec<f64> = (0..ly)
+                .map(|y| 1.0 - ((y as f64 - mid) / mid).powi(2))
+                .collect();
+            assert!(shear_across(&poiseuille).abs() < 1e-15, "{ly}");
+            assert_eq!(shear_across(&vec![0.7; ly]), 0.0);
+        }
+        assert!(shear_across(&[1.0]).is_nan());
+    }
 
     #[test]
     fn the_angular_order_is_one_for_a_rigid_rotation_and_zero_for_a_radial_flow() {

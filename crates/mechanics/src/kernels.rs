@@ -136,6 +136,9 @@ pub(crate) struct EvalInput<'a, T: Real> {
     pub active: bool,
     pub growth: &'a [f64],
     pub node_terms: &'a [Option<&'a dyn NodeTerm>],
+    /// The walls' field in effect and their friction `ξ_w`, when it is not zero
+    /// ([`crate::walls::wall_overlap`]).
+    pub wall_friction: Option<(&'a phasefield::WallField, f64)>,
 }
 
 /// Where one evaluation writes what it computes on the way (all of it left for inspection).
@@ -230,6 +233,7 @@ pub(crate) fn evaluate<T: Real>(
         active,
         growth,
         node_terms: terms,
+        wall_friction,
     } = *input;
     let EvalScratch {
         sums: global,
@@ -329,6 +333,13 @@ pub(crate) fn evaluate<T: Real>(
     let body = |i: usize, out: &mut [T], cell: &[T], st: &mut CellState, post: CellPost<'_, T>| {
         let xs = map.cell_x(shape, i);
         let CellConstants { coef, xi, .. } = constants(i);
+        // A cell on a wall with friction: `(ξ + ξ_w o_i) v_i = F_i`.
+        let xi = match wall_friction {
+            None => xi,
+            Some((field, f)) => {
+                xi + f * crate::walls::wall_overlap(field, cell, shape, xs, map.cell_y(shape, i))
+            }
+        };
         let c_self = pressure_self_coefficient(kind, &coef);
         let node = node_terms.as_ref().map(|n| n.of_class(class(i)));
         force_and_rhs(&force_input, i, xs, coef, xi, c_self, node, cell, st, out);

@@ -640,6 +640,11 @@ impl<T: Real> Tissue<T> {
             active: self.active,
             growth: &self.ext.target_scale,
             node_terms: &node_terms,
+            wall_friction: self.ext.walls.as_ref().and_then(|w| {
+                (w.friction != 0.0)
+                    .then(|| w.field(self.active).map(|f| (f, w.friction)))
+                    .flatten()
+            }),
         };
         let scratch = EvalScratch {
             sums,

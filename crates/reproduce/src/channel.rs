@@ -20,6 +20,7 @@
 use render::{Plot, Series};
 
 use super::pipeline::{cell, sci, Csv, Made, PerSeed};
+use super::rule::Rule;
 use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 use study::SweepError;
 
@@ -29,6 +30,15 @@ const ZETAS: [&str; 5] = ["0", "0.001", "0.0025", "0.005", "0.01"];
 /// The coherence `Φ/v_rms` from which a channel flows along itself: half the flow is net
 /// flow.
 pub(crate) const FLOWS: f64 = 0.5;
+
+/// The wall frictions ξ_w (`[walls] friction`): free walls, and walls that hold the cells
+/// touching them (a cell pressed on a wall of thickness 1 overlaps it by a few nodes, so
+/// ξ_w = 1 about doubles its friction).
+const FRICTIONS: [&str; 2] = ["0", "1"];
+
+/// The polar control's widths (the narrowest first: its claim) and run length.
+const POLAR_WIDTHS: [usize; 2] = [24, 48];
+const POLAR_TIME: f64 = 2000.0;
 
 /// The continuum exponent of `W_c ∝ ζ^b`.
 pub(crate) const CONTINUUM: f64 = -0.5;
@@ -125,16 +135,16 @@ pub(crate) fn exponent(
     (b, err, wc)
 }
 
-/// The verdict on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se` and the onsets: holds within 2
-/// standard errors (and an error below 0.25), does not hold beyond 3, inconclusive between or
-/// when the exponent or its error could not be measured; "not testable" (inconclusive) when no
+/// The verdict on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se` and the onsets, by
+/// [`exponent_rule`] (inconclusive when the exponent or its error could not be measured);
+/// "not testable" (inconclusive) when no
 /// activity flows coherently at any width, or every one that does already flows at the
 /// narrowest width, so that no channel that resolves a cell is quiescent.
 pub(crate) fn verdict(b: f64, se: f64, onsets: &[Onset]) -> (Verdict, String) {
     if !onsets.is_empty() && onsets.iter().all(|o| *o == Onset::Wider) {
         return (
             Verdict::Inconclusive,
-            format!("not testable in this model: no activity has a coherent net flow along the channel (Φ/v_rms ≥ {FLOWS}) at any width: the active flow in a channel is undirected, so there is no onset of spontaneous flow to scale"),
+            format!("not testable in this model: no activity has a coherent shear flow across the channel (Σ/v_rms ≥ {FLOWS}) at any width: the active flow in a channel is undirected, so there is no onset of spontaneous flow to scale"),
         );
     }
     let flowing: Vec<&Onset> = onsets.iter().filter(|o| **o != Onset::Wider).collect();
@@ -150,23 +160,15 @@ pub(crate) fn verdict(b: f64, se: f64, onsets: &[Onset]) -> (Verdict, String) {
             "the onset lies inside the widths at fewer than two activities (or in fewer than three seeds' jackknife samples)".into(),
         );
     }
-    let off = (b - CONTINUUM).abs() / se.max(1e-12);
-    if off <= 2.0 && se < 0.25 {
-        (
-            Verdict::Holds,
-            format!("the exponent is {} standard errors from −½", g(off)),
-        )
-    } else if off > 3.0 {
-        (
-            Verdict::DoesNotHold,
-            format!("the exponent is {} standard errors from −½", g(off)),
-        )
-    } else {
-        (
-            Verdict::Inconclusive,
-            format!("the exponent is {} standard errors from −½ with an error of {}: the data do not decide", g(off), g(se)),
-        )
-    }
+    let o = exponent_rule().decide(b - CONTINUUM, se);
+    (o.verdict, o.why)
+}
+
+/// The rule on the exponent: its distance from −½, with ¼ counting (an absence: the law holds
+/// when the exponent is resolved within ¼ of −½, and does not when it is resolved at least ¼
+/// from it).
+fn exponent_rule() -> Rule {
+    Rule::absence("exponent b − (−½)", 0.25)
 }
 
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
@@ -180,121 +182,216 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .iter()
         .map(|z| z.parse().expect("a number"))
         .collect();
-    // Each width's activities, each with its runs' net flow Φ and v_rms by seed.
+    // Each width's points (ζ, ξ_w), each with its runs' net flow, shear and v_rms by seed.
     let mut flows: Vec<(usize, Vec<Flow>)> = Vec::new();
     for &w in &ws {
         let res = width_sweep(p, lx, w, t)?;
-        let by_zeta = res
+        let by_point = res
             .points(None)?
             .iter()
-            .map(|pt| {
-                Ok(Flow {
-                    zeta: pt.values[0].clone(),
-                    net: pt.measure(|r| {
-                        super::late_mean(
-                            &r.run.join("analysis/observables.csv"),
-                            "v_mean_x",
-                            200.0 + t / 2.0,
-                            f64::abs,
-                        )
-                    })?,
-                    v_rms: pt.measure(|r| Ok(r.summary.v_rms))?,
-                })
-            })
+            .map(|pt| Flow::of(pt, 200.0 + t / 2.0))
             .collect::<Result<_, SweepError>>()?;
-        flows.push((w, by_zeta));
+        flows.push((w, by_point));
     }
+    let polar = polar_control(p, lx)?;
     p.reporter.stage("channel: tables and plots");
-    let flow = |w: usize, z: &str| -> Result<&Flow, SweepError> {
+    let flow = |w: usize, z: &str, f: &str| -> Result<&Flow, SweepError> {
         flows
             .iter()
             .find(|(ww, _)| *ww == w)
-            .and_then(|(_, f)| f.iter().find(|f| f.zeta == z))
+            .and_then(|(_, fl)| fl.iter().find(|x| x.zeta == z && x.friction == f))
             .ok_or_else(|| SweepError::Reproduce {
-                why: format!("the channel sweep of width {w} has no ζ = {z}"),
+                why: format!("the channel sweep of width {w} has no ζ = {z}, ξ_w = {f}"),
             })
     };
     let n_seeds = flows[0].1[0].net.values.len();
-    // ratio[seed][zeta][width] of the net flow Φ to v_rms.
-    let mut ratio = vec![vec![vec![f64::NAN; ws.len()]; ZETAS.len() - 1]; n_seeds];
-    for (zi, z) in ZETAS[1..].iter().enumerate() {
-        for (wi, &w) in ws.iter().enumerate() {
-            for (s, c) in flow(w, z)?.coherence().into_iter().enumerate() {
-                ratio[s][zi][wi] = c;
-            }
-        }
-    }
     let wf: Vec<f64> = ws.iter().map(|&w| w as f64).collect();
-    let (b, se, wc) = exponent(&wf, &zetas, &ratio);
 
     let mut csv = Csv::new(&[
         "width",
         "zeta",
+        "wall_friction",
         "net_flow",
         "net_flow_se",
-        "coherence",
-        "coherence_se",
+        "net_coherence",
+        "net_coherence_se",
+        "shear",
+        "shear_se",
+        "shear_coherence",
+        "shear_coherence_se",
         "v_rms",
         "v_rms_se",
     ]);
-    let mut plot = Plot::new(
-        "Coherence of the flow along a channel against its width",
-        "channel width W (nodes)",
-        "C = Φ / v_rms, mean ± s.e. over seeds",
-    );
-    plot.log_y = true;
-    plot.hlines = vec![(FLOWS, "coherent: half the flow is net flow".into())];
-    for (zi, z) in ZETAS[1..].iter().enumerate() {
-        let mut ys = Vec::new();
-        let mut es = Vec::new();
-        for (wi, &w) in ws.iter().enumerate() {
-            let r = mean_se(&ratio.iter().map(|s| s[zi][wi]).collect::<Vec<_>>());
-            let f = flow(w, z)?;
-            let (v, u) = (f.net.mean_se(), f.v_rms.mean_se());
-            csv.row(
-                [w.to_string(), cell(z)]
-                    .into_iter()
-                    .chain([v.0, v.1, r.0, r.1, u.0, u.1].map(sci)),
-            );
-            ys.push(r.0);
-            es.push(if r.1.is_finite() { r.1 } else { 0.0 });
+    let mut claims = Vec::new();
+    let mut plots = Vec::new();
+    // The largest seed mean of the net coherence over every active point, with its error.
+    let mut largest_net: (f64, f64, String) = (f64::NEG_INFINITY, f64::NAN, String::new());
+    for fr in FRICTIONS {
+        // shear[seed][zeta][width]: the shear coherence Σ/v_rms.
+        let mut shear = vec![vec![vec![f64::NAN; ws.len()]; ZETAS.len() - 1]; n_seeds];
+        let mut plot = Plot::new(
+            format!("Shear across a channel against its width, wall friction ξ_w = {fr}"),
+            "channel width W (nodes)",
+            "C_s = Σ / v_rms, mean ± s.e. over seeds",
+        );
+        plot.log_y = true;
+        plot.hlines = vec![(FLOWS, "shear flow: half the flow is shear across".into())];
+        for (zi, z) in ZETAS.iter().enumerate() {
+            let (mut ys, mut es) = (Vec::new(), Vec::new());
+            for (wi, &w) in ws.iter().enumerate() {
+                let f = flow(w, z, fr)?;
+                let (cn, cs) = (f.net_coherence(), f.shear_coherence());
+                if zi > 0 {
+                    for (s, c) in cs.iter().enumerate() {
+                        shear[s][zi - 1][wi] = *c;
+                    }
+                    let m = mean_se(&cn);
+                    if m.0 > largest_net.0 {
+                        largest_net = (m.0, m.1, format!("W = {w}, ζ = {z}, ξ_w = {fr}"));
+                    }
+                }
+                let (v, sh, u) = (f.net.mean_se(), f.shear.mean_se(), f.v_rms.mean_se());
+                let (rn, rs) = (mean_se(&cn), mean_se(&cs));
+                csv.row(
+                    [w.to_string(), cell(z), cell(fr)]
+                        .into_iter()
+                        .chain([v.0, v.1, rn.0, rn.1, sh.0, sh.1, rs.0, rs.1, u.0, u.1].map(sci)),
+                );
+                ys.push(rs.0);
+                es.push(if rs.1.is_finite() { rs.1 } else { 0.0 });
+            }
+            plot.series
+                .push(Series::new(format!("ζ = {z}")).with_points(&wf, &ys, &es));
         }
-        plot.series
-            .push(Series::new(format!("ζ = {z}")).with_points(&wf, &ys, &es));
+        // N cells moving in random directions: E|v̄_x| = v/√(πN), and about as much shear.
+        let random: Vec<f64> = ws
+            .iter()
+            .map(|&w| {
+                let n = (lx * w) as f64 / AREA_PER_CELL;
+                1.0 / (std::f64::consts::PI * n).sqrt()
+            })
+            .collect();
+        plot.series.push(
+            Series::new("cells in random directions, 1/√(πN)")
+                .with_points(&wf, &random, &vec![0.0; wf.len()])
+                .line_only(),
+        );
+        let (b, se, wc) = exponent(&wf, &zetas, &shear);
+        let tag = if fr == "0" { "" } else { "_friction" };
+        if let Some(wplot) = critical_width_plot(&zetas, &wc) {
+            plots.push((format!("channel_critical_width{tag}.png"), wplot));
+        }
+        plots.push((format!("channel_shear{tag}.png"), plot));
+        claims.push(claim(b, se, &wc, ws[0], fr));
     }
-    // N cells moving in random directions: E|v̄_x| = v/√(πN).
-    let random: Vec<f64> = ws
-        .iter()
-        .map(|&w| {
-            let n = (lx * w) as f64 / AREA_PER_CELL;
-            1.0 / (std::f64::consts::PI * n).sqrt()
-        })
-        .collect();
-    plot.series.push(
-        Series::new("cells in random directions, 1/√(πN)")
-            .with_points(&wf, &random, &vec![0.0; wf.len()])
-            .line_only(),
-    );
-    for &w in &ws {
-        let f = flow(w, "0")?;
-        let (v, u, c) = (f.net.mean_se(), f.v_rms.mean_se(), mean_se(&f.coherence()));
-        csv.row(
-            [w.to_string(), cell(0)]
+    claims.push(no_net_flow(largest_net));
+    claims.push(polar_claim(&polar));
+    let mut pcsv = Csv::new(&[
+        "width",
+        "net_coherence",
+        "net_coherence_se",
+        "shear_coherence",
+        "shear_coherence_se",
+        "v_rms",
+    ]);
+    for (w, f) in &polar {
+        let (rn, rs) = (mean_se(&f.net_coherence()), mean_se(&f.shear_coherence()));
+        pcsv.row(
+            [w.to_string()]
                 .into_iter()
-                .chain([v.0, v.1, c.0, c.1, u.0, u.1].map(sci)),
+                .chain([rn.0, rn.1, rs.0, rs.1, f.v_rms.mean_se().0].map(sci)),
         );
     }
     let mut made = Made::new(Vec::new(), String::new())
         .table("channel_flow.csv", csv)
-        .plot("channel_flow.png", plot);
-    if let Some(wplot) = critical_width_plot(&zetas, &wc) {
-        made = made.plot("channel_critical_width.png", wplot);
+        .table("channel_polar.csv", pcsv);
+    for (name, plot) in plots {
+        made = made.plot(&name, plot);
     }
-    let claims = vec![claim(b, se, &wc, ws[0])];
-    let settings = settings(p.scale, lx, t, &ws);
     made.claims = claims;
-    made.settings = settings;
+    made.settings = settings(p.scale, lx, t, &ws);
     Ok(made)
+}
+
+/// The polar control: cells that propel themselves and align with their velocity (α = 0.04,
+/// rate 1), without activity, in the channels of [`POLAR_WIDTHS`], for [`POLAR_TIME`] TU.
+fn polar_control(p: &ReproduceParams, lx: usize) -> Result<Vec<(usize, Flow)>, SweepError> {
+    let t = POLAR_TIME;
+    let mut out = Vec::new();
+    for w in POLAR_WIDTHS {
+        let ly = w + 2;
+        let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
+        let mut sets = vec![
+            format!("domain.lx={lx}"),
+            format!("domain.ly={ly}"),
+            format!("cells.count={count}"),
+            "walls.kind=\"channel\"".to_string(),
+            "model.pressure=\"interaction\"".to_string(),
+            "polarity.alpha=0.04".to_string(),
+            "polarity.align=\"velocity\"".to_string(),
+            "polarity.align_rate=1".to_string(),
+            format!("run.time={t}"),
+            "run.output_every=10".to_string(),
+        ];
+        sets.extend(p.scale.integrator());
+        sets.push(format!("integrator.margin={}", 12.min((ly - 1) / 2)));
+        let res = super::sweep(
+            p,
+            SweepJob {
+                scene: super::PAPER_SCENE,
+                name: format!("channel-polar-w{w}-{}", p.scale.name()),
+                sets,
+                varies: vec!["model.zeta=0".into()],
+                analyze: Some(study::analyze::AnalyzeOptions::default()),
+                seeds: None,
+            },
+        )?;
+        let pts = res.points(None)?;
+        let pt = pts.first().ok_or_else(|| SweepError::Reproduce {
+            why: format!("the polar control of width {w} has no runs"),
+        })?;
+        out.push((w, Flow::of(pt, 200.0 + t / 2.0)?));
+    }
+    Ok(out)
+}
+
+/// The active nematic's net flow along the channel: the claim (Duclos et al.) that it stays
+/// small, by the rule of an absence with [`FLOWS`] counting, on the largest seed mean of the
+/// net coherence over every width, activity and wall friction.
+fn no_net_flow((c, se, at): (f64, f64, String)) -> Claim {
+    let o = Rule::absence("largest net coherence C = Φ/v_rms", FLOWS).decide(c, se);
+    Claim::new(
+        "channel: an active nematic tissue has no net flow along a channel (its flow is undirected or a shear, Duclos et al. 2018)",
+        format!("largest seed mean of C = Φ/v_rms: {} ± {} ({at})", g(c), g(se)),
+        o.verdict,
+        o.why,
+    )
+}
+
+/// The polar control at the narrowest width: polar cells must flow along the channel, by
+/// the rule of an effect with [`FLOWS`] counting.
+fn polar_claim(polar: &[(usize, Flow)]) -> Claim {
+    let (w, f) = &polar[0];
+    let (c, se) = mean_se(&f.net_coherence());
+    let o = Rule::effect("net coherence C = Φ/v_rms", FLOWS).decide(c, se);
+    let others: Vec<String> = polar[1..]
+        .iter()
+        .map(|(w, f)| {
+            let (c, se) = mean_se(&f.net_coherence());
+            format!("W = {w}: {} ± {}", g(c), g(se))
+        })
+        .collect();
+    Claim::new(
+        format!("channel, control: polar cells (α = 0.04, aligning with their velocity, ζ = 0) flow along a channel of width {w}: the net-flow measure sees a directed flow"),
+        format!(
+            "C = Φ/v_rms at W = {w}: {} ± {}{}",
+            g(c),
+            g(se),
+            if others.is_empty() { String::new() } else { format!(" ({})", others.join("; ")) }
+        ),
+        o.verdict,
+        o.why,
+    )
 }
 
 /// The sweep over ζ of the channel of width `w` (and length `lx`), runs of `t` TU.
@@ -327,7 +424,10 @@ fn width_sweep(
             scene: super::PAPER_SCENE,
             name: format!("channel-w{w}-{}", p.scale.name()),
             sets,
-            varies: vec![format!("model.zeta={}", ZETAS.join(","))],
+            varies: vec![
+                format!("model.zeta={}", ZETAS.join(",")),
+                format!("walls.friction={}", FRICTIONS.join(",")),
+            ],
             analyze: Some(study::analyze::AnalyzeOptions::default()),
             seeds: None,
         },
@@ -369,8 +469,8 @@ fn critical_width_plot(zetas: &[f64], wc: &[Onset]) -> Option<Plot> {
 }
 
 /// The claim on `W_c ∝ ζ^{−1/2}` from the exponent `b ± se`, the onsets `wc` of the activities
-/// and the narrowest width.
-fn claim(b: f64, se: f64, wc: &[Onset], narrowest: usize) -> Claim {
+/// (of the shear coherence), the narrowest width and the wall friction.
+fn claim(b: f64, se: f64, wc: &[Onset], narrowest: usize, friction: &str) -> Claim {
     let (v, reason) = verdict(b, se, wc);
     let wc_text: Vec<String> = ZETAS[1..]
         .iter()
@@ -381,13 +481,13 @@ fn claim(b: f64, se: f64, wc: &[Onset], narrowest: usize) -> Claim {
                 match w {
                     Onset::At(w) => g(*w),
                     Onset::Narrower => format!("flows at W = {narrowest}"),
-                    Onset::Wider => "does not flow".into(),
+                    Onset::Wider => "no shear flow".into(),
                 }
             )
         })
         .collect();
     Claim::new(
-        "channel (extensions T3.4): the critical width of channel flow scales as W_c ∝ ζ^(−1/2)",
+        format!("channel (extensions T3.4), wall friction ξ_w = {friction}: the critical width of the spontaneous shear flow scales as W_c ∝ ζ^(−1/2)"),
         format!(
             "W_c: {}; exponent b = {} ± {} (jackknife over seeds)",
             wc_text.join(", "),
@@ -405,32 +505,59 @@ fn settings(scale: Scale, lx: usize, t: f64, ws: &[usize]) -> String {
     format!(
         "- A channel along x: `[walls] kind = \"channel\"`, lx = {lx}, free width W ∈ {{{}}} (ly = W + 2), the paper's density (a cell per {:.1} nodes), the paper's parameters with the interaction pressure (docs/model.md §11.4: in the paper's form the walls' push dominates v_rms); ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; integrator {} (margin at most (ly − 1)/2); f32 storage; frames every 10 TU, analysed. The narrowest width is 24 nodes (3R): narrower channels clip an R = 8 cell's patch.\n\
-         - Order parameter, zero at rest: the net flow along the channel Φ = ⟨|v̄_x|⟩, the time mean over the second half of the active phase of the magnitude of the lattice mean of v_x (`v_mean_x` of `analysis/observables.csv`). Statistic: the coherence C = Φ/v_rms of each run (1 for a plug flow, about 1/√(πN) for N cells in random directions). W_c: the narrowest width at which the seed mean of C reaches {FLOWS}, linear from the width below (a fixed level: it does not depend on the widest width). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: not testable when no activity flows coherently at any width, or every one that does already at the narrowest; holds within 2 standard errors of −½ (error below 0.25), does not hold beyond 3, inconclusive between. Data in `channel_flow.csv` (Φ, C and v_rms), plots `channel_flow.png` and, when an onset is found, `channel_critical_width.png`.",
+         - Wall friction ξ_w ∈ {{{fr}}} (`[walls] friction`, docs/model.md §11.4: a cell moves at F_i/(ξ + ξ_w Σ_x φ_i w)), each over every width and ζ.\n\
+         - Order parameters, zero at rest, from `analysis/observables.csv`, each the time mean over the second half of the active phase of a magnitude: the net flow along the channel Φ = ⟨|v̄_x|⟩ (`v_mean_x`, the lattice mean of v_x) and the shear across it Σ = ⟨|v_shear_x|⟩ (half the difference of the mean v_x above and below the middle line: the antisymmetric part of the profile v_x(y), Duclos et al.'s shear flow). Statistics: the coherences C = Φ/v_rms and C_s = Σ/v_rms of each run (1 for a plug flow or a pure shear; about 1/√(πN) for N cells in random directions).\n\
+         - W_c: the narrowest width at which the seed mean of C_s reaches {FLOWS}, linear from the width below (a fixed level: it does not depend on the widest width). Exponent: least-squares slope of ln W_c against ln ζ; error: jackknife over seeds. Rule: not testable when no activity has a shear flow at any width, or every one that has already at the narrowest; otherwise the exponent's distance from −½, by the rule of an absence with ¼ counting (2 s.e.).\n\
+         - No net flow: the largest seed mean of C over every active point, by the rule of an absence with {FLOWS} counting. Control: polar cells (ζ = 0, α = 0.04, aligning with their velocity at rate 1) in channels W ∈ {{{pw}}}, {POLAR_TIME} TU; the net flow at W = {pw0} must be present (rule of an effect, {FLOWS} counting). Data in `channel_flow.csv` (Φ, Σ, C, C_s, v_rms by width, ζ and ξ_w) and `channel_polar.csv`; plots `channel_shear.png`, `channel_shear_friction.png` and, when an onset is found, `channel_critical_width*.png`.",
         ws.iter().map(|w| w.to_string()).collect::<Vec<_>>().join(", "),
         AREA_PER_CELL,
         ZETAS.join(", "),
         scale.seeds(),
-        scale.integrator_name()
+        scale.integrator_name(),
+        fr = FRICTIONS.join(", "),
+        pw = POLAR_WIDTHS.map(|w| w.to_string()).join(", "),
+        pw0 = POLAR_WIDTHS[0],
     )
 }
 
-/// One activity of one width: its runs' net flow `Φ` and `v_rms`, by seed.
+/// One point (activity and wall friction) of one width: its runs' net flow `Φ`, shear `Σ`
+/// and `v_rms`, by seed.
 struct Flow {
     zeta: String,
+    friction: String,
     net: PerSeed,
+    shear: PerSeed,
     v_rms: PerSeed,
 }
 
 impl Flow {
-    /// The coherence `Φ/v_rms` of each seed's run.
-    fn coherence(&self) -> Vec<f64> {
-        self.net
-            .values
-            .iter()
-            .zip(&self.v_rms.values)
-            .map(|(v, u)| v / u)
-            .collect()
+    /// The point's flows, from each run's `analysis/observables.csv` from `from` on.
+    fn of(pt: &super::pipeline::PointRuns, from: f64) -> Result<Self, SweepError> {
+        let obs = |r: &super::Rec, col: &str| {
+            super::late_mean(&r.run.join("analysis/observables.csv"), col, from, f64::abs)
+        };
+        Ok(Flow {
+            zeta: pt.values[0].clone(),
+            friction: pt.values.get(1).cloned().unwrap_or_else(|| "0".into()),
+            net: pt.measure(|r| obs(r, "v_mean_x"))?,
+            shear: pt.measure(|r| obs(r, "v_shear_x"))?,
+            v_rms: pt.measure(|r| Ok(r.summary.v_rms))?,
+        })
     }
+
+    /// The coherence `Φ/v_rms` of each seed's run.
+    fn net_coherence(&self) -> Vec<f64> {
+        ratio(&self.net, &self.v_rms)
+    }
+
+    /// The shear coherence `Σ/v_rms` of each seed's run.
+    fn shear_coherence(&self) -> Vec<f64> {
+        ratio(&self.shear, &self.v_rms)
+    }
+}
+
+fn ratio(a: &PerSeed, b: &PerSeed) -> Vec<f64> {
+    a.values.iter().zip(&b.values).map(|(v, u)| v / u).collect()
 }
 
 #[cfg(test)]
@@ -490,9 +617,39 @@ mod tests {
         );
         // A large scatter between seeds: inconclusive.
         assert_eq!(
-            verdict(-0.9, 0.19, &[Onset::At(30.0), Onset::At(40.0)]).0,
+            verdict(-0.9, 0.25, &[Onset::At(30.0), Onset::At(40.0)]).0,
             Verdict::Inconclusive
         );
+    }
+
+    /// A flow with net coherences `c` by seed (v_rms 1, no shear).
+    fn flow_of(c: &[f64]) -> Flow {
+        let per = |v: Vec<f64>| PerSeed {
+            seeds: (0..v.len() as u64).collect(),
+            values: v,
+        };
+        Flow {
+            zeta: "0".into(),
+            friction: "0".into(),
+            net: per(c.to_vec()),
+            shear: per(vec![0.0; c.len()]),
+            v_rms: per(vec![1.0; c.len()]),
+        }
+    }
+
+    /// The polar control and the no-net-flow claim reach each outcome: a plug flow, an
+    /// undirected flow, and a flow too scattered to decide.
+    #[test]
+    fn the_net_flow_rules_reach_each_verdict() {
+        let polar = |c: &[f64]| polar_claim(&[(24, flow_of(c)), (48, flow_of(&[0.3, 0.2]))]);
+        assert_eq!(polar(&[0.84, 0.79, 0.86]).verdict, Verdict::Holds);
+        assert_eq!(polar(&[0.05, 0.08, 0.06]).verdict, Verdict::DoesNotHold);
+        assert_eq!(polar(&[0.1, 0.9, 0.4]).verdict, Verdict::Inconclusive);
+        assert!(polar(&[0.84, 0.79, 0.86]).measured.contains("W = 48"));
+        let none = |c: f64, se: f64| no_net_flow((c, se, "W = 24".into())).verdict;
+        assert_eq!(none(0.08, 0.02), Verdict::Holds);
+        assert_eq!(none(0.8, 0.05), Verdict::DoesNotHold);
+        assert_eq!(none(0.4, 0.1), Verdict::Inconclusive);
     }
 
     #[test]

@@ -38,7 +38,9 @@ fn unit(column: &str) -> &'static str {
         "step" | "frame" => "time steps",
         "time" => "TU",
         "zeta" => "force/length (model units)",
-        "v_rms" | "v_rms_smooth" | "cell_speed_rms" | "v_mean_x" | "v_mean_y" => "nodes/TU",
+        "v_rms" | "v_rms_smooth" | "cell_speed_rms" | "v_mean_x" | "v_mean_y" | "v_shear_x" => {
+            "nodes/TU"
+        }
         "area_mean" | "area_min" | "area_max" => "nodes² (Σ φ²)",
         "x" | "y" | "r" | "length" => "nodes",
         "lag" => "TU",

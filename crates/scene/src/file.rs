@@ -303,6 +303,10 @@ pub struct WallsSpec {
     /// The wall adhesion ω_w (default 0).
     #[serde(default)]
     pub omega: f64,
+    /// The wall friction ξ_w per node of overlap with the wall (default 0): a cell moves at
+    /// `F_i/(ξ + ξ_w Σ_x φ_i w)`.
+    #[serde(default)]
+    pub friction: f64,
     /// `"channel"`: the free width in nodes (default `ly − 2`, one solid row at each edge);
     /// `"wound"`: the band's width (default `lx / 4`).
     #[serde(default, skip_serializing_if = "Option::is_none")]

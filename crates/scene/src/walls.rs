@@ -50,7 +50,8 @@ pub(crate) fn walls_of(
         WallField::new(lattice, &solid, spec.thickness, reach),
         spec.kappa,
         spec.omega,
-    );
+    )
+    .with_friction(spec.friction);
     Ok(match spec.kind {
         WallKind::Wound => walls.replaced_when_active(None),
         _ => walls,
@@ -80,17 +81,21 @@ fn check_keys(spec: &WallsSpec) -> Result<(), SceneError> {
             "use 0.5–1 (the reference code's examples)",
         ));
     }
-    for (key, v) in [("kappa", spec.kappa), ("omega", spec.omega)] {
+    for (key, v) in [
+        ("kappa", spec.kappa),
+        ("omega", spec.omega),
+        ("friction", spec.friction),
+    ] {
         if !(v.is_finite() && v >= 0.0) {
             return Err(invalid(
                 "walls",
                 key,
                 v,
                 "must be zero or positive",
-                if key == "kappa" {
-                    "use 1 (the reference code's examples)"
-                } else {
-                    "use 0 (no wall adhesion) or a small value such as 0.002"
+                match key {
+                    "kappa" => "use 1 (the reference code's examples)",
+                    "omega" => "use 0 (no wall adhesion) or a small value such as 0.002",
+                    _ => "use 0 (no wall friction) or a value of the order of ξ (2)",
                 },
             ));
         }

@@ -434,7 +434,7 @@ impl Accumulator {
             _ => f64::NAN,
         };
         let mut line = format!(
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -450,7 +450,10 @@ impl Accumulator {
             rotation,
             shape_index,
             f.vx.iter().sum::<f64>() / area,
-            f.vy.iter().sum::<f64>() / area
+            f.vy.iter().sum::<f64>() / area,
+            analysis::confinement::shear_across(&analysis::confinement::mean_over_x(
+                &f.vx, lattice.lx, lattice.ly
+            ))
         );
         for name in columns.iter() {
             let v = term_obs

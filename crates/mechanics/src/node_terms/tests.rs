@@ -63,6 +63,7 @@ fn evaluate_with(
         active: true,
         growth: &[],
         node_terms: terms,
+        wall_friction: None,
     };
     let scratch = EvalScratch {
         sums: &mut sums,

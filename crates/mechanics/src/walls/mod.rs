@@ -10,6 +10,17 @@
 //! ([`crate::equations::wall_pressure`]) and through it the force `F_i = Σ_x P ∇φ_i`, which is
 //! how a wall pushes a cell. A wall can be removed when the activity switches on (a wound that
 //! opens after the relaxation).
+//!
+//! A wall may also hold the cells back (`[walls] friction`, ξ_w, default 0): a cell in contact
+//! with it feels a friction in proportion to its overlap with the wall,
+//!
+//! ```text
+//! (ξ + ξ_w o_i) v_i = F_i,        o_i = Σ_x φ_i w        (overlap, in nodes)
+//! ```
+//!
+//! ([`wall_overlap`], evaluated with the cell's force at every evaluation): a cell far from the
+//! wall moves as before, one pressed on it slides along it more slowly. This is the friction at
+//! the walls that sets the flow profile of a confined active tissue (shear against plug flow).
 
 use std::sync::Arc;
 
@@ -23,6 +34,8 @@ pub struct Walls {
     pub kappa: f64,
     /// Adhesion `ω_w`.
     pub omega: f64,
+    /// Friction `ξ_w` per node of overlap with the wall (0: none).
+    pub friction: f64,
     relaxation: Arc<WallField>,
     active: Option<Arc<WallField>>,
 }
@@ -35,9 +48,16 @@ impl Walls {
         Self {
             kappa,
             omega,
+            friction: 0.0,
             active: Some(field.clone()),
             relaxation: field,
         }
+    }
+
+    /// These walls with friction `ξ_w` per node of overlap ([`wall_overlap`]).
+    pub fn with_friction(mut self, friction: f64) -> Self {
+        self.friction = friction;
+        self
     }
 
     /// These walls during the relaxation only, replaced by `after` (none: removed) when the
@@ -71,12 +91,16 @@ impl Walls {
         let Walls {
             kappa,
             omega,
+            friction,
             relaxation: _,
             active: _,
         } = self;
         let mut out = vec![("[walls] kappa".to_string(), kappa.to_string())];
         if *omega != 0.0 {
             out.push(("[walls] omega".into(), omega.to_string()));
+        }
+        if *friction != 0.0 {
+            out.push(("[walls] friction".into(), friction.to_string()));
         }
         if self.open_when_active() {
             out.push((
@@ -93,6 +117,7 @@ impl Walls {
     pub fn same_as(&self, other: &Walls) -> bool {
         self.kappa == other.kappa
             && self.omega == other.omega
+            && self.friction == other.friction
             && *self.relaxation == *other.relaxation
             && self.active.as_deref() == other.active.as_deref()
     }
@@ -106,6 +131,29 @@ impl Walls {
                 .filter(|a| !Arc::ptr_eq(a, &self.relaxation))
                 .map_or(0, |a| a.heap_bytes())
     }
+}
+
+/// The overlap `o_i = Σ_x φ_i(x) w(x)` of a cell with the wall field `w`, over its patch:
+/// `cell` its field in patch storage (`shape`), `xs` and `ys` the lattice column and row of
+/// each storage column and row ([`phasefield::PatchMap::cell_x`]). In nodes: about the length
+/// of its contact line times the wall's decay length for a cell pressed on a wall, 0 far from
+/// it.
+pub fn wall_overlap<T: phasefield::Real>(
+    field: &WallField,
+    cell: &[T],
+    shape: &phasefield::PatchShape,
+    xs: &[u32],
+    ys: &[u32],
+) -> f64 {
+    let (w, ly) = (field.w(), field.lattice().ly);
+    let mut sum = 0.0;
+    for (column, &x) in cell.chunks_exact(shape.ny).zip(xs) {
+        let wc = &w[x as usize * ly..(x as usize + 1) * ly];
+        for (c, &y) in column.iter().zip(ys) {
+            sum += c.to_f64() * wc[y as usize];
+        }
+    }
+    sum
 }
 
 #[cfg(test)]

@@ -214,3 +214,71 @@ fn wall_adhesion_spreads_a_cell_along_the_wall() {
     }
     assert!(results[2].1 < 0.25, "{results:?}");
 }
+
+/// `Σ_x φ w` of cell 0 over the whole lattice: the overlap that the wall's friction weighs.
+fn friction_overlap(t: &Tissue, field: &WallField) -> f64 {
+    let l = t.lattice();
+    let mut s = 0.0;
+    for x in 0..l.lx {
+        for y in 0..l.ly {
+            s += t.cells().value_at(0, x, y) * field.w()[l.index(x, y)];
+        }
+    }
+    s
+}
+
+/// Wall friction: a cell on a wall with friction ξ_w moves at `(F_i + f_i)/(ξ + ξ_w o_i)`,
+/// `o_i = Σ_x φ_i w` summed here over the whole lattice (the kernel sums over the patch): the
+/// same state evaluated with and without the friction has the same forces, and velocities in
+/// the ratio of the frictions, to round-off. Far from the wall (`o_i` below 10⁻⁶ of a node)
+/// nothing changes.
+#[test]
+fn wall_friction_slows_a_cell_by_its_overlap() {
+    let (t, _, field) = cell_pushed_at_a_wall(0.0, 1000.0);
+    let xi = t.params().xi;
+    let o = friction_overlap(&t, &field);
+    // A cell pressed on a ℓ_w = 0.5 wall overlaps it by a few nodes.
+    assert!(o > 0.5 && o < 20.0, "overlap {o}");
+    let evaluate = |friction: f64| {
+        let pol = Polarity::new(0.04).with_initial_angle(0.0);
+        let mut u = Tissue::new(t.cells().clone(), *t.params())
+            .with(Terms::new(1).with(pol))
+            .with(Walls::new(field.clone(), 1.0, 0.0).with_friction(friction));
+        u.set_active(true);
+        let mut ws = Workspace::new(u.cells());
+        u.refresh(&mut ws);
+        *ws.cell(0)
+    };
+    let (free, held) = (evaluate(0.0), evaluate(0.5));
+    assert_eq!(free.force, held.force);
+    assert_eq!(free.cell_force, held.cell_force);
+    let ratio = xi / (xi + 0.5 * o);
+    eprintln!(
+        "overlap {o:.4} nodes: v {:?} against {:?}, ratio {ratio:.4}",
+        held.velocity, free.velocity
+    );
+    for k in 0..2 {
+        let want = free.velocity[k] * ratio;
+        assert!(
+            (held.velocity[k] - want).abs() <= 1e-12 * free.velocity.norm().max(1e-30),
+            "component {k}: {} against {want}",
+            held.velocity[k]
+        );
+    }
+    assert!(held.velocity.norm() < 0.9 * free.velocity.norm());
+    // The same cell at the channel's middle: no overlap, no change.
+    let lattice = t.lattice();
+    let shape = t.cells().shape().clone();
+    let middle = init::discs(lattice, shape, &[[24.0, 24.0]], 8.0, 2.5);
+    let at = |friction: f64| {
+        let mut u = Tissue::new(middle.clone(), *t.params())
+            .with(Terms::new(1).with(Polarity::new(0.04)))
+            .with(Walls::new(field.clone(), 1.0, 0.0).with_friction(friction));
+        u.set_active(true);
+        let mut ws = Workspace::new(u.cells());
+        u.refresh(&mut ws);
+        ws.cell(0).velocity
+    };
+    let (a, b) = (at(0.0), at(0.5));
+    assert!((a - b).norm() <= 1e-5 * a.norm(), "{a:?} against {b:?}");
+}
