@@ -178,10 +178,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     };
     let lx = 200usize;
     let ws = widths(p.scale);
-    let zetas: Vec<f64> = ZETAS[1..]
-        .iter()
-        .map(|z| z.parse().expect("a number"))
-        .collect();
     // Each width's points (ζ, ξ_w), each with its runs' net flow, shear and v_rms by seed.
     let mut flows: Vec<(usize, Vec<Flow>)> = Vec::new();
     for &w in &ws {
@@ -195,6 +191,126 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     }
     let polar = polar_control(p, lx)?;
     p.reporter.stage("channel: tables and plots");
+    let mut made =
+        analyse(&flows, &polar, lx)?.table("channel_runs.csv", runs_table(&flows, &polar));
+    made.settings = settings(p.scale, lx, t, &ws);
+    Ok(made)
+}
+
+/// `channel_runs.csv`: every run's late flows, the figure's raw data.
+fn runs_table(flows: &[(usize, Vec<Flow>)], polar: &[(usize, Flow)]) -> Csv {
+    let mut csv = Csv::new(&[
+        "kind",
+        "width",
+        "zeta",
+        "wall_friction",
+        "seed",
+        "net_flow",
+        "shear",
+        "v_rms",
+    ]);
+    let nematic = flows
+        .iter()
+        .flat_map(|(w, f)| f.iter().map(move |f| ("nematic", *w, f)));
+    let polar = polar.iter().map(|(w, f)| ("polar", *w, f));
+    for (kind, w, f) in nematic.chain(polar) {
+        for (k, seed) in f.net.seeds.iter().enumerate() {
+            csv.row(
+                [
+                    cell(kind),
+                    cell(w),
+                    cell(&f.zeta),
+                    cell(&f.friction),
+                    cell(seed),
+                ]
+                .into_iter()
+                .chain([f.net.values[k], f.shear.values[k], f.v_rms.values[k]].map(sci)),
+            );
+        }
+    }
+    csv
+}
+
+/// The flows of `channel_runs.csv` in `dir`, as [`make`] had them: the nematic tissue's by
+/// width and point, and the polar control's by width.
+#[cfg(test)]
+type Flows = (Vec<(usize, Vec<Flow>)>, Vec<(usize, Flow)>);
+
+#[cfg(test)]
+fn flows_from_table(dir: &std::path::Path) -> Result<Flows, SweepError> {
+    let t = super::Table::read(&dir.join("channel_runs.csv"))?;
+    let (kind, width, zeta, fr, seed) = (
+        t.col("kind")?,
+        t.col("width")?,
+        t.col("zeta")?,
+        t.col("wall_friction")?,
+        t.col("seed")?,
+    );
+    let (net, shear, v) = (t.f64s("net_flow")?, t.f64s("shear")?, t.f64s("v_rms")?);
+    let mut nematic: Vec<(usize, Vec<Flow>)> = Vec::new();
+    let mut polar: Vec<(usize, Flow)> = Vec::new();
+    for (k, row) in t.rows.iter().enumerate() {
+        let w: usize = row[width].parse().map_err(|_| SweepError::Reproduce {
+            why: format!("{}: row {}: width {}", t.path.display(), k + 1, row[width]),
+        })?;
+        let s: u64 = row[seed].parse().unwrap_or(0);
+        let flow = if row[kind] == "polar" {
+            if !polar.iter().any(|p| p.0 == w) {
+                polar.push((w, Flow::empty(&row[zeta], &row[fr])));
+            }
+            &mut polar.iter_mut().find(|p| p.0 == w).expect("pushed").1
+        } else {
+            if !nematic.iter().any(|p| p.0 == w) {
+                nematic.push((w, Vec::new()));
+            }
+            let list = &mut nematic.iter_mut().find(|p| p.0 == w).expect("pushed").1;
+            if !list
+                .iter()
+                .any(|f| f.zeta == row[zeta] && f.friction == row[fr])
+            {
+                list.push(Flow::empty(&row[zeta], &row[fr]));
+            }
+            list.iter_mut()
+                .find(|f| f.zeta == row[zeta] && f.friction == row[fr])
+                .expect("pushed")
+        };
+        for (per, x) in [
+            (&mut flow.net, net[k]),
+            (&mut flow.shear, shear[k]),
+            (&mut flow.v_rms, v[k]),
+        ] {
+            per.seeds.push(s);
+            per.values.push(x);
+        }
+    }
+    Ok((nematic, polar))
+}
+
+/// The claims of the figure's tables kept in `dir` (`channel_runs.csv`).
+#[cfg(test)]
+pub(crate) fn verdicts_from_tables(
+    dir: &std::path::Path,
+) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let (flows, polar) = flows_from_table(dir)?;
+    Ok(analyse(&flows, &polar, 200)?
+        .claims
+        .into_iter()
+        .map(|c| (c.claim, c.verdict))
+        .collect())
+}
+
+/// The tables, plots and claims of the flows: the nematic tissue's `flows` by width (each
+/// point a ζ and a wall friction) and the polar control's, in channels `lx` long.
+fn analyse(
+    flows: &[(usize, Vec<Flow>)],
+    polar: &[(usize, Flow)],
+    lx: usize,
+) -> Result<Made, SweepError> {
+    let ws: Vec<usize> = flows.iter().map(|f| f.0).collect();
+    let zetas: Vec<f64> = ZETAS[1..]
+        .iter()
+        .map(|z| z.parse().expect("a number"))
+        .collect();
     let flow = |w: usize, z: &str, f: &str| -> Result<&Flow, SweepError> {
         flows
             .iter()
@@ -285,7 +401,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         claims.push(claim(b, se, &wc, ws[0], fr));
     }
     claims.push(no_net_flow(largest_net));
-    claims.push(polar_claim(&polar));
+    claims.push(polar_claim(polar));
     let mut pcsv = Csv::new(&[
         "width",
         "net_coherence",
@@ -294,7 +410,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "shear_coherence_se",
         "v_rms",
     ]);
-    for (w, f) in &polar {
+    for (w, f) in polar {
         let (rn, rs) = (mean_se(&f.net_coherence()), mean_se(&f.shear_coherence()));
         pcsv.row(
             [w.to_string()]
@@ -309,7 +425,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         made = made.plot(&name, plot);
     }
     made.claims = claims;
-    made.settings = settings(p.scale, lx, t, &ws);
     Ok(made)
 }
 
@@ -531,6 +646,22 @@ struct Flow {
 }
 
 impl Flow {
+    /// A point with no runs yet.
+    #[cfg(test)]
+    fn empty(zeta: &str, friction: &str) -> Self {
+        let none = || PerSeed {
+            seeds: Vec::new(),
+            values: Vec::new(),
+        };
+        Flow {
+            zeta: zeta.into(),
+            friction: friction.into(),
+            net: none(),
+            shear: none(),
+            v_rms: none(),
+        }
+    }
+
     /// The point's flows, from each run's `analysis/observables.csv` from `from` on.
     fn of(pt: &super::pipeline::PointRuns, from: f64) -> Result<Self, SweepError> {
         let obs = |r: &super::Rec, col: &str| {
@@ -650,6 +781,16 @@ mod tests {
         assert_eq!(none(0.08, 0.02), Verdict::Holds);
         assert_eq!(none(0.8, 0.05), Verdict::DoesNotHold);
         assert_eq!(none(0.4, 0.1), Verdict::Inconclusive);
+    }
+
+    /// The channel section of docs/reproduction.md states the verdicts that the figure's own
+    /// runs give, kept in `docs/data/channel/quick/channel_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let want = verdicts_from_tables(&root.join("docs/data/channel/quick")).unwrap();
+        assert_eq!(want.len(), 4);
+        crate::assert_doc_verdicts("channel", "**Verdicts (quick):**", &want);
     }
 
     #[test]

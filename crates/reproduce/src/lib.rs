@@ -28,6 +28,7 @@ mod run_length;
 mod scaling;
 mod sorting;
 mod stability;
+mod systematics;
 mod table;
 mod threshold;
 

@@ -44,8 +44,9 @@ mod walls;
 
 pub use error::{SceneError, MAX_SIDE, MAX_STEPS};
 pub use file::{
-    AdhesionSpec, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain, InitKind,
-    Integrator, Model, PolaritySpec, PopulationSpec, Run, SceneFile, WallKind, WallsSpec,
+    AdhesionSpec, AlignKind, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain,
+    InitKind, Integrator, Model, PolaritySpec, PopulationSpec, PropulsionKind, Run, SceneFile,
+    WallKind, WallsSpec,
 };
 pub use paths::absolute_paths;
 pub use registry::{register_term, registered_terms, TermBuilder, TermError};
