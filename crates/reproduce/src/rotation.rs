@@ -216,8 +216,116 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         made = made.plot(name, plot);
     }
     made.claims = claims(&points, &nulls, &radii, &densities);
+    p.reporter
+        .stage("rotation: saturation, the largest disc run three times as long");
+    let (claim, plot, csv) = saturation(p, &points, &radii, &densities, t)?;
+    made.claims.push(claim);
+    made = made
+        .plot("rotation_saturation.png", plot)
+        .table("rotation_saturation.csv", csv);
     made.settings = settings_text(p, &radii, &densities, t);
     Ok(made)
+}
+
+/// How much longer the saturation runs are than the figure's.
+const SATURATION_FACTOR: f64 = 3.0;
+
+/// Saturation (issue 54): the largest disc at the scene's point (align to the velocity, J = 1,
+/// α = 0.04), each density, run [`SATURATION_FACTOR`] times as long. Its `|Ω̄|` over the second
+/// half of the long runs against the figure's (over the second half of `t`), seed by seed:
+/// the rule of an absence on the difference, with [`STILL`] counting, for each density; the
+/// claim holds when each does. The plot shows Ω(t) of every long run.
+fn saturation(
+    p: &ReproduceParams,
+    points: &[PointResult],
+    radii: &[f64],
+    densities: &[f64],
+    t: f64,
+) -> Result<(Claim, Plot, Csv), SweepError> {
+    let rk = *radii.last().expect("radii");
+    let long = SATURATION_FACTOR * t;
+    let relax = 100.0;
+    let mut plot = Plot::new(
+        format!(
+            "Ω(t) of the largest disc (R_d = {rk}R), align = \"{}\", J = {}, α = {}, {long} TU",
+            SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
+        ),
+        "time (TU)",
+        "Ω = ⟨(r × v)/(|r||v|)⟩",
+    );
+    plot.hlines = vec![(0.0, String::new())];
+    let mut csv = Csv::new(&[
+        "area_fraction",
+        "seed",
+        "omega_mean_short",
+        "omega_mean_long",
+    ]);
+    let (mut outcomes, mut text) = (Vec::new(), Vec::new());
+    let rule = super::rule::Rule::absence("|Ω̄|(long runs) − |Ω̄|(figure's runs)", STILL);
+    for &dens in densities {
+        let (mut sets, _) = disc(rk, dens, long, p.scale);
+        sets.extend([
+            format!("polarity.align=\"{}\"", SCENE_POINT.0),
+            format!("polarity.align_rate={}", SCENE_POINT.1),
+            format!("polarity.alpha={}", SCENE_POINT.2),
+        ]);
+        let res = super::sweep(
+            p,
+            SweepJob {
+                name: format!("rotation-saturation-r{rk}-d{dens}-{}", p.scale.name()),
+                scene: DISC_SCENE,
+                sets,
+                varies: Vec::new(),
+                analyze: Some(AnalyzeOptions::default()),
+                seeds: Some(seeds(p.scale)),
+            },
+        )?;
+        let Some(short) = points.iter().find(|q| {
+            q.radius == rk
+                && q.density == dens
+                && (q.rule.as_str(), q.rate.as_str(), q.alpha.as_str()) == SCENE_POINT
+        }) else {
+            continue;
+        };
+        let mut long_runs = Vec::new();
+        for pt in res.points(None)? {
+            let mut seen = |seed: u64, times: &[f64], omega: &[f64]| {
+                plot.series.push(
+                    Series::new(format!("area fraction {dens}, seed {seed}"))
+                        .with_points(times, omega, &vec![0.0; times.len()])
+                        .line_only(),
+                );
+            };
+            long_runs.extend(statistics(&pt, relax + long / 2.0, &mut seen)?);
+        }
+        let mut diffs = Vec::new();
+        for (seed, o_long, _) in &long_runs {
+            if let Some((_, o_short, _)) = short.runs.iter().find(|r| r.0 == *seed) {
+                csv.row([cell(dens), cell(seed), sci(*o_short), sci(*o_long)]);
+                diffs.push(o_long.abs() - o_short.abs());
+            }
+        }
+        let (m, se) = mean_se(&diffs);
+        let o = rule.decide(m, se);
+        let abs_long = mean_se(&long_runs.iter().map(|r| r.1.abs()).collect::<Vec<_>>());
+        text.push(format!(
+            "area fraction {dens}: |Ω̄| {} at {t} TU, {} at {long} TU",
+            super::pm(short.abs),
+            super::pm(abs_long)
+        ));
+        outcomes.push(super::rule::Outcome {
+            verdict: o.verdict,
+            why: format!("area fraction {dens}: {}", o.why),
+        });
+    }
+    let (v, why) = super::rules::all_of(&outcomes);
+    let claim = Claim::new(
+        format!("saturation (issue 54): the largest disc (R_d = {rk}R) has reached its lasting rotation within the figure's {t} TU (the same discs run {long} TU)"),
+        text.join("; "),
+        v,
+        why,
+    );
+    Ok((claim, plot, csv))
 }
 
 /// The rule name of the null points: alignment off.
@@ -636,6 +744,7 @@ fn settings_text(p: &ReproduceParams, radii: &[f64], densities: &[f64], t: f64) 
          - Statistic: Ω = ⟨(r_i × v_i)/(|r_i||v_i|)⟩ about the disc's centre at each frame (`rotation` of `analysis/observables.csv`); a run's Ω̄ is its mean over the second half of the active phase, its persistence the share of those frames with the sign of Ω̄. A point rotates when the mean over seeds of |Ω̄| less two standard errors is at least {ROTATES} and the mean persistence at least {PERSISTENT}; it is still when the mean of |Ω̄| plus two standard errors is below {STILL}; otherwise not established. (Undirected motion of N cells gives Ω of spread about 1/√(2N) per frame, less in the time mean.)\n\
          - Claim 1 holds when a point rotates, does not hold when every point is still. Claim 2 holds when a combination rotating in the smallest disc is still in the largest, does not hold when every such combination also rotates in the largest.\n\
          - Null and control (issue 54): the same discs and α with alignment off (`align = \"none\"`, rule `none` in the tables): what |Ω̄| N cells reach by chance. \"Lost with size\" compares each combination in the largest disc with its null: |Ω̄| − |Ω̄|_null, by the rule of an effect with {STILL} the smallest that counts (rotating when it holds, still when it does not hold). The control, that the null points rotate, must not hold.\n\
+         - Saturation (issue 54): the largest disc at `scenes/disc.toml`'s point, each area fraction, run {SATURATION_FACTOR}× as long; per seed, |Ω̄| over the second half of the long run less |Ω̄| of the figure's run; the mean difference by the rule of an absence with {STILL} counting, for each area fraction (`rotation_saturation.csv`, Ω(t) in `rotation_saturation.png`).\n\
          - Data: `rotation_runs.csv` (every run), `rotation_points.csv` (every point and its state); plots `rotation_velocity.png`, `rotation_force.png` (|Ω̄| against R_d), `rotation_in_time.png` (Ω(t) of each seed at R_d = {SCENE_RADIUS}R, area fraction {SCENE_DENSITY}, align = \"{}\", J = {}, α = {}: `scenes/disc.toml`'s settings).",
         radii.iter().map(|r| g(*r)).collect::<Vec<_>>().join(", "),
         densities.iter().map(|d| g(*d)).collect::<Vec<_>>().join(", "),
