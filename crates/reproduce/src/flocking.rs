@@ -181,37 +181,29 @@ pub(crate) fn critical_noise(d: &[f64], order: &[Vec<f64>]) -> (Option<f64>, f64
     (Some(dc), dc * err)
 }
 
-/// The verdict on "the cells flock below a critical noise and lose order above it", from the
-/// mean and standard error of the order at each noise and the critical noise: holds when the
-/// lowest noise is ordered (mean less two standard errors above ½), the highest disordered
-/// (mean plus two standard errors below ½) and `D_c` has an error; does not hold when the
-/// lowest noise is already disordered (no flock at any noise scanned); inconclusive
-/// otherwise.
+/// The verdict on "the cells flock below a critical noise and lose their order above it", from
+/// the mean and standard error of the order at each noise and the critical noise, through the
+/// rule of [`control`] (an effect: the order above ½, 0.05 counting) at each end of the scan:
+/// holds when it holds at the lowest noise, does not hold at the highest, and `D_c` has an
+/// error; does not hold when it does not hold even at the lowest noise (no flock at any noise
+/// scanned); inconclusive otherwise.
 pub(crate) fn verdict(stats: &[(f64, f64)], dc: Option<f64>, dc_err: f64) -> (Verdict, String) {
-    let (Some(lo), Some(hi)) = (stats.first(), stats.last()) else {
+    let (Some(&lo), Some(&hi)) = (stats.first(), stats.last()) else {
         return (Verdict::Inconclusive, "no noise was run".into());
     };
-    let ordered = |s: &(f64, f64)| s.1.is_finite() && s.0 - 2.0 * s.1 > HALF;
-    let disordered = |s: &(f64, f64)| s.1.is_finite() && s.0 + 2.0 * s.1 < HALF;
-    if disordered(lo) {
+    let (vl, wl) = control(lo);
+    let (vh, wh) = control(hi);
+    if vl == Verdict::DoesNotHold {
         return (
             Verdict::DoesNotHold,
-            format!(
-                "even the lowest noise is disordered: order {} ± {}",
-                g(lo.0),
-                g(lo.1)
-            ),
+            format!("even the lowest noise is disordered: {wl}"),
         );
     }
     match dc {
-        Some(dc) if ordered(lo) && disordered(hi) && dc_err.is_finite() => (
+        Some(dc) if vl == Verdict::Holds && vh == Verdict::DoesNotHold && dc_err.is_finite() => (
             Verdict::Holds,
             format!(
-                "ordered at the lowest noise ({} ± {}), disordered at the highest ({} ± {}); D_c = {} ± {}",
-                g(lo.0),
-                g(lo.1),
-                g(hi.0),
-                g(hi.1),
+                "ordered at the lowest noise ({wl}), disordered at the highest ({wh}); D_c = {} ± {}",
                 g(dc),
                 g(dc_err)
             ),
@@ -219,11 +211,7 @@ pub(crate) fn verdict(stats: &[(f64, f64)], dc: Option<f64>, dc_err: f64) -> (Ve
         _ => (
             Verdict::Inconclusive,
             format!(
-                "order {} ± {} at the lowest noise and {} ± {} at the highest: the scan does not bracket a transition within two standard errors (or a jackknife sample has no crossing)",
-                g(lo.0),
-                g(lo.1),
-                g(hi.0),
-                g(hi.1)
+                "the scan does not bracket a transition (lowest noise: {wl}; highest: {wh}), or D_c has no error (a jackknife sample without a crossing, or a systematic run without one)"
             ),
         ),
     }
@@ -578,7 +566,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "- `scenes/polar.toml`'s tissue: 80 polar cells (R = 8) in a periodic 120² box, ζ = 0, α = 0.04, alignment to the velocity at J = 1 (a free cell's alignment rate J α/ξ = {}), D_r ∈ {{{}}}; seeds {}.\n\
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: the polar order |⟨p_i⟩| of each frame (`polar_order` of `analysis/observables.csv`), its time mean over the second half of the active phase per run, mean ± standard error over seeds. D_c: where the seed mean first falls below ½, linear in ln D_r; error: jackknife over seeds (the interpolation's own error is not in it: the scanned noises that bracket D_c are given beside it). Random orientations give √(π/4N) = {}.\n\
-         - Rule: holds when the lowest noise is ordered and the highest disordered by two standard errors each way from ½ and D_c has an error; does not hold when the lowest noise is already disordered; inconclusive otherwise.\n\
+         - Rule: the rule of an effect on the order above ½ (0.05 counting, two standard errors) at each end of the scan: holds when it holds at the lowest noise and does not at the highest, and D_c has an error; does not hold when it does not hold even at the lowest noise; inconclusive otherwise.\n\
          - Control (issue 54): the claim that the cells flock, at the highest noise alone, by the rule of an effect on the order above ½; far above the transition it must read \"does not hold\".\n\
          - Systematics (issue 54): the same tissue at half the time step and on a grid twice as fine (every length doubled in nodes, `crates/reproduce/src/systematics.rs`), at D_r ∈ {{{sys}}}; each shifts D_c (found on those four noises, against the base runs on the same four) and the shifts add to the jackknife error in quadrature. The main rule takes that total error.\n\
          - Sizes (issue 54): the same noises for {sizes} at the same density. Binder cumulant U = 1 − ⟨m⁴⟩/(2⟨m²⟩²) of the polar order m over the frames of the second half, pooled over seeds (0 disordered, ½ ordered, a dip below 0 marks a discontinuous transition); each pair of sizes crosses where the larger tissue stops being the more ordered, linear in ln D_r, error by jackknife over seeds. Rule: the two crossings agree (the rule of an absence on their difference over their mean, ¼ counting); inconclusive where a pair does not cross.\n\
