@@ -14,7 +14,7 @@ use render::{Plot, Series};
 use study::analyze::AnalyzeOptions;
 use study::SweepError;
 
-use super::pipeline::{cell, sci, Csv, Made, PerSeed};
+use super::pipeline::{cell, sci, Csv, Made};
 use super::{g, mean_se, Claim, Rec, ReproduceParams, Scale, SweepJob, Verdict};
 
 /// `scenes/polar.toml`'s tissue: 80 polar cells in a periodic 120² box, aligning with their
@@ -273,81 +273,13 @@ fn moments(r: &Rec, from: f64) -> Result<Moments, SweepError> {
     ))
 }
 
-/// Each point's runs' moments, `[seed][noise]`.
-fn moments_by_seed(res: &super::SweepResult, from: f64) -> Result<Vec<Vec<Moments>>, SweepError> {
-    let pts = res.points(None)?;
-    let by_noise: Vec<Vec<Moments>> = pts
-        .iter()
-        .map(|pt| pt.runs.iter().map(|r| moments(r, from)).collect())
-        .collect::<Result<_, _>>()?;
-    let n = by_noise.iter().map(Vec::len).min().unwrap_or(0);
-    Ok((0..n)
-        .map(|s| by_noise.iter().map(|m| m[s]).collect())
-        .collect())
-}
-
-/// Each point's late mean order by seed, `[seed][noise]`.
-fn order_by_seed(res: &super::SweepResult, from: f64) -> Result<Vec<Vec<f64>>, SweepError> {
-    let pts = res.points(None)?;
-    let by_noise: Vec<PerSeed> = pts
-        .iter()
-        .map(|pt| {
-            pt.measure(|r| {
-                super::late_mean(
-                    &r.run.join("analysis/observables.csv"),
-                    "polar_order",
-                    from,
-                    |v| v,
-                )
-            })
-        })
-        .collect::<Result<_, _>>()?;
-    let n = by_noise.iter().map(|m| m.values.len()).min().unwrap_or(0);
-    Ok((0..n)
-        .map(|s| by_noise.iter().map(|m| m.values[s]).collect())
-        .collect())
-}
-
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (noises, t) = settings(p.scale);
     let relax = 100.0;
     let from = relax + t / 2.0;
     let res = noise_sweep(p, "", t, &noises, Vec::new())?;
-    let points = res.points(None)?;
-    p.reporter.stage("flocking: tables and plots");
-    let d: Vec<f64> = noises
-        .iter()
-        .map(|v| v.parse().expect("a number"))
-        .collect();
-    // Each run's late polar order, by noise.
-    let late = |r: &Rec| {
-        super::late_mean(
-            &r.run.join("analysis/observables.csv"),
-            "polar_order",
-            from,
-            |v| v,
-        )
-    };
-    let by_noise: Vec<PerSeed> = points
-        .iter()
-        .map(|pt| pt.measure(late))
-        .collect::<Result<_, _>>()?;
-    let mut runs_csv = Csv::new(&["rotational_diffusion", "seed", "polar_order_mean"]);
-    for (pt, m) in points.iter().zip(&by_noise) {
-        for (seed, v) in m.seeds.iter().zip(&m.values) {
-            runs_csv.row([cell(&pt.values[0]), cell(seed), sci(*v)]);
-        }
-    }
-    // order[seed][noise].
-    let order: Vec<Vec<f64>> = (0..by_noise.first().map_or(0, |m| m.values.len()))
-        .map(|s| by_noise.iter().map(|m| m.values[s]).collect())
-        .collect();
-    let stats: Vec<(f64, f64)> = by_noise.iter().map(PerSeed::mean_se).collect();
-    let (dc, dc_stat) = critical_noise(&d, &order);
-
+    let mut runs = runs_of(&res, "n80", from)?;
     // The finite-size study: the same noises on two larger tissues at the same density.
-    let mut sizes_moments = vec![moments_by_seed(&res, from)?];
-    let mut sizes_order = vec![order];
     for &(n, l) in &SIZES[1..] {
         let r = noise_sweep(
             p,
@@ -360,19 +292,191 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 format!("cells.count={n}"),
             ],
         )?;
-        sizes_moments.push(moments_by_seed(&r, from)?);
-        sizes_order.push(order_by_seed(&r, from)?);
+        runs.extend(runs_of(&r, &format!("n{n}"), from)?);
     }
-    let order = &sizes_order[0];
-    let crossings: Vec<(Option<f64>, f64)> = sizes_moments
-        .windows(2)
-        .map(|w| binder_crossing_of(&d, &w[0], &w[1]))
-        .collect();
-
     // The systematics: half the time step and a grid twice as fine, on the first tissue, at
     // the noises around D_c.
     let base_sets: Vec<String> = std::iter::once(format!("run.time={t}"))
         .chain(p.scale.own_dt_set())
+        .collect();
+    let sub_noises: Vec<&str> = SYSTEMATIC_NOISES
+        .iter()
+        .copied()
+        .filter(|n| noises.contains(n))
+        .collect();
+    let half = noise_sweep(
+        p,
+        "-dt-half",
+        t,
+        &sub_noises,
+        vec![super::systematics::half_dt(POLAR_SCENE, &base_sets)?],
+    )?;
+    runs.extend(runs_of(&half, "dt_half", from)?);
+    let finer = noise_sweep(
+        p,
+        "-grid-half",
+        t,
+        &sub_noises,
+        super::systematics::finer_grid(POLAR_SCENE, &base_sets)?,
+    )?;
+    runs.extend(runs_of(&finer, "grid_half", from)?);
+    p.reporter.stage("flocking: tables and plots");
+    let points = res.points(None)?;
+    let tplot = order_in_time(&points)?;
+    let mut made = analyse(&runs)?;
+    made.settings = settings_text(p, &noises, t);
+    Ok(made
+        .table("flocking_runs.csv", runs_table(&runs))
+        .plot("flocking_in_time.png", tplot))
+}
+
+/// One run of the figure: its tissue or variant (`n80`, `n180`, `n320`, `dt_half`,
+/// `grid_half`), noise, seed, and its polar order over the second half of its active phase:
+/// the time mean and the moments `⟨m²⟩`, `⟨m⁴⟩`.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FlockRun {
+    pub variant: String,
+    pub noise: String,
+    pub seed: u64,
+    pub order: f64,
+    pub m2: f64,
+    pub m4: f64,
+}
+
+/// The runs of a sweep, tagged `variant`, from `from` on.
+fn runs_of(
+    res: &super::SweepResult,
+    variant: &str,
+    from: f64,
+) -> Result<Vec<FlockRun>, SweepError> {
+    let mut out = Vec::new();
+    for pt in res.points(None)? {
+        for r in &pt.runs {
+            let order = super::late_mean(
+                &r.run.join("analysis/observables.csv"),
+                "polar_order",
+                from,
+                |v| v,
+            )?;
+            let (m2, m4) = moments(r, from)?;
+            out.push(FlockRun {
+                variant: variant.into(),
+                noise: pt.values[0].clone(),
+                seed: r.seed,
+                order,
+                m2,
+                m4,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// `flocking_runs.csv`: every run, the figure's raw data.
+fn runs_table(runs: &[FlockRun]) -> Csv {
+    let mut csv = Csv::new(&[
+        "variant",
+        "rotational_diffusion",
+        "seed",
+        "polar_order_mean",
+        "m2",
+        "m4",
+    ]);
+    for r in runs {
+        csv.row(
+            [cell(&r.variant), cell(&r.noise), cell(r.seed)]
+                .into_iter()
+                .chain([r.order, r.m2, r.m4].map(sci)),
+        );
+    }
+    csv
+}
+
+/// The runs of `flocking_runs.csv` in `dir`.
+#[cfg(test)]
+pub(crate) fn runs_from_table(dir: &std::path::Path) -> Result<Vec<FlockRun>, SweepError> {
+    let t = super::Table::read(&dir.join("flocking_runs.csv"))?;
+    let (v, n, s) = (
+        t.col("variant")?,
+        t.col("rotational_diffusion")?,
+        t.col("seed")?,
+    );
+    let (o, m2, m4) = (t.f64s("polar_order_mean")?, t.f64s("m2")?, t.f64s("m4")?);
+    Ok(t.rows
+        .iter()
+        .enumerate()
+        .map(|(k, row)| FlockRun {
+            variant: row[v].clone(),
+            noise: row[n].clone(),
+            seed: row[s].parse().unwrap_or(0),
+            order: o[k],
+            m2: m2[k],
+            m4: m4[k],
+        })
+        .collect())
+}
+
+/// A variant's noises (in the order of its runs) and its values `f` as `[seed][noise]` over
+/// the seeds every noise has.
+fn grid_of<V: Copy>(
+    runs: &[FlockRun],
+    variant: &str,
+    f: impl Fn(&FlockRun) -> V,
+) -> (Vec<String>, Vec<Vec<V>>) {
+    let mine: Vec<&FlockRun> = runs.iter().filter(|r| r.variant == variant).collect();
+    let mut noises: Vec<String> = Vec::new();
+    let mut seeds: Vec<u64> = Vec::new();
+    for r in &mine {
+        if !noises.contains(&r.noise) {
+            noises.push(r.noise.clone());
+        }
+        if !seeds.contains(&r.seed) {
+            seeds.push(r.seed);
+        }
+    }
+    let rows = seeds
+        .iter()
+        .filter_map(|&s| {
+            noises
+                .iter()
+                .map(|n| {
+                    mine.iter()
+                        .find(|r| r.seed == s && &r.noise == n)
+                        .map(|r| f(r))
+                })
+                .collect::<Option<Vec<V>>>()
+        })
+        .collect();
+    (noises, rows)
+}
+
+/// The figure's claims, tables and plots (but the runs' table and Ω(t)) from its runs.
+fn analyse(runs: &[FlockRun]) -> Result<Made, SweepError> {
+    let (names, order) = grid_of(runs, "n80", |r| r.order);
+    if names.is_empty() {
+        return Err(SweepError::Reproduce {
+            why: "the flocking figure has no runs of its first tissue".into(),
+        });
+    }
+    let noises: Vec<&str> = names.iter().map(String::as_str).collect();
+    let d: Vec<f64> = noises
+        .iter()
+        .map(|v| v.parse().unwrap_or(f64::NAN))
+        .collect();
+    let stats: Vec<(f64, f64)> = (0..d.len())
+        .map(|k| mean_se(&order.iter().map(|row| row[k]).collect::<Vec<_>>()))
+        .collect();
+    let (dc, dc_stat) = critical_noise(&d, &order);
+    let mut sizes_moments = Vec::new();
+    let mut sizes_order = Vec::new();
+    for (n, _) in SIZES {
+        let tag = format!("n{n}");
+        sizes_moments.push(grid_of(runs, &tag, |r| (r.m2, r.m4)).1);
+        sizes_order.push(grid_of(runs, &tag, |r| r.order).1);
+    }
+    let crossings: Vec<(Option<f64>, f64)> = sizes_moments
+        .windows(2)
+        .map(|w| binder_crossing_of(&d, &w[0], &w[1]))
         .collect();
     let sub: Vec<usize> = SYSTEMATIC_NOISES
         .iter()
@@ -388,21 +492,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .iter()
         .map(|row| sub.iter().map(|&k| row[k]).collect())
         .collect();
-    let half = noise_sweep(
-        p,
-        "-dt-half",
-        t,
-        &sub_noises,
-        vec![super::systematics::half_dt(POLAR_SCENE, &base_sets)?],
-    )?;
-    let finer = noise_sweep(
-        p,
-        "-grid-half",
-        t,
-        &sub_noises,
-        super::systematics::finer_grid(POLAR_SCENE, &base_sets)?,
-    )?;
-    let (half_order, finer_order) = (order_by_seed(&half, from)?, order_by_seed(&finer, from)?);
+    let (half_order, finer_order) = (
+        grid_of(runs, "dt_half", |r| r.order).1,
+        grid_of(runs, "grid_half", |r| r.order).1,
+    );
     let shift = |o: &[Vec<f64>]| match (at_sub(o), at_sub(&base_sub)) {
         (Some(a), Some(b)) => a - b,
         _ => f64::NAN,
@@ -438,7 +531,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             &stats.iter().map(|s| s.1).collect::<Vec<_>>(),
         ),
     );
-    let tplot = order_in_time(&points, &by_noise)?;
     let (v, why) = verdict(&stats, dc, dc_err);
     // The alignment rate of a cell at its free speed, J α/ξ (ξ = 2).
     let align_rate = 1.0 * 0.04 / 2.0;
@@ -562,7 +654,20 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             sys_csv.row([cell(name), cell(v), sci(st.0), sci(st.1)]);
         }
     }
-    let settings = format!(
+    Ok(Made::new(claims, String::new())
+        .table("flocking.csv", points_csv)
+        .table("flocking_sizes.csv", sizes_csv)
+        .table("flocking_systematics.csv", sys_csv)
+        .plot("flocking_binder.png", bplot)
+        .plot("flocking.png", plot))
+}
+
+/// The figure's settings, for its verdict: the noises `noises` run for `t` TU.
+fn settings_text(p: &ReproduceParams, noises: &[&str], t: f64) -> String {
+    // The alignment rate of a cell at its free speed, J α/ξ (ξ = 2).
+    let align_rate = 1.0 * 0.04 / 2.0;
+    let null = (std::f64::consts::PI / (4.0 * CELLS)).sqrt();
+    format!(
         "- `scenes/polar.toml`'s tissue: 80 polar cells (R = 8) in a periodic 120² box, ζ = 0, α = 0.04, alignment to the velocity at J = 1 (a free cell's alignment rate J α/ξ = {}), D_r ∈ {{{}}}; seeds {}.\n\
          - 100 TU of relaxation, then {t} TU; dt = {}; frames every 20 TU.\n\
          - Statistic: the polar order |⟨p_i⟩| of each frame (`polar_order` of `analysis/observables.csv`), its time mean over the second half of the active phase per run, mean ± standard error over seeds. D_c: where the seed mean first falls below ½, linear in ln D_r; error: jackknife over seeds (the interpolation's own error is not in it: the scanned noises that bracket D_c are given beside it). Random orientations give √(π/4N) = {}.\n\
@@ -582,26 +687,15 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             .map(|(n, l)| format!("{n} cells on {l}²"))
             .collect::<Vec<_>>()
             .join(", "),
-    );
-    Ok(Made::new(claims, settings)
-        .table("flocking_runs.csv", runs_csv)
-        .table("flocking.csv", points_csv)
-        .table("flocking_sizes.csv", sizes_csv)
-        .table("flocking_systematics.csv", sys_csv)
-        .plot("flocking_binder.png", bplot)
-        .plot("flocking.png", plot)
-        .plot("flocking_in_time.png", tplot))
+    )
 }
 
 /// The polar order in time of each noise's first run (the first seed's).
-fn order_in_time(
-    points: &[super::pipeline::PointRuns],
-    by_noise: &[PerSeed],
-) -> Result<Plot, SweepError> {
-    let first_seed = by_noise
+fn order_in_time(points: &[super::pipeline::PointRuns]) -> Result<Plot, SweepError> {
+    let first_seed = points
         .first()
-        .and_then(|m| m.seeds.first().copied())
-        .unwrap_or(1);
+        .and_then(|pt| pt.runs.first())
+        .map_or(1, |r| r.seed);
     let mut tplot = Plot::new(
         format!("Polar order in time, seed {first_seed}"),
         "time (TU)",
@@ -677,6 +771,22 @@ mod tests {
         assert_eq!(binder_claim(&loose, 0.01).0, Verdict::Inconclusive);
         let open = [(None, f64::NAN), (Some(5e-3), 2e-4)];
         assert!(binder_claim(&open, -0.1).1.starts_with("not established"));
+    }
+
+    /// The flocking section of docs/reproduction.md states the verdicts that the figure's own
+    /// runs give, kept in `docs/data/flocking/quick/flocking_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let runs = runs_from_table(&root.join("docs/data/flocking/quick")).unwrap();
+        let want: Vec<(String, Verdict)> = analyse(&runs)
+            .unwrap()
+            .claims
+            .into_iter()
+            .map(|c| (c.claim, c.verdict))
+            .collect();
+        assert_eq!(want.len(), 3);
+        crate::assert_doc_verdicts("flocking", "**Verdicts (quick):**", &want);
     }
 
     #[test]
