@@ -936,3 +936,17 @@ fn a_term_of_your_own_is_refused_by_name() {
         "{err}"
     );
 }
+
+/// Wall friction (`[walls] friction`), which the kernels do not implement, is refused by its
+/// key and value; the same walls without it pass the check. No adapter is needed to say so.
+#[test]
+fn wall_friction_is_refused_by_name() {
+    let sp = StepParams::paper();
+    let lattice = Lattice::new(100, 100);
+    let field = || WallField::of_shape(lattice, &WallShape::Channel { width: 80.0 }, 1.0, 0.0);
+    let free = paper_tissue(0.0).with(Walls::new(field(), 1.0, 0.0));
+    assert!(GpuBackend::check(&free, &sp).is_ok());
+    let held = paper_tissue(0.0).with(Walls::new(field(), 1.0, 0.0).with_friction(0.5));
+    let err = GpuBackend::check(&held, &sp).unwrap_err().to_string();
+    assert!(err.contains("[walls] friction = 0.5"), "{err}");
+}
