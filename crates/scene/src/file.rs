@@ -167,6 +167,11 @@ pub enum ComputeBackend {
     Gpu,
 }
 
+/// Whether a value is its default 0 (a key a written scene leaves out).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
 impl ComputeBackend {
     /// The default, which a written scene leaves out.
     pub fn is_cpu(&self) -> bool {
@@ -304,8 +309,9 @@ pub struct WallsSpec {
     #[serde(default)]
     pub omega: f64,
     /// The wall friction ξ_w per node of overlap with the wall (default 0): a cell moves at
-    /// `F_i/(ξ + ξ_w Σ_x φ_i w)`.
-    #[serde(default)]
+    /// `F_i/(ξ + ξ_w Σ_x φ_i w)`. Left out of a written scene when 0, so that the scenes of runs
+    /// made before the key existed read the same.
+    #[serde(default, skip_serializing_if = "is_zero")]
     pub friction: f64,
     /// `"channel"`: the free width in nodes (default `ly − 2`, one solid row at each edge);
     /// `"wound"`: the band's width (default `lx / 4`).
