@@ -743,36 +743,43 @@ fn claim_9_2b(pressure: &str, mine: &[&Group], lin: &[String]) -> Claim {
     )
 }
 
-/// The pressure form (issue 11): is the interaction form's ζ_cr the lower one?
+/// The pressure form (issue 11): for each box and γ, the interaction form's ζ_cr below the
+/// paper form's, paired by seed ([`paired_shift`]), relative to the paper form's, by the rule
+/// of an effect with 10 % counting; holds when every pair holds, does not hold when one does
+/// not, inconclusive otherwise.
 fn claim_pressure_form(all: &[Group]) -> Claim {
-    let mut diffs = Vec::new();
-    let mut lower = 0;
-    let mut n = 0;
+    let rule = super::rule::Rule::effect(
+        "(ζ_cr paper − ζ_cr interaction)/ζ_cr paper",
+        super::rules::TENTH,
+    );
+    let (mut text, mut outcomes) = (Vec::new(), Vec::new());
     for (lx, _) in BOXES {
         for gamma in GAMMAS {
-            let z = |p: &str| {
+            let find = |p: &str| {
                 all.iter()
                     .find(|g| g.lx == lx && g.gamma == gamma && g.pressure == p)
-                    .map_or(f64::NAN, |g| bracket(g.threshold).0)
             };
-            let (zp, zi) = (z("paper"), z("interaction"));
-            if zp.is_finite() && zi.is_finite() {
-                n += 1;
-                if zi < zp {
-                    lower += 1;
-                }
-            }
-            diffs.push(format!(
-                "L = {lx}, γ = {gamma}: {} (paper) vs {} (interaction)",
+            let (Some(pa), Some(it)) = (find("paper"), find("interaction")) else {
+                continue;
+            };
+            let (zp, zi) = (pa.seed_zeta().0, it.seed_zeta().0);
+            let (m, se, n) = paired_shift(it, pa);
+            text.push(format!(
+                "L = {lx}, γ = {gamma}: {} (paper) vs {} (interaction), paired over {n} seeds",
                 g(zp),
                 g(zi)
             ));
+            let o = rule.decide(m / zp, se / zp);
+            outcomes.push(super::rule::Outcome {
+                verdict: o.verdict,
+                why: format!("L = {lx}, γ = {gamma}: {}", o.why),
+            });
         }
     }
-    let (v, why) = rule_pressure_form(lower, n);
+    let (v, why) = super::rules::all_of(&outcomes);
     Claim::new(
         "Pressure form (issue 11): does the interaction pressure give a lower ζ_cr than the paper form?",
-        diffs.join("; "),
+        text.join("; "),
         v,
         why,
     )
@@ -882,22 +889,6 @@ fn claim_discretisation(all: &[Group], systematic: &[Group]) -> Claim {
         if outcomes.is_empty() { Verdict::Inconclusive } else { combine(&outcomes) },
         outcomes.into_iter().map(|o| o.1).collect::<Vec<_>>().join("; "),
     )
-}
-
-/// The pressure form's verdict from the count of bracketed pairs (box, γ) in which the
-/// interaction form's ζ_cr is the lower: holds when it is lower in every pair, does not hold
-/// when in none, inconclusive when in some, or without a pair.
-fn rule_pressure_form(lower: usize, n: usize) -> (Verdict, String) {
-    let v = if n == 0 {
-        Verdict::Inconclusive
-    } else if lower == n {
-        Verdict::Holds
-    } else if lower == 0 {
-        Verdict::DoesNotHold
-    } else {
-        Verdict::Inconclusive
-    };
-    (v, format!("lower in {lower} of {n} bracketed pairs"))
 }
 
 /// One verdict from several: does not hold if any does not, holds if all hold, else
@@ -1078,11 +1069,33 @@ mod tests {
     /// The pressure form's count gives each outcome, and the synthetic runs reach "does not
     /// hold" when the interaction form's threshold is the higher.
     #[test]
-    fn the_pressure_form_count_gives_each_outcome() {
-        assert_eq!(rule_pressure_form(6, 6).0, Verdict::Holds);
-        assert_eq!(rule_pressure_form(0, 6).0, Verdict::DoesNotHold);
-        assert_eq!(rule_pressure_form(4, 6).0, Verdict::Inconclusive);
-        assert_eq!(rule_pressure_form(0, 0).0, Verdict::Inconclusive);
+    fn the_pressure_form_rule_gives_each_outcome() {
+        let pressure = |cr: &dyn Fn(f64, &str) -> f64| {
+            let recs = recs(cr);
+            let all: Vec<Group> = BOXES
+                .iter()
+                .flat_map(|(lx, _)| groups(&recs, *lx, "test", true))
+                .collect();
+            claim_pressure_form(&all).verdict
+        };
+        // Lower by 20 % and more everywhere: holds.
+        assert_eq!(
+            pressure(&|g, p| if p == "paper" {
+                0.002 + 0.1 * g
+            } else {
+                0.0015 + 0.08 * g
+            }),
+            Verdict::Holds
+        );
+        // Lower by 2 % everywhere, resolved (paired by seed): below the 10 % that counts.
+        assert_eq!(
+            pressure(&|g, p| if p == "paper" {
+                0.002 + 0.1 * g
+            } else {
+                0.98 * (0.002 + 0.1 * g)
+            }),
+            Verdict::DoesNotHold
+        );
         let higher = recs(|gamma, p| {
             if p == "paper" {
                 0.001 + 0.1 * gamma
