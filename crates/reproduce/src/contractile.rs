@@ -14,12 +14,16 @@ const ZETAS: [&str; 3] = ["-0.0018", "0", "0.005"];
 /// the runs are long enough to show flow.
 const CONTRAST: f64 = 3.0;
 
+/// The smallest decay rate of the contractile flow that counts as "stays at rest": 10⁻⁴ per TU
+/// (an e-fold in 10⁴ TU, a tenth of the passive packing's own relaxation rate at ζ = 0).
+const DECAY: f64 = 1e-4;
+
 /// The verdict on "contractile activity stays stable" from the contractile runs' late growth
 /// rate `d ln v_rms/dt` (mean, standard error over seeds) and the extensile runs' v_rms ratio
-/// to ζ = 0 (mean, standard error): holds when the rate is negative by more than two standard
-/// errors and the extensile contrast exceeds [`CONTRAST`] by two; does not hold when the rate
-/// is positive by more than two standard errors; inconclusive otherwise (a rate within two
-/// standard errors of zero, or runs too short to show the extensile flow).
+/// to ζ = 0 (mean, standard error): the rule of an effect on the decay rate `−r` with
+/// [`DECAY`] counting (issue 54's `Rule`). "Holds" also needs the extensile contrast above
+/// [`CONTRAST`] by two standard errors (else inconclusive: runs too short to show the extensile
+/// flow); "does not hold" does not. Inconclusive without an error.
 pub(crate) fn rule(rate: (f64, f64), extensile: (f64, f64)) -> (Verdict, String) {
     let (r, e) = rate;
     if !e.is_finite() {
@@ -28,42 +32,25 @@ pub(crate) fn rule(rate: (f64, f64), extensile: (f64, f64)) -> (Verdict, String)
             "fewer than two seeds: the growth rate has no error".into(),
         );
     }
-    let contrast = extensile.0 - 2.0 * extensile.1.max(0.0) > CONTRAST;
-    if r - 2.0 * e > 0.0 {
-        (
-            Verdict::DoesNotHold,
-            format!(
-                "the contractile flow grows: its late growth rate is {} standard errors above zero",
-                g(r / e)
-            ),
-        )
-    } else if r + 2.0 * e < 0.0 && contrast {
-        (
-            Verdict::Holds,
-            format!(
-                "the contractile flow decays (late growth rate {} standard errors below zero: below the threshold by the protocol of the threshold figure), while the extensile run flows {}× faster than ζ = 0",
-                g(-r / e),
-                g(extensile.0)
-            ),
-        )
-    } else if !contrast {
-        (
+    let o = super::rule::Rule::effect("decay rate −d ln v_rms/dt (1/TU)", DECAY).decide(-r, e);
+    // A flow that is resolved not to decay does not hold, whatever the contrast.
+    if o.verdict != Verdict::DoesNotHold && extensile.0 - 2.0 * extensile.1.max(0.0) <= CONTRAST {
+        return (
             Verdict::Inconclusive,
             format!(
                 "the extensile contrast does not flow clearly ({}× ζ = 0, less two standard errors not above {CONTRAST}): the runs may be too short",
                 g(extensile.0)
             ),
-        )
-    } else {
-        (
-            Verdict::Inconclusive,
-            format!(
-                "the late growth rate is within two standard errors of zero ({} ± {} /TU)",
-                g(r),
-                g(e)
-            ),
-        )
+        );
     }
+    (
+        o.verdict,
+        format!(
+            "{}; the extensile run flows {}× faster than ζ = 0",
+            o.why,
+            g(extensile.0)
+        ),
+    )
 }
 
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
@@ -225,6 +212,8 @@ mod tests {
         assert_eq!(rule((1e-3, 2e-4), (1.0, 0.1)).0, Verdict::DoesNotHold);
         // Negative but within two standard errors of zero: inconclusive.
         assert_eq!(rule((-2e-4, 4e-4), (12.0, 1.0)).0, Verdict::Inconclusive);
+        // Decays, but resolved slower than an e-fold in 10⁴ TU: does not count as at rest.
+        assert_eq!(rule((-3e-5, 1e-5), (12.0, 1.0)).0, Verdict::DoesNotHold);
         // Decays, but the extensile runs do not flow clearly: inconclusive.
         assert_eq!(rule((-2e-3, 4e-4), (3.5, 1.0)).0, Verdict::Inconclusive);
         // One seed: no error.
