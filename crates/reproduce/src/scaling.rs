@@ -99,49 +99,29 @@ fn run_steps(
 }
 
 /// The verdict on `cost ∝ N^k` with `k` in `[lo, hi]`, from the time exponents of the repeats
-/// `kt` and the memory exponent `km` (deterministic): the time exponent's interval is its mean
-/// ± 2 standard deviations of the repeats (at least ± 0.05, the fit's resolution over a
-/// decade). Holds when that interval and `km` lie inside `[lo, hi]`; does not hold when the
-/// interval lies wholly outside it, or `km` does; inconclusive otherwise (the spread straddles
-/// a bound).
+/// `kt` and the memory exponent `km` (deterministic): the rule of an absence (issue 54's `Rule`)
+/// on the time exponent's distance from the band's middle, with the band's half-width counting
+/// and the repeats' standard deviation as its error (at least 0.025: the fit's resolution over a
+/// decade is ± 0.05). A memory exponent outside the band does not hold whatever the time.
 fn rule(kt: &[f64], km: f64, lo: f64, hi: f64) -> (Verdict, String) {
-    let (m, sd) = mean_std(kt);
-    let half = (2.0 * sd).max(0.05);
-    let (a, b) = (m - half, m + half);
-    let inside = |x: f64| (lo..=hi).contains(&x);
-    if !inside(km) {
-        (
+    if !(lo..=hi).contains(&km) {
+        return (
             Verdict::DoesNotHold,
             format!("the memory exponent {} lies outside [{lo}, {hi}]", g(km)),
-        )
-    } else if a >= lo && b <= hi {
-        (
-            Verdict::Holds,
-            format!(
-                "the time exponent's interval [{}, {}] (mean ± 2 s.d. of the repeats) and the memory exponent lie in [{lo}, {hi}]",
-                g(a),
-                g(b)
-            ),
-        )
-    } else if b < lo || a > hi {
-        (
-            Verdict::DoesNotHold,
-            format!(
-                "the time exponent's interval [{}, {}] lies outside [{lo}, {hi}]",
-                g(a),
-                g(b)
-            ),
-        )
-    } else {
-        (
-            Verdict::Inconclusive,
-            format!(
-                "the time exponent's interval [{}, {}] straddles a bound of [{lo}, {hi}]: the repeats disagree",
-                g(a),
-                g(b)
-            ),
-        )
+        );
     }
+    let (m, sd) = mean_std(kt);
+    let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+    let o = super::rule::Rule::absence(format!("time exponent − {}", g(mid)), half)
+        .decide(m - mid, sd.max(0.025));
+    (
+        o.verdict,
+        format!(
+            "{} (the repeats' s.d. as the error); memory exponent {} in [{lo}, {hi}]",
+            o.why,
+            g(km)
+        ),
+    )
 }
 
 /// The exponent of `y ∝ x^k`: the least-squares slope in log–log.
@@ -260,7 +240,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let settings = format!(
         "- Paper scene at its density (15 cells per 50²), ζ = 0.005, dt 0.5, f32, one thread, no output, straight from a random start.\n\
          - Subdomains: margin 16 (patches of side 2(R + 16) = 48), L ∈ {{{}}}. Full domain: margin 0 (every cell on the whole lattice), L ∈ {{{}}}.\n\
-         - Time: the process's CPU time per step (user + system, `/proc/self/stat`; wall time varies 2–10× with other work on a shared machine), each point timed {REPEATS} times for at least {MIN_CPU_S} s of CPU; the time exponent is fitted per repeat, and the verdict reads mean ± 2 s.d. of those (at least ± 0.05): holds inside the bounds, does not hold wholly outside, inconclusive across a bound. The plot's bars are half the range of the repeats. Memory: the heap bytes the simulation holds (fields, patch maps, scratch buffers, lattice sums and tables: `Tissue::heap_bytes` + `Workspace::heap_bytes`), counted from the buffers' capacities, not sampled from the process.\n\
+         - Time: the process's CPU time per step (user + system, `/proc/self/stat`; wall time varies 2–10× with other work on a shared machine), each point timed {REPEATS} times for at least {MIN_CPU_S} s of CPU; the time exponent is fitted per repeat, and the verdict is the rule of an absence on its mean's distance from the bounds' middle, with their half-width counting and the repeats' s.d. (at least 0.025) as the error: holds when it is inside by two s.d., does not hold when it is resolved at or beyond a bound; a memory exponent outside the bounds does not hold. The plot's bars are half the range of the repeats. Memory: the heap bytes the simulation holds (fields, patch maps, scratch buffers, lattice sums and tables: `Tissue::heap_bytes` + `Workspace::heap_bytes`), counted from the buffers' capacities, not sampled from the process.\n\
          - Files: `scaling.csv`, `time_per_step.png`, `memory.png`.",
         sub.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", "),
         full.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", ")
