@@ -434,22 +434,12 @@ fn polar_control(p: &ReproduceParams, lx: usize) -> Result<Vec<(usize, Flow)>, S
     let t = POLAR_TIME;
     let mut out = Vec::new();
     for w in POLAR_WIDTHS {
-        let ly = w + 2;
-        let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
-        let mut sets = vec![
-            format!("domain.lx={lx}"),
-            format!("domain.ly={ly}"),
-            format!("cells.count={count}"),
-            "walls.kind=\"channel\"".to_string(),
-            "model.pressure=\"interaction\"".to_string(),
-            "polarity.alpha=0.04".to_string(),
-            "polarity.align=\"velocity\"".to_string(),
-            "polarity.align_rate=1".to_string(),
-            format!("run.time={t}"),
-            "run.output_every=10".to_string(),
+        let polar = [
+            "polarity.alpha=0.04",
+            "polarity.align=\"velocity\"",
+            "polarity.align_rate=1",
         ];
-        sets.extend(p.scale.integrator());
-        sets.push(format!("integrator.margin={}", 12.min((ly - 1) / 2)));
+        let sets = channel_sets(p, lx, w, t, &polar, 12);
         let res = super::sweep(
             p,
             SweepJob {
@@ -509,13 +499,18 @@ fn polar_claim(polar: &[(usize, Flow)]) -> Claim {
     )
 }
 
-/// The sweep over ζ of the channel of width `w` (and length `lx`), runs of `t` TU.
-fn width_sweep(
+/// The overrides of [`super::PAPER_SCENE`] for a channel `lx` long of free width `w` (ly = w + 2)
+/// at the paper's density, the interaction pressure, `extra` settings, runs of `t` TU with
+/// frames every 10 TU, the scale's integrator and a margin of at most `margin` (and of
+/// (ly − 1)/2, so that the patch fits).
+fn channel_sets(
     p: &ReproduceParams,
     lx: usize,
     w: usize,
     t: f64,
-) -> Result<super::SweepResult, SweepError> {
+    extra: &[&str],
+    margin: usize,
+) -> Vec<String> {
     let ly = w + 2;
     let count = ((lx * w) as f64 / AREA_PER_CELL).round() as usize;
     let mut sets = vec![
@@ -524,15 +519,26 @@ fn width_sweep(
         format!("cells.count={count}"),
         "walls.kind=\"channel\"".to_string(),
         "model.pressure=\"interaction\"".to_string(),
-        format!("run.time={t}"),
-        "run.output_every=10".to_string(),
     ];
+    sets.extend(extra.iter().map(|s| s.to_string()));
+    sets.extend([format!("run.time={t}"), "run.output_every=10".to_string()]);
     sets.extend(p.scale.integrator());
+    sets.push(format!("integrator.margin={}", margin.min((ly - 1) / 2)));
+    sets
+}
+
+/// The sweep over ζ of the channel of width `w` (and length `lx`), runs of `t` TU.
+fn width_sweep(
+    p: &ReproduceParams,
+    lx: usize,
+    w: usize,
+    t: f64,
+) -> Result<super::SweepResult, SweepError> {
     let margin: usize = match p.scale {
         Scale::Quick => 16,
         Scale::Paper => 12,
     };
-    sets.push(format!("integrator.margin={}", margin.min((ly - 1) / 2)));
+    let sets = channel_sets(p, lx, w, t, &[], margin);
     super::sweep(
         p,
         SweepJob {
@@ -664,14 +670,28 @@ impl Flow {
 
     /// The point's flows, from each run's `analysis/observables.csv` from `from` on.
     fn of(pt: &super::pipeline::PointRuns, from: f64) -> Result<Self, SweepError> {
-        let obs = |r: &super::Rec, col: &str| {
-            super::late_mean(&r.run.join("analysis/observables.csv"), col, from, f64::abs)
+        // Each run's net flow and shear, from one reading of its observables.
+        let flows: Vec<Vec<f64>> = pt
+            .runs
+            .iter()
+            .map(|r| {
+                super::late_means(
+                    &r.run.join("analysis/observables.csv"),
+                    &["v_mean_x", "v_shear_x"],
+                    from,
+                    f64::abs,
+                )
+            })
+            .collect::<Result<_, _>>()?;
+        let column = |k: usize| PerSeed {
+            seeds: pt.runs.iter().map(|r| r.seed).collect(),
+            values: flows.iter().map(|f| f[k]).collect(),
         };
         Ok(Flow {
             zeta: pt.values[0].clone(),
             friction: pt.values.get(1).cloned().unwrap_or_else(|| "0".into()),
-            net: pt.measure(|r| obs(r, "v_mean_x"))?,
-            shear: pt.measure(|r| obs(r, "v_shear_x"))?,
+            net: column(0),
+            shear: column(1),
             v_rms: pt.measure(|r| Ok(r.summary.v_rms))?,
         })
     }

@@ -256,8 +256,9 @@ fn noise_sweep(
     )
 }
 
-/// A run's moments of the polar order over its frames from `from` on.
-fn moments(r: &Rec, from: f64) -> Result<Moments, SweepError> {
+/// A run's polar order over its frames from `from` on: its mean and its moments `⟨m²⟩`, `⟨m⁴⟩`
+/// (NaN without such frames).
+fn late_order(r: &Rec, from: f64) -> Result<(f64, f64, f64), SweepError> {
     let t = super::Table::read(&r.run.join("analysis/observables.csv"))?;
     let (times, m) = (t.f64s("time")?, t.f64s("polar_order")?);
     let late: Vec<f64> = times
@@ -268,6 +269,7 @@ fn moments(r: &Rec, from: f64) -> Result<Moments, SweepError> {
         .collect();
     let n = late.len() as f64;
     Ok((
+        late.iter().sum::<f64>() / n,
         late.iter().map(|v| v * v).sum::<f64>() / n,
         late.iter().map(|v| v.powi(4)).sum::<f64>() / n,
     ))
@@ -352,13 +354,7 @@ fn runs_of(
     let mut out = Vec::new();
     for pt in res.points(None)? {
         for r in &pt.runs {
-            let order = super::late_mean(
-                &r.run.join("analysis/observables.csv"),
-                "polar_order",
-                from,
-                |v| v,
-            )?;
-            let (m2, m4) = moments(r, from)?;
+            let (order, m2, m4) = late_order(r, from)?;
             out.push(FlockRun {
                 variant: variant.into(),
                 noise: pt.values[0].clone(),

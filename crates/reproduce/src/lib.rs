@@ -668,19 +668,35 @@ pub(crate) fn late_mean(
     from: f64,
     f: impl Fn(f64) -> f64,
 ) -> Result<f64, SweepError> {
+    Ok(late_means(path, &[column], from, f)?[0])
+}
+
+/// [`late_mean`] of each of `columns`, from one reading of the table.
+pub(crate) fn late_means(
+    path: &Path,
+    columns: &[&str],
+    from: f64,
+    f: impl Fn(f64) -> f64,
+) -> Result<Vec<f64>, SweepError> {
     let t = Table::read(path)?;
-    let (times, values) = (t.f64s("time")?, t.f64s(column)?);
-    let late: Vec<f64> = times
+    let times = t.f64s("time")?;
+    columns
         .iter()
-        .zip(&values)
-        .filter(|(t, v)| **t >= from && v.is_finite())
-        .map(|(_, v)| f(*v))
-        .collect();
-    Ok(if late.is_empty() {
-        f64::NAN
-    } else {
-        late.iter().sum::<f64>() / late.len() as f64
-    })
+        .map(|column| {
+            let values = t.f64s(column)?;
+            let late: Vec<f64> = times
+                .iter()
+                .zip(&values)
+                .filter(|(t, v)| **t >= from && v.is_finite())
+                .map(|(_, v)| f(*v))
+                .collect();
+            Ok(if late.is_empty() {
+                f64::NAN
+            } else {
+                late.iter().sum::<f64>() / late.len() as f64
+            })
+        })
+        .collect()
 }
 
 /// The mean and spread over the runs `runs` of the columns `cols` of their table `file`

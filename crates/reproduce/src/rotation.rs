@@ -200,8 +200,7 @@ struct PointResult {
 
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (radii, densities, t) = settings(p.scale);
-    let relax = 100.0;
-    let from = relax + t / 2.0;
+    let from = RELAX + t / 2.0;
     let (points, series_of_scene) = run_points(p, &radii, &densities, t, from)?;
     p.reporter
         .stage("rotation: the null, the same discs with alignment off");
@@ -227,6 +226,14 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     Ok(made)
 }
 
+/// The relaxation before the activity (`relax_time` of [`DISC_SCENE`]).
+const RELAX: f64 = 100.0;
+
+/// An empty plot of Ω against time, titled `title`.
+fn omega_in_time(title: String) -> Plot {
+    Plot::new(title, "time (TU)", "Ω = ⟨(r × v)/(|r||v|)⟩")
+}
+
 /// How much longer the saturation runs are than the figure's.
 const SATURATION_FACTOR: f64 = 3.0;
 
@@ -244,15 +251,10 @@ fn saturation(
 ) -> Result<(Claim, Plot, Csv), SweepError> {
     let rk = *radii.last().expect("radii");
     let long = SATURATION_FACTOR * t;
-    let relax = 100.0;
-    let mut plot = Plot::new(
-        format!(
-            "Ω(t) of the largest disc (R_d = {rk}R), align = \"{}\", J = {}, α = {}, {long} TU",
-            SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
-        ),
-        "time (TU)",
-        "Ω = ⟨(r × v)/(|r||v|)⟩",
-    );
+    let mut plot = omega_in_time(format!(
+        "Ω(t) of the largest disc (R_d = {rk}R), align = \"{}\", J = {}, α = {}, {long} TU",
+        SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
+    ));
     plot.hlines = vec![(0.0, String::new())];
     let mut csv = Csv::new(&[
         "area_fraction",
@@ -296,7 +298,7 @@ fn saturation(
                         .line_only(),
                 );
             };
-            long_runs.extend(statistics(&pt, relax + long / 2.0, &mut seen)?);
+            long_runs.extend(statistics(&pt, RELAX + long / 2.0, &mut seen)?);
         }
         let mut diffs = Vec::new();
         for (seed, o_long, _) in &long_runs {
@@ -586,14 +588,10 @@ fn plots(
         }
         out.push((format!("rotation_{rule}.png"), plot));
     }
-    let mut tplot = Plot::new(
-        format!(
-            "Ω(t) at R_d = {SCENE_RADIUS}R, area fraction {SCENE_DENSITY}, align = \"{}\", J = {}, α = {}",
-            SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
-        ),
-        "time (TU)",
-        "Ω = ⟨(r × v)/(|r||v|)⟩",
-    );
+    let mut tplot = omega_in_time(format!(
+        "Ω(t) at R_d = {SCENE_RADIUS}R, area fraction {SCENE_DENSITY}, align = \"{}\", J = {}, α = {}",
+        SCENE_POINT.0, SCENE_POINT.1, SCENE_POINT.2
+    ));
     for (seed, times, omega) in series_of_scene {
         tplot.series.push(
             Series::new(format!("seed {seed}"))

@@ -35,20 +35,38 @@ pub(crate) fn rule_agree(pairs: &[(f64, f64, f64, f64)]) -> (Verdict, String) {
     all_of(&outcomes)
 }
 
-/// Several outcomes of one rule as one verdict: does not hold when one does not (its reason
-/// given), holds when all hold (the first reason given, with the count), inconclusive
-/// otherwise (the first undecided reason).
-pub(crate) fn all_of(outcomes: &[Outcome]) -> (Verdict, String) {
-    let n = outcomes.len();
-    if let Some(o) = outcomes.iter().find(|o| o.verdict == Verdict::DoesNotHold) {
-        (Verdict::DoesNotHold, o.why.clone())
-    } else if let Some(o) = outcomes.iter().find(|o| o.verdict == Verdict::Inconclusive) {
-        (Verdict::Inconclusive, o.why.clone())
-    } else if let Some(o) = outcomes.first() {
-        (Verdict::Holds, format!("all {n} hold; first: {}", o.why))
-    } else {
-        (Verdict::Inconclusive, "nothing was measured".into())
+/// One verdict from several: does not hold when one does not, holds when there is at least one
+/// and all hold, inconclusive otherwise.
+pub(crate) fn all_hold(verdicts: impl IntoIterator<Item = Verdict>) -> Verdict {
+    let (mut any, mut all_hold) = (false, true);
+    for v in verdicts {
+        if v == Verdict::DoesNotHold {
+            return Verdict::DoesNotHold;
+        }
+        any = true;
+        all_hold &= v == Verdict::Holds;
     }
+    if any && all_hold {
+        Verdict::Holds
+    } else {
+        Verdict::Inconclusive
+    }
+}
+
+/// Several outcomes of one rule as one verdict ([`all_hold`]), with the reason that decided:
+/// the first that does not hold, the first undecided one, or the first (with the count) when
+/// all hold.
+pub(crate) fn all_of(outcomes: &[Outcome]) -> (Verdict, String) {
+    let v = all_hold(outcomes.iter().map(|o| o.verdict));
+    let why = match (v, outcomes.first()) {
+        (Verdict::Holds, Some(o)) => format!("all {} hold; first: {}", outcomes.len(), o.why),
+        (_, None) => "nothing was measured".into(),
+        _ => outcomes
+            .iter()
+            .find(|o| o.verdict == v)
+            .map_or_else(String::new, |o| o.why.clone()),
+    };
+    (v, why)
 }
 
 /// Linearity in γ: a weighted parabola through the points. Its bend is the curvature's

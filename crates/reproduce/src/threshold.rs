@@ -26,7 +26,6 @@ fn run_time(_scale: Scale) -> f64 {
 
 /// One group of runs (a box, a pressure form, a γ, an integrator): its threshold and the
 /// seed statistics at each ζ.
-#[derive(Clone)]
 struct Group {
     lx: usize,
     pressure: String,
@@ -181,9 +180,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         systematic,
     } = sweeps(p, t)?;
     p.reporter.stage("threshold: tables and plots");
-    let extra: Vec<Group> = compare.iter().chain(&systematic).cloned().collect();
-    let mut made = Made::new(Vec::new(), String::new())
-        .table("threshold.csv", threshold_table(&all, &extra, t));
+    let mut made = Made::new(Vec::new(), String::new()).table(
+        "threshold.csv",
+        threshold_table(all.iter().chain(&compare).chain(&systematic), t),
+    );
     made.add_table("fig2a.csv", fig2a_table(&all, &compare));
     let (by_length, length_series) = by_run_length(&long_recs, t, &integ_name)?;
     made.add_table("threshold_vs_run_length.csv", by_length);
@@ -260,22 +260,12 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
     if p.scale == Scale::Quick {
         let mut sets = vec![format!("run.time={t}"), format!("run.output_every={t}")];
         sets.extend(Scale::Paper.integrator());
-        let res = super::sweep(
+        compare = small_box(
             p,
-            SweepJob {
-                scene: super::PAPER_SCENE,
-                name: "threshold-L100-paper-integrator".into(),
-                sets,
-                varies: vec![
-                    format!("model.pressure={}", PRESSURES.join(",")),
-                    format!("model.zeta={ZETAS}"),
-                ],
-                analyze: None,
-                seeds: None,
-            },
+            "threshold-L100-paper-integrator".into(),
+            sets,
+            &Scale::Paper.integrator_name(),
         )?;
-        let name = Scale::Paper.integrator_name();
-        compare = groups(&res.records(None)?, 100, &name, false);
     }
     // The systematics: the small box at half the time step and on a grid twice as fine.
     let mut systematic: Vec<Group> = Vec::new();
@@ -291,7 +281,7 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
     let half = super::systematics::half_dt(super::PAPER_SCENE, &base)?;
     let finer = super::systematics::finer_grid(super::PAPER_SCENE, &base)?;
     for (tag, name, extra) in [
-        ("dt-half", format!("dt/2 ({half})"), vec![half.clone()]),
+        ("dt-half", format!("dt/2 ({half})"), vec![half]),
         (
             "grid-half",
             "grid/2 (every length 2× in nodes)".to_string(),
@@ -300,21 +290,8 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
     ] {
         let mut sets = base.clone();
         sets.extend(extra);
-        let res = super::sweep(
-            p,
-            SweepJob {
-                scene: super::PAPER_SCENE,
-                name: format!("threshold-L{lx}-{tag}-{}", p.scale.name()),
-                sets,
-                varies: vec![
-                    format!("model.pressure={}", PRESSURES.join(",")),
-                    format!("model.zeta={ZETAS}"),
-                ],
-                analyze: None,
-                seeds: None,
-            },
-        )?;
-        systematic.extend(groups(&res.records(None)?, lx, &name, false));
+        let name_of_sweep = format!("threshold-L{lx}-{tag}-{}", p.scale.name());
+        systematic.extend(small_box(p, name_of_sweep, sets, &name)?);
     }
     Ok(Sweeps {
         all,
@@ -322,6 +299,31 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
         compare,
         systematic,
     })
+}
+
+/// The sweep `name` of the small box (L = 100, the scene's) with the overrides `sets`, over both
+/// pressure forms and every ζ at the scene's γ, as groups whose integrator reads `label`.
+fn small_box(
+    p: &ReproduceParams,
+    name: String,
+    sets: Vec<String>,
+    label: &str,
+) -> Result<Vec<Group>, SweepError> {
+    let res = super::sweep(
+        p,
+        SweepJob {
+            scene: super::PAPER_SCENE,
+            name,
+            sets,
+            varies: vec![
+                format!("model.pressure={}", PRESSURES.join(",")),
+                format!("model.zeta={ZETAS}"),
+            ],
+            analyze: None,
+            seeds: None,
+        },
+    )?;
+    Ok(groups(&res.records(None)?, BOXES[0].0, label, false))
 }
 
 /// The columns of a threshold's bracket and its excess's, as `csv_fields` writes them.
@@ -335,7 +337,7 @@ const BRACKET_COLUMNS: [&str; 6] = [
 ];
 
 /// `threshold.csv`: every group's threshold, its bracket and its seed statistics.
-fn threshold_table(all: &[Group], compare: &[Group], t: f64) -> Csv {
+fn threshold_table<'a>(groups: impl Iterator<Item = &'a Group>, t: f64) -> Csv {
     // threshold.csv
     let mut csv = Csv::new(
         &[
@@ -353,7 +355,7 @@ fn threshold_table(all: &[Group], compare: &[Group], t: f64) -> Csv {
         ]
         .concat(),
     );
-    for gr in all.iter().chain(compare) {
+    for gr in groups {
         let (m, se, n) = gr.seed_zeta();
         csv.row(
             [cell(gr.gamma), cell(gr.lx), cell(&gr.pressure)]
@@ -710,7 +712,7 @@ fn claims_9_2a(pressure: &str, mine: &[&Group]) -> (Vec<String>, Vec<Claim>) {
         claims.push(Claim::new(
             claim,
             format!("per-seed ζ_cr, mean ± s.e.: {}", lin.join("; ")),
-            combine(&v),
+            super::rules::all_hold(v.iter().map(|x| x.0)),
             v.iter().map(|x| x.1.clone()).collect::<Vec<_>>().join("; "),
         ));
     }
@@ -735,7 +737,7 @@ fn claim_9_2b(pressure: &str, mine: &[&Group], lin: &[String]) -> Claim {
     Claim::new(
         format!("9.2b ({pressure} pressure): ζ_cr does not depend on the domain size"),
         format!("per-seed ζ_cr, mean ± s.e.: {}", lin.join("; ")),
-        combine(&same),
+        super::rules::all_hold(same.iter().map(|x| x.0)),
         same.iter()
             .map(|x| x.1.clone())
             .collect::<Vec<_>>()
@@ -819,7 +821,7 @@ fn claim_integrator(all: &[Group], compare: &[Group]) -> Claim {
     Claim::new(
         "Integrator (issue 11): ζ_cr moves by less than 20 % between the default integrator and the paper's dt 0.2 / margin 12 (L = 100, γ = 0.01)",
         text.join("; "),
-        if outcomes.is_empty() { Verdict::Inconclusive } else { combine(&outcomes) },
+        super::rules::all_hold(outcomes.iter().map(|o| o.0)),
         outcomes.into_iter().map(|o| o.1).collect::<Vec<_>>().join("; "),
     )
 }
@@ -887,21 +889,9 @@ fn claim_discretisation(all: &[Group], systematic: &[Group]) -> Claim {
     Claim::new(
         "Discretisation (issue 54): ζ_cr moves by less than 20 % at half the time step and on a grid twice as fine (L = 100, γ = 0.01)",
         text.join("; "),
-        if outcomes.is_empty() { Verdict::Inconclusive } else { combine(&outcomes) },
+        super::rules::all_hold(outcomes.iter().map(|o| o.0)),
         outcomes.into_iter().map(|o| o.1).collect::<Vec<_>>().join("; "),
     )
-}
-
-/// One verdict from several: does not hold if any does not, holds if all hold, else
-/// inconclusive.
-fn combine(v: &[(Verdict, String)]) -> Verdict {
-    if v.iter().any(|x| x.0 == Verdict::DoesNotHold) {
-        Verdict::DoesNotHold
-    } else if !v.is_empty() && v.iter().all(|x| x.0 == Verdict::Holds) {
-        Verdict::Holds
-    } else {
-        Verdict::Inconclusive
-    }
 }
 
 #[cfg(test)]
