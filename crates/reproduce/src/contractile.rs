@@ -151,52 +151,78 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         plots.push((format!("contractile_v_rms_{pressure}.png"), v));
         plots.push((format!("contractile_s_rms_{pressure}.png"), s));
 
-        // The verdict: the contractile flow decays at least as the passive one, paired by seed.
-        // `f(run, its ζ = 0 twin)` for every run of activity z with a twin of the same seed.
-        let rest = of("0")?;
-        let (contractile, extensile) = (of("-0.0018")?, of("0.005")?);
-        let rate_excess = |r: &Rec, b: &Rec| r.summary.growth_rate - b.summary.growth_rate;
-        let v_rms_ratio = |r: &Rec, b: &Rec| r.summary.v_rms / b.summary.v_rms;
-        let d_rate = mean_std(&contractile.paired(rest, rate_excess));
-        let d_s = mean_std(&contractile.paired(rest, |r, b| r.summary.s_rms - b.summary.s_rms));
-        let v_ratio = mean_std(&contractile.paired(rest, v_rms_ratio));
-        let e_ratio = mean_std(&extensile.paired(rest, v_rms_ratio));
-        let e_rate = mean_std(&extensile.paired(rest, rate_excess));
-        // Stable: its flow decays, ⟨r⟩ < 0 beyond its error, the threshold protocol's "below
-        // ζ_cr".
-        let rate = contractile
-            .measure(|r| Ok(r.summary.growth_rate))?
-            .mean_se();
-        let e_ratio_se = mean_se(&extensile.paired(rest, v_rms_ratio));
-        let (verdict, reason) = rule(rate, e_ratio_se);
-        claims.push(Claim::new(
-            format!("9.3 ({pressure} pressure): contractile activity (ζ = −0.0018) stays stable"),
-            format!(
-                "over the second half of the active phase: late growth rate d ln v_rms/dt = {} /TU (mean ± s.e.); against ζ = 0 from the same seeds (mean ± std): v_rms ratio {}, excess growth rate {} /TU, S_rms excess {}; extensile ζ = 0.005 for contrast: v_rms ratio {}, excess growth rate {} /TU",
-                pm(rate),
-                pm(v_ratio),
-                pm(d_rate),
-                pm(d_s),
-                pm(e_ratio),
-                pm(e_rate)
-            ),
-            verdict,
-            reason,
-        ));
+        claims.push(claim(&points, pressure)?);
     }
     let settings = format!(
         "- Paper scene (docs/model.md §8): 60 cells, L = 100, γ = 0.01, both pressure forms; ζ ∈ {{{}}}; seeds {}.\n\
          - 200 TU of relaxation at ζ = 0, then {t} TU; integrator {}; f32 storage.\n\
-         - Verdict from the second half of the active phase; the series every 10 TU in `contractile_series.csv`, plotted in `contractile_v_rms_*.png` and `contractile_s_rms_*.png` (one per pressure form).",
+         - Verdict from the second half of the active phase (each run's summary over it in `contractile_runs.csv`); the series every 10 TU in `contractile_series.csv`, plotted in `contractile_v_rms_*.png` and `contractile_s_rms_*.png` (one per pressure form).",
         ZETAS.join(", "),
         p.scale.seeds(),
         p.scale.integrator_name()
     );
-    let mut made = Made::new(claims, settings).table("contractile_series.csv", csv);
+    let mut made = Made::new(claims, settings)
+        .table("contractile_series.csv", csv)
+        .table(
+            "contractile_runs.csv",
+            super::pipeline::runs_table(&["pressure", "zeta"], &points),
+        );
     for (name, plot) in plots {
         made = made.plot(name, plot);
     }
     Ok(made)
+}
+
+/// The verdict on the contractile runs of one pressure form, from the sweep's `points`: the
+/// contractile flow decays, paired by seed with ζ = 0 and the extensile contrast.
+fn claim(points: &[PointRuns], pressure: &str) -> Result<Claim, SweepError> {
+    let of = |z: &str| -> Result<&PointRuns, SweepError> {
+        point(points, &[pressure, z]).ok_or_else(|| SweepError::Reproduce {
+            why: format!("the sweep has no point {pressure}, ζ = {z}"),
+        })
+    };
+    // The verdict: the contractile flow decays at least as the passive one, paired by seed.
+    // `f(run, its ζ = 0 twin)` for every run of activity z with a twin of the same seed.
+    let rest = of("0")?;
+    let (contractile, extensile) = (of("-0.0018")?, of("0.005")?);
+    let rate_excess = |r: &Rec, b: &Rec| r.summary.growth_rate - b.summary.growth_rate;
+    let v_rms_ratio = |r: &Rec, b: &Rec| r.summary.v_rms / b.summary.v_rms;
+    let d_rate = mean_std(&contractile.paired(rest, rate_excess));
+    let d_s = mean_std(&contractile.paired(rest, |r, b| r.summary.s_rms - b.summary.s_rms));
+    let v_ratio = mean_std(&contractile.paired(rest, v_rms_ratio));
+    let e_ratio = mean_std(&extensile.paired(rest, v_rms_ratio));
+    let e_rate = mean_std(&extensile.paired(rest, rate_excess));
+    // Stable: its flow decays, ⟨r⟩ < 0 beyond its error, the threshold protocol's "below
+    // ζ_cr".
+    let rate = contractile
+        .measure(|r| Ok(r.summary.growth_rate))?
+        .mean_se();
+    let e_ratio_se = mean_se(&extensile.paired(rest, v_rms_ratio));
+    let (verdict, reason) = rule(rate, e_ratio_se);
+    Ok(Claim::new(
+        format!("9.3 ({pressure} pressure): contractile activity (ζ = −0.0018) stays stable"),
+        format!(
+            "over the second half of the active phase: late growth rate d ln v_rms/dt = {} /TU (mean ± s.e.); against ζ = 0 from the same seeds (mean ± std): v_rms ratio {}, excess growth rate {} /TU, S_rms excess {}; extensile ζ = 0.005 for contrast: v_rms ratio {}, excess growth rate {} /TU",
+            pm(rate),
+            pm(v_ratio),
+            pm(d_rate),
+            pm(d_s),
+            pm(e_ratio),
+            pm(e_rate)
+        ),
+        verdict,
+        reason,
+))
+}
+
+/// The claims of the figure's table kept in `dir` (`contractile_runs.csv`).
+#[cfg(test)]
+fn verdicts_from_tables(dir: &std::path::Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let points = super::pipeline::points_from_runs_table(&dir.join("contractile_runs.csv"), 2)?;
+    ["paper", "interaction"]
+        .iter()
+        .map(|p| claim(&points, p).map(|c| (c.claim, c.verdict)))
+        .collect()
 }
 
 #[cfg(test)]
@@ -221,5 +247,15 @@ mod tests {
             rule((-2e-3, f64::NAN), (12.0, 1.0)).0,
             Verdict::Inconclusive
         );
+    }
+
+    /// The contractile section of docs/reproduction.md states the verdicts of the figure's
+    /// runs, kept in `docs/data/contractile/quick/contractile_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let want = verdicts_from_tables(&root.join("docs/data/contractile/quick")).unwrap();
+        assert_eq!(want.len(), 2);
+        crate::assert_doc_verdicts("contractile", "**Verdicts (quick):**", &want);
     }
 }

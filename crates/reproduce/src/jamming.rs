@@ -567,6 +567,95 @@ impl PerRun {
     }
 }
 
+impl PerRun {
+    /// The runs of a table that [`PerRun::read`] wrote (`jamming_runs.csv` or
+    /// `jamming_gas_runs.csv`), as it had them: each point's runs in the table's order.
+    #[cfg(test)]
+    fn from_table(path: &std::path::Path) -> Result<Self, SweepError> {
+        let t = super::Table::read(path)?;
+        let (gc, ac) = (t.col("gamma")?, t.col("alpha")?);
+        let (lag, msd, ratio_c, beta_c, q_c) = (
+            t.f64s("lag")?,
+            t.f64s("msd")?,
+            t.f64s("d_eff_over_d_free")?,
+            t.f64s("msd_exponent")?,
+            t.f64s("shape_index")?,
+        );
+        let index = |k: usize, col: usize, of: &[&str]| -> Result<usize, SweepError> {
+            of.iter()
+                .position(|v| *v == t.rows[k][col])
+                .ok_or_else(|| SweepError::Reproduce {
+                    why: format!(
+                        "{}: row {}: {} is not of the sweep",
+                        path.display(),
+                        k + 1,
+                        t.rows[k][col]
+                    ),
+                })
+        };
+        // The seed index of a run: how many runs of its point came before it.
+        let mut seen = vec![vec![0usize; ALPHAS.len()]; GAMMAS.len()];
+        let mut at = Vec::new();
+        for k in 0..t.rows.len() {
+            let (gi, ai) = (index(k, gc, &GAMMAS)?, index(k, ac, &ALPHAS)?);
+            at.push((gi, seen[gi][ai], ai));
+            seen[gi][ai] += 1;
+        }
+        let n_seeds = seen.iter().flatten().copied().max().unwrap_or(0);
+        let mut ln_msd = vec![vec![vec![f64::NAN; ALPHAS.len()]; n_seeds]; GAMMAS.len()];
+        let (mut q, mut beta, mut ratio) = (ln_msd.clone(), ln_msd.clone(), ln_msd.clone());
+        for (k, &(gi, si, ai)) in at.iter().enumerate() {
+            ln_msd[gi][si][ai] = msd[k].ln();
+            q[gi][si][ai] = q_c[k];
+            beta[gi][si][ai] = beta_c[k];
+            ratio[gi][si][ai] = ratio_c[k];
+        }
+        Ok(Self {
+            beta,
+            ratio,
+            ln_msd,
+            q,
+            lag_l: lag.last().copied().unwrap_or(f64::NAN),
+            runs_csv: Csv::new(&[]),
+        })
+    }
+}
+
+/// The claims of the figure's tables kept in `dir` (`jamming_runs.csv`,
+/// `jamming_gas_runs.csv`), as [`make`] gives them.
+#[cfg(test)]
+fn verdicts_from_tables(dir: &std::path::Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let alphas: Vec<f64> = ALPHAS
+        .iter()
+        .map(|a| a.parse().expect("a number"))
+        .collect();
+    let gammas: Vec<f64> = GAMMAS
+        .iter()
+        .map(|a| a.parse().expect("a number"))
+        .collect();
+    let runs = PerRun::from_table(&dir.join("jamming_runs.csv"))?;
+    let mut lines = Lines::new(runs.lag_l);
+    for (gi, gamma) in GAMMAS.iter().enumerate() {
+        lines.add(gamma, &alphas, &runs, gi);
+    }
+    let gas = PerRun::from_table(&dir.join("jamming_gas_runs.csv"))?;
+    let gi = GAMMAS
+        .iter()
+        .position(|v| *v == GAS_GAMMA)
+        .expect("a γ of the sweep");
+    let mut gas_lines = Lines::new(gas.lag_l);
+    gas_lines.add(GAS_GAMMA, &alphas, &gas, gi);
+    let mut claims = claims(
+        &lines.rows,
+        &gammas,
+        &lines.ac_pts,
+        &lines.q_at,
+        &lines.line_text,
+    );
+    claims.push(gas_claim(&gas_lines.rows, &gas, gi));
+    Ok(claims.into_iter().map(|c| (c.claim, c.verdict)).collect())
+}
+
 /// The points of each γ's line, and what the figure draws and claims of them.
 struct Lines {
     points_csv: Csv,
@@ -729,6 +818,16 @@ impl Lines {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The jamming section of docs/reproduction.md states the verdicts of the figure's runs,
+    /// kept in `docs/data/jamming/quick/jamming_runs.csv` and `jamming_gas_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let want = verdicts_from_tables(&root.join("docs/data/jamming/quick")).unwrap();
+        assert_eq!(want.len(), 4);
+        crate::assert_doc_verdicts("jamming", "**Verdicts (quick):**", &want);
+    }
 
     /// Synthetic seeds: β = ½ + 0.3 ln(α/α_c) with a seed's scatter.
     fn synthetic(ac: f64, scatter: f64) -> (Vec<f64>, Vec<Vec<f64>>) {

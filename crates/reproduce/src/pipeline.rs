@@ -185,6 +185,82 @@ impl SweepResult {
     }
 }
 
+/// Every run of `points` with its summary, one a row: the point's values under the names
+/// `axes`, the seed, then the summary's columns (`study::summary::SUMMARY_COLUMNS`), to every
+/// digit. The raw table of a figure whose verdicts come from its runs' summaries alone, kept
+/// in `docs/data` and read back by [`points_from_runs_table`] (issue 54).
+pub(crate) fn runs_table(axes: &[&str], points: &[PointRuns]) -> Csv {
+    let mut columns = axes.to_vec();
+    columns.push("seed");
+    columns.extend(study::summary::SUMMARY_COLUMNS.split(','));
+    let mut csv = Csv::new(&columns);
+    for pt in points {
+        for r in &pt.runs {
+            csv.row(
+                pt.values
+                    .iter()
+                    .map(cell)
+                    .chain([cell(r.seed)])
+                    .chain(r.summary.csv().split(',').map(str::to_string)),
+            );
+        }
+    }
+    csv
+}
+
+/// The points of a table that [`runs_table`] wrote with `axes` value columns, in the order of
+/// their first rows, each point's runs in seed order. The runs have no directory: only what
+/// their summaries say.
+///
+/// # Errors
+/// When the file cannot be read, lacks a column, or has a field that is not a number.
+#[cfg(test)]
+pub(crate) fn points_from_runs_table(
+    path: &Path,
+    axes: usize,
+) -> Result<Vec<PointRuns>, SweepError> {
+    let t = Table::read(path)?;
+    let bad = |k: usize, what: &str| SweepError::Reproduce {
+        why: format!("{}: row {}: {what} is not a number", path.display(), k + 1),
+    };
+    let col = |name: &str| t.col(name);
+    let (seed, rows) = (col("seed")?, col("rows")?);
+    let f = |row: &[String], k: usize, name: &str| -> Result<f64, SweepError> {
+        row[col(name)?].parse().map_err(|_| bad(k, name))
+    };
+    let mut points: Vec<PointRuns> = Vec::new();
+    for (k, row) in t.rows.iter().enumerate() {
+        let values: Vec<String> = row[..axes].to_vec();
+        let summary = study::summary::RunSummary {
+            window_start: f(row, k, "window_start")?,
+            window_end: f(row, k, "window_end")?,
+            rows: row[rows].parse().map_err(|_| bad(k, "rows"))?,
+            v_rms: f(row, k, "v_rms")?,
+            s_rms: f(row, k, "s_rms")?,
+            area_mean: f(row, k, "area_mean")?,
+            growth_rate: f(row, k, "growth_rate")?,
+            growth_exponent: f(row, k, "growth_exponent")?,
+        };
+        let rec = Rec {
+            values: values.clone(),
+            seed: row[seed].parse().map_err(|_| bad(k, "seed"))?,
+            run: std::path::PathBuf::new(),
+            summary,
+        };
+        match points.iter_mut().find(|p| p.values == values) {
+            Some(p) => p.runs.push(rec),
+            None => points.push(PointRuns {
+                values,
+                runs: vec![rec],
+            }),
+        }
+    }
+    for p in &mut points {
+        p.runs.sort_by_key(|r| r.seed);
+    }
+    Ok(points)
+}
+
 /// The point whose values are `values`, if the sweep has it.
 pub(crate) fn point<'a>(points: &'a [PointRuns], values: &[&str]) -> Option<&'a PointRuns> {
     points.iter().find(|p| p.values.iter().eq(values.iter()))

@@ -151,13 +151,12 @@ pub(crate) fn verdict_rotates(states: &[State]) -> (Verdict, String) {
     let n = |s: State| states.iter().filter(|&&x| x == s).count();
     let (r, st, ne) = (n(State::Rotates), n(State::Still), n(State::NotEstablished));
     let counts = format!("{r} points rotate, {st} are still, {ne} not established");
-    if r > 0 {
-        (Verdict::Holds, counts)
-    } else if !states.is_empty() && st == states.len() {
-        (Verdict::DoesNotHold, counts)
-    } else {
-        (Verdict::Inconclusive, counts)
-    }
+    let verdicts = states.iter().map(|s| match s {
+        State::Rotates => Verdict::Holds,
+        State::Still => Verdict::DoesNotHold,
+        State::NotEstablished => Verdict::Inconclusive,
+    });
+    (super::rules::any_holds(verdicts), counts)
 }
 
 /// The claim that coherent rotation is lost as the disc grows, from each combination of the
@@ -262,8 +261,7 @@ fn saturation(
         "omega_mean_short",
         "omega_mean_long",
     ]);
-    let (mut outcomes, mut text) = (Vec::new(), Vec::new());
-    let rule = super::rule::Rule::absence("|Ω̄|(long runs) − |Ω̄|(figure's runs)", STILL);
+    let mut per_density = Vec::new();
     for &dens in densities {
         let (mut sets, _) = disc(rk, dens, long, p.scale);
         sets.extend([
@@ -300,19 +298,38 @@ fn saturation(
             };
             long_runs.extend(statistics(&pt, RELAX + long / 2.0, &mut seen)?);
         }
-        let mut diffs = Vec::new();
+        let mut pairs = Vec::new();
         for (seed, o_long, _) in &long_runs {
             if let Some((_, o_short, _)) = short.runs.iter().find(|r| r.0 == *seed) {
                 csv.row([cell(dens), cell(seed), sci(*o_short), sci(*o_long)]);
-                diffs.push(o_long.abs() - o_short.abs());
+                pairs.push((*seed, *o_short, *o_long));
             }
         }
+        per_density.push((dens, short.abs, pairs));
+    }
+    let claim = saturation_claim(rk, t, &per_density);
+    Ok((claim, plot, csv))
+}
+
+/// Each density's `(area fraction, |Ω̄| of the figure's runs (mean, s.e.), (seed, Ω̄ of the
+/// figure's run, Ω̄ of the long run) paired by seed)`.
+type Saturation = Vec<(f64, (f64, f64), Vec<(u64, f64, f64)>)>;
+
+/// The saturation claim on the largest disc (`rk` radii) from the figure's runs of `t` TU and
+/// the long runs: the rule of an absence on `|Ω̄|(long) − |Ω̄|(short)` paired by seed, with
+/// [`STILL`] counting, for each density; holds when each does.
+fn saturation_claim(rk: f64, t: f64, per_density: &Saturation) -> Claim {
+    let long = SATURATION_FACTOR * t;
+    let rule = super::rule::Rule::absence("|Ω̄|(long runs) − |Ω̄|(figure's runs)", STILL);
+    let (mut outcomes, mut text) = (Vec::new(), Vec::new());
+    for (dens, short_abs, pairs) in per_density {
+        let diffs: Vec<f64> = pairs.iter().map(|p| p.2.abs() - p.1.abs()).collect();
         let (m, se) = mean_se(&diffs);
         let o = rule.decide(m, se);
-        let abs_long = mean_se(&long_runs.iter().map(|r| r.1.abs()).collect::<Vec<_>>());
+        let abs_long = mean_se(&pairs.iter().map(|p| p.2.abs()).collect::<Vec<_>>());
         text.push(format!(
             "area fraction {dens}: |Ω̄| {} at {t} TU, {} at {long} TU",
-            super::pm(short.abs),
+            super::pm(*short_abs),
             super::pm(abs_long)
         ));
         outcomes.push(super::rule::Outcome {
@@ -321,13 +338,96 @@ fn saturation(
         });
     }
     let (v, why) = super::rules::all_of(&outcomes);
-    let claim = Claim::new(
+    Claim::new(
         format!("saturation (issue 54): the largest disc (R_d = {rk}R) has reached its lasting rotation within the figure's {t} TU (the same discs run {long} TU)"),
         text.join("; "),
         v,
         why,
+    )
+}
+
+/// The points of `rotation_runs.csv` in `dir` (the figure's, then the nulls'), as
+/// [`make`] had them.
+#[cfg(test)]
+fn points_from_table(dir: &std::path::Path) -> Result<Vec<PointResult>, SweepError> {
+    let t = super::Table::read(&dir.join("rotation_runs.csv"))?;
+    let c = |n: &str| t.col(n);
+    let (rad, den, cells, rule, rate, alpha, seed) = (
+        t.f64s("radius_over_r")?,
+        t.f64s("area_fraction")?,
+        c("cells")?,
+        c("align")?,
+        c("align_rate")?,
+        c("alpha")?,
+        c("seed")?,
     );
-    Ok((claim, plot, csv))
+    let (om, per) = (t.f64s("omega_mean")?, t.f64s("persistence")?);
+    type Key = (u64, u64, String, String, String, String);
+    let mut keys: Vec<(Key, usize, Vec<(u64, f64, f64)>)> = Vec::new();
+    for (k, row) in t.rows.iter().enumerate() {
+        let key: Key = (
+            rad[k].to_bits(),
+            den[k].to_bits(),
+            row[rule].clone(),
+            row[rate].clone(),
+            row[alpha].clone(),
+            row[cells].clone(),
+        );
+        let run = (row[seed].parse().unwrap_or(0), om[k], per[k]);
+        match keys.iter_mut().find(|x| x.0 == key) {
+            Some(x) => x.2.push(run),
+            None => keys.push((key, k, vec![run])),
+        }
+    }
+    Ok(keys
+        .into_iter()
+        .map(|((_, _, rule, rate, alpha, n), k, runs)| {
+            PointResult::new(
+                rad[k],
+                den[k],
+                n.parse().unwrap_or(0),
+                &rule,
+                &rate,
+                &alpha,
+                runs,
+            )
+        })
+        .collect())
+}
+
+/// The claims of the figure's tables kept in `dir` (`rotation_runs.csv`,
+/// `rotation_saturation.csv`) at `scale`, as [`make`] gives them.
+#[cfg(test)]
+fn verdicts_from_tables(
+    dir: &std::path::Path,
+    scale: Scale,
+) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let (radii, densities, t) = settings(scale);
+    let all = points_from_table(dir)?;
+    let (nulls, points): (Vec<PointResult>, Vec<PointResult>) =
+        all.into_iter().partition(|p| p.rule == NULL);
+    let mut claims = claims(&points, &nulls, &radii, &densities);
+    let rk = *radii.last().expect("radii");
+    let sat = super::Table::read(&dir.join("rotation_saturation.csv"))?;
+    let (dens, seed) = (sat.f64s("area_fraction")?, sat.col("seed")?);
+    let (short, long) = (sat.f64s("omega_mean_short")?, sat.f64s("omega_mean_long")?);
+    let mut per_density: Saturation = Vec::new();
+    for &d in &densities {
+        let Some(pt) = points.iter().find(|q| {
+            q.radius == rk
+                && q.density == d
+                && (q.rule.as_str(), q.rate.as_str(), q.alpha.as_str()) == SCENE_POINT
+        }) else {
+            continue;
+        };
+        let pairs = (0..sat.rows.len())
+            .filter(|&k| dens[k] == d)
+            .map(|k| (sat.rows[k][seed].parse().unwrap_or(0), short[k], long[k]))
+            .collect();
+        per_density.push((d, pt.abs, pairs));
+    }
+    claims.push(saturation_claim(rk, t, &per_density));
+    Ok(claims.into_iter().map(|c| (c.claim, c.verdict)).collect())
 }
 
 /// The rule name of the null points: alignment off.
@@ -766,6 +866,17 @@ const SCENE_DENSITY: f64 = 0.85;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rotation section of docs/reproduction.md states the verdicts of the figure's runs,
+    /// kept in `docs/data/rotation/quick/` (`rotation_runs.csv`, `rotation_saturation.csv`).
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let dir = root.join("docs/data/rotation/quick");
+        let want = verdicts_from_tables(&dir, Scale::Quick).unwrap();
+        assert_eq!(want.len(), 4);
+        crate::assert_doc_verdicts("rotation", "**Verdicts (quick):**", &want);
+    }
 
     /// Against the null: well above it rotates, within it is still, a wide spread decides
     /// neither.

@@ -53,6 +53,25 @@ pub(crate) fn all_hold(verdicts: impl IntoIterator<Item = Verdict>) -> Verdict {
     }
 }
 
+/// One verdict from several, when one is enough: holds when one holds, does not hold when
+/// there is at least one and none holds and all do not hold, inconclusive otherwise (the
+/// outcome of a claim that one point of a scan shows an effect).
+pub(crate) fn any_holds(verdicts: impl IntoIterator<Item = Verdict>) -> Verdict {
+    let (mut any, mut all_fail) = (false, true);
+    for v in verdicts {
+        if v == Verdict::Holds {
+            return Verdict::Holds;
+        }
+        any = true;
+        all_fail &= v == Verdict::DoesNotHold;
+    }
+    if any && all_fail {
+        Verdict::DoesNotHold
+    } else {
+        Verdict::Inconclusive
+    }
+}
+
 /// Several outcomes of one rule as one verdict ([`all_hold`]), with the reason that decided:
 /// the first that does not hold, the first undecided one, or the first (with the count) when
 /// all hold.
@@ -242,6 +261,38 @@ pub(crate) fn rule_converged(diffs: &[f64], zeta: f64) -> (Verdict, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `any_holds` is `all_hold` with holds and does-not-hold swapped (De Morgan), on every
+    /// list of up to three verdicts.
+    #[test]
+    fn any_holds_is_the_dual_of_all_hold() {
+        use Verdict::*;
+        let all = [Holds, DoesNotHold, Inconclusive];
+        let flip = |v: Verdict| match v {
+            Holds => DoesNotHold,
+            DoesNotHold => Holds,
+            Inconclusive => Inconclusive,
+        };
+        let mut lists: Vec<Vec<Verdict>> = vec![vec![]];
+        for n in 1..=3 {
+            let mut next = Vec::new();
+            for l in lists.iter().filter(|l| l.len() == n - 1) {
+                for v in all {
+                    let mut m = l.clone();
+                    m.push(v);
+                    next.push(m);
+                }
+            }
+            lists.extend(next);
+        }
+        for l in &lists {
+            let dual = flip(all_hold(l.iter().map(|&v| flip(v))));
+            assert_eq!(any_holds(l.iter().copied()), dual, "{l:?}");
+        }
+        assert_eq!(any_holds([Inconclusive, Holds]), Holds);
+        assert_eq!(any_holds([DoesNotHold, DoesNotHold]), DoesNotHold);
+        assert_eq!(any_holds([]), Inconclusive);
+    }
 
     #[test]
     fn agreement_rule_gives_each_outcome() {

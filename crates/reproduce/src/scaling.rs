@@ -131,6 +131,71 @@ fn exponent(x: &[f64], y: &[f64]) -> f64 {
     study::summary::slope(&lx, &ly)
 }
 
+/// One method's timings: its name and, for each size, `(cells, CPU seconds per step of each
+/// repeat, heap bytes)`.
+type Row = (String, Vec<(f64, Vec<f64>, f64)>);
+
+/// The claims on each method's exponents.
+fn claims(rows: &[Row]) -> Vec<Claim> {
+    let mut claims = Vec::new();
+    for (method, pts) in rows {
+        let n: Vec<f64> = pts.iter().map(|p| p.0).collect();
+        let m: Vec<f64> = pts.iter().map(|p| p.2).collect();
+        // One exponent per repeat (the k-th timing of every size).
+        let repeats = pts.iter().map(|p| p.1.len()).min().unwrap_or(0);
+        let kt: Vec<f64> = (0..repeats)
+            .map(|k| {
+                let tk: Vec<f64> = pts.iter().map(|p| p.1[k]).collect();
+                exponent(&n, &tk)
+            })
+            .collect();
+        let km = exponent(&n, &m);
+        let (want, lo, hi) = if method == "subdomains" {
+            ("O(N)", 0.8, 1.25)
+        } else {
+            ("O(N²)", 1.7, 2.3)
+        };
+        let (verdict, reason) = rule(&kt, km, lo, hi);
+        claims.push(Claim::new(
+            format!("9.7: {method} cost {want} in time and memory"),
+            format!(
+                "time ∝ N^k with k = {} ± {} over {} repeats (CPU time), memory ∝ N^{}",
+                g(mean_std(&kt).0),
+                g(mean_std(&kt).1),
+                kt.len(),
+                g(km)
+            ),
+            verdict,
+            reason,
+        ));
+    }
+    claims
+}
+
+/// The timings of `scaling.csv` in `dir`, as [`make`] had them.
+#[cfg(test)]
+fn rows_from_table(dir: &std::path::Path) -> Result<Vec<Row>, SweepError> {
+    let t = super::Table::read(&dir.join("scaling.csv"))?;
+    let (method, cells, secs, heap) = (
+        t.col("method")?,
+        t.f64s("cells")?,
+        t.f64s("cpu_seconds_per_step")?,
+        t.f64s("heap_bytes")?,
+    );
+    let mut rows: Vec<Row> = Vec::new();
+    for (k, row) in t.rows.iter().enumerate() {
+        if rows.last().is_none_or(|r| r.0 != row[method]) {
+            rows.push((row[method].clone(), Vec::new()));
+        }
+        let pts = &mut rows.last_mut().expect("pushed").1;
+        if pts.last().is_none_or(|p| p.0 != cells[k]) {
+            pts.push((cells[k], Vec::new(), heap[k]));
+        }
+        pts.last_mut().expect("pushed").1.push(secs[k]);
+    }
+    Ok(rows)
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (sub, full): (Vec<usize>, Vec<usize>) = match p.scale {
         Scale::Quick => (vec![100, 200, 400], vec![50, 100, 150, 200]),
@@ -149,7 +214,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "cpu_seconds_per_step",
         "heap_bytes",
     ]);
-    type Row<'a> = (&'a str, Vec<(f64, Vec<f64>, f64)>);
     let mut rows: Vec<Row> = Vec::new();
     for (method, sizes, margin) in [("subdomains", &sub, 16usize), ("full domain", &full, 0)] {
         let mut pts = Vec::new();
@@ -168,7 +232,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             }
             pts.push((cells, t, m));
         }
-        rows.push((method, pts));
+        rows.push((method.to_string(), pts));
     }
     let mut pt = Plot::new(
         "CPU time per step at the paper's density (1 thread, f32)",
@@ -184,8 +248,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     );
     pm.log_x = true;
     pm.log_y = true;
-    let mut claims = Vec::new();
-    let mut summary = Vec::new();
     for (method, pts) in &rows {
         let n: Vec<f64> = pts.iter().map(|p| p.0).collect();
         let median = |v: &[f64]| {
@@ -205,38 +267,11 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         let m: Vec<f64> = pts.iter().map(|p| p.2).collect();
         let zero = vec![0.0; n.len()];
         pt.series
-            .push(Series::new(*method).with_points(&n, &t, &spread));
+            .push(Series::new(method.as_str()).with_points(&n, &t, &spread));
         pm.series
-            .push(Series::new(*method).with_points(&n, &m, &zero));
-        // One exponent per repeat (the k-th timing of every size).
-        let per_repeat: Vec<f64> = (0..REPEATS)
-            .map(|k| {
-                let tk: Vec<f64> = pts.iter().map(|p| p.1[k]).collect();
-                exponent(&n, &tk)
-            })
-            .collect();
-        summary.push((method.to_string(), per_repeat, exponent(&n, &m)));
+            .push(Series::new(method.as_str()).with_points(&n, &m, &zero));
     }
-    for (method, kt, km) in &summary {
-        let (want, lo, hi) = if method == "subdomains" {
-            ("O(N)", 0.8, 1.25)
-        } else {
-            ("O(N²)", 1.7, 2.3)
-        };
-        let (verdict, reason) = rule(kt, *km, lo, hi);
-        claims.push(Claim::new(
-            format!("9.7: {method} cost {want} in time and memory"),
-            format!(
-                "time ∝ N^k with k = {} ± {} over {} repeats (CPU time), memory ∝ N^{}",
-                g(mean_std(kt).0),
-                g(mean_std(kt).1),
-                kt.len(),
-                g(*km)
-            ),
-            verdict,
-            reason,
-        ));
-    }
+    let claims = claims(&rows);
     let settings = format!(
         "- Paper scene at its density (15 cells per 50²), ζ = 0.005, dt 0.5, f32, one thread, no output, straight from a random start.\n\
          - Subdomains: margin 16 (patches of side 2(R + 16) = 48), L ∈ {{{}}}. Full domain: margin 0 (every cell on the whole lattice), L ∈ {{{}}}.\n\
@@ -289,6 +324,22 @@ mod tests {
             );
         }
         std::hint::black_box(x);
+    }
+
+    /// The scaling section of docs/reproduction.md states the verdicts of the figure's timings,
+    /// kept in `docs/data/scaling/quick/scaling.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let rows = rows_from_table(&root.join("docs/data/scaling/quick")).unwrap();
+        let want: Vec<(String, Verdict)> = claims(&rows)
+            .into_iter()
+            .map(|c| (c.claim, c.verdict))
+            .collect();
+        assert_eq!(want.len(), 2);
+        let heading =
+            "**Verdicts (quick,** 2026-12-07, AMD EPYC, load 1.5, 24 s; issue 54's rule**):**";
+        crate::assert_doc_verdicts("scaling", heading, &want);
     }
 
     #[test]

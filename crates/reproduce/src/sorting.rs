@@ -110,13 +110,12 @@ pub(crate) fn verdict(states: &[State]) -> (Verdict, String) {
         n(State::Mixed),
         n(State::NotEstablished)
     );
-    if n(State::Sorts) > 0 {
-        (Verdict::Holds, counts)
-    } else if !states.is_empty() && n(State::Mixed) == states.len() {
-        (Verdict::DoesNotHold, counts)
-    } else {
-        (Verdict::Inconclusive, counts)
-    }
+    let verdicts = states.iter().map(|s| match s {
+        State::Sorts => Verdict::Holds,
+        State::Mixed => Verdict::DoesNotHold,
+        State::NotEstablished => Verdict::Inconclusive,
+    });
+    (super::rules::any_holds(verdicts), counts)
 }
 
 /// A point: its name, what differs, and the settings of its populations `[ζ_a, ζ_b, γ_a, γ_b]`.
@@ -217,6 +216,33 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         }
     }
     p.reporter.stage("sorting: tables and plots");
+    let (claims, csv) = claims(&late);
+    let mut plot = Plot::new(
+        "Demixing of two populations in time",
+        "time (TU)",
+        "demixing parameter, mean over seeds",
+    );
+    plot.hlines = vec![
+        (MATERIAL, "sorting: 0.05".into()),
+        (0.0, "labels dealt at random".into()),
+    ];
+    for (spec, (times, mean)) in SPECS.iter().zip(&in_time) {
+        plot.series.push(
+            Series::new(spec.name)
+                .with_points(times, mean, &vec![0.0; times.len()])
+                .line_only(),
+        );
+    }
+    let settings = settings(p.scale, t);
+    Ok(Made::new(claims, settings)
+        .table("sorting.csv", csv)
+        .table("sorting_runs.csv", runs_table(&late))
+        .plot("sorting_in_time.png", plot))
+}
+
+/// The claims and the table of the points' late demixing `late` (by seed, in the order of
+/// [`SPECS`]: the control first).
+fn claims(late: &[PerSeed]) -> (Vec<Claim>, Csv) {
     let control = late[0].values.clone();
     let mut csv = Csv::new(&[
         "point",
@@ -232,7 +258,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     ]);
     let mut states_by_axis: Vec<(&str, State)> = Vec::new();
     let mut measured: Vec<String> = Vec::new();
-    for (spec, vals) in SPECS.iter().zip(&late) {
+    for (spec, vals) in SPECS.iter().zip(late) {
         let (state, d, e) = classify(&vals.values);
         let [za, zb, ga, gb] = spec.values;
         csv.row([
@@ -262,22 +288,6 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             ));
         }
     }
-    let mut plot = Plot::new(
-        "Demixing of two populations in time",
-        "time (TU)",
-        "demixing parameter, mean over seeds",
-    );
-    plot.hlines = vec![
-        (MATERIAL, "sorting: 0.05".into()),
-        (0.0, "labels dealt at random".into()),
-    ];
-    for (spec, (times, mean)) in SPECS.iter().zip(&in_time) {
-        plot.series.push(
-            Series::new(spec.name)
-                .with_points(times, mean, &vec![0.0; times.len()])
-                .line_only(),
-        );
-    }
     let axis_states = |axis: &str| -> Vec<State> {
         states_by_axis
             .iter()
@@ -298,6 +308,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let (va, wa) = verdict(&axis_states("activity"));
     let (vs, ws) = verdict(&axis_states("stiffness"));
     let (m0, s0) = mean_se(&control);
+    let (vc, wc) = control_verdict(&control);
     let claims = vec![
         Claim::new(
             "sorting (issue 41): a mixture sorts by a difference in activity (extensile against contractile or passive cells)",
@@ -317,11 +328,67 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             Verdict::Inconclusive,
             "not testable in this model: `[adhesion] omega` is one ω for every pair of cells, so a heterotypic contact is as adhesive as a homotypic one, and each cell's interface energy γ_i ∫|∇φ_i|² does not depend on its neighbour, so a heterotypic contact costs γ_a + γ_b, exactly the mean of the two homotypic ones (2γ_a, 2γ_b): the driving force of differential adhesion or interfacial tension is zero by construction. A pair-dependent ω is needed",
         ),
+        Claim::new(
+            "sorting (issue 54's control): two identical populations sort (must not hold)",
+            "the control: both populations ζ = 0.005, γ = 0.01, labels dealt at random",
+            vc,
+            wc,
+        ),
     ];
-    let settings = settings(p.scale, t);
-    Ok(Made::new(claims, settings)
-        .table("sorting.csv", csv)
-        .plot("sorting_in_time.png", plot))
+    (claims, csv)
+}
+
+/// The control's verdict: identical populations "sort" by the rule of a point ([`classify`]).
+/// Their labels are a random partition, so it must read "does not hold".
+fn control_verdict(control: &[f64]) -> (Verdict, String) {
+    let (state, m, e) = classify(control);
+    let v = match state {
+        State::Sorts => Verdict::Holds,
+        State::Mixed => Verdict::DoesNotHold,
+        State::NotEstablished => Verdict::Inconclusive,
+    };
+    (
+        v,
+        format!(
+            "late demixing {} ± {} (s.e.): {}; the labels carry no physics",
+            g(m),
+            g(e),
+            state.name()
+        ),
+    )
+}
+
+/// `sorting_runs.csv`: every run's late demixing, the figure's raw data.
+fn runs_table(late: &[PerSeed]) -> Csv {
+    let mut csv = Csv::new(&["point", "seed", "demixing"]);
+    for (spec, per) in SPECS.iter().zip(late) {
+        for (seed, v) in per.seeds.iter().zip(&per.values) {
+            csv.row([cell(spec.name), cell(seed), sci(*v)]);
+        }
+    }
+    csv
+}
+
+/// The late demixing of `sorting_runs.csv` in `dir`, by point in the order of [`SPECS`].
+#[cfg(test)]
+fn late_from_table(dir: &std::path::Path) -> Result<Vec<PerSeed>, SweepError> {
+    let t = super::Table::read(&dir.join("sorting_runs.csv"))?;
+    let (point, seed, d) = (t.col("point")?, t.col("seed")?, t.f64s("demixing")?);
+    Ok(SPECS
+        .iter()
+        .map(|spec| {
+            let rows: Vec<usize> = (0..t.rows.len())
+                .filter(|&k| t.rows[k][point] == spec.name)
+                .collect();
+            PerSeed {
+                seeds: rows
+                    .iter()
+                    .map(|&k| t.rows[k][seed].parse().unwrap_or(0))
+                    .collect(),
+                values: rows.iter().map(|&k| d[k]).collect(),
+            }
+        })
+        .collect())
 }
 
 #[cfg(test)]
@@ -346,5 +413,30 @@ mod tests {
         assert_eq!(verdict(&[Mixed, Mixed]).0, Verdict::DoesNotHold);
         assert_eq!(verdict(&[Mixed, NotEstablished]).0, Verdict::Inconclusive);
         assert_eq!(verdict(&[]).0, Verdict::Inconclusive);
+        // The control: identical populations mixed, sorted, or undecided.
+        assert_eq!(
+            control_verdict(&[0.002, -0.003, 0.0]).0,
+            Verdict::DoesNotHold
+        );
+        assert_eq!(control_verdict(&[0.15, 0.16, 0.14]).0, Verdict::Holds);
+        assert_eq!(
+            control_verdict(&[0.3, -0.01, 0.02]).0,
+            Verdict::Inconclusive
+        );
+    }
+
+    /// The sorting section of docs/reproduction.md states the verdicts of the figure's runs,
+    /// kept in `docs/data/sorting/quick/sorting_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let late = late_from_table(&root.join("docs/data/sorting/quick")).unwrap();
+        let want: Vec<(String, Verdict)> = claims(&late)
+            .0
+            .into_iter()
+            .map(|c| (c.claim, c.verdict))
+            .collect();
+        assert_eq!(want.len(), 4);
+        crate::assert_doc_verdicts("sorting", "**Verdicts (quick):**", &want);
     }
 }
