@@ -113,7 +113,8 @@ fn failed(what: &str, e: StabilityError) -> SweepError {
 /// One pressure form's results.
 struct Form {
     pressure: PressureKind,
-    tiling: BlochTiling,
+    /// The rest state's tiling (`None` for a form read back from the figure's tables).
+    tiling: Option<BlochTiling>,
     waves: Vec<WaveThreshold>,
     /// The waves at half the grid's spacing around the lowest one, and the longest waves along
     /// each axis.
@@ -251,7 +252,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> 
         let whole_box = whole_box(&done, &tiling, pressure)?;
         forms.push(Form {
             pressure,
-            tiling,
+            tiling: Some(tiling),
             waves,
             refined,
             whole_box,
@@ -593,21 +594,104 @@ fn settings(scale: Scale, forms: &[Form]) -> String {
         ARNOLDI.eps,
         grid(scale).len()
     );
-    for f in forms {
+    for (f, tiling) in forms
+        .iter()
+        .filter_map(|f| f.tiling.as_ref().map(|t| (f, t)))
+    {
         s.push_str(&format!(
             "- {} form: rest state relaxed for {} TU, S_rms = {}, asymmetry between copies {}\n",
             pressure_name(f.pressure),
-            g(f.tiling.rest.time),
-            g(f.tiling.rest.s_rms),
-            g(f.tiling.asymmetry())
+            g(tiling.rest.time),
+            g(tiling.rest.s_rms),
+            g(tiling.asymmetry())
         ));
     }
     s
 }
 
+/// The forms of the figure's tables kept in `dir` (`waves.csv`, `growth_rates.csv`,
+/// `thresholds.csv`): each wave rebuilt from its evaluations as a kept wave is
+/// ([`WaveThreshold::from_points`]), the whole box's threshold as written.
+#[cfg(test)]
+fn forms_from_tables(dir: &Path) -> Result<Vec<Form>, SweepError> {
+    let waves = super::Table::read(&dir.join("waves.csv"))?;
+    let points = super::Table::read(&dir.join("growth_rates.csv"))?;
+    let th = super::Table::read(&dir.join("thresholds.csv"))?;
+    let (wp, wqx, wqy) = (waves.col("pressure")?, waves.f64s("qx")?, waves.f64s("qy")?);
+    let (sx, sy, refined) = (
+        waves.col("supercell_x")?,
+        waves.col("supercell_y")?,
+        waves.col("refined")?,
+    );
+    let (pp, pqx, pqy) = (
+        points.col("pressure")?,
+        points.f64s("qx")?,
+        points.f64s("qy")?,
+    );
+    let (pz, ps, pr) = (
+        points.f64s("zeta")?,
+        points.f64s("sigma")?,
+        points.f64s("residual")?,
+    );
+    let (tp, what, tz, te) = (
+        th.col("pressure")?,
+        th.col("what")?,
+        th.f64s("zeta_cr")?,
+        th.f64s("zeta_cr_err")?,
+    );
+    let mut forms = Vec::new();
+    for pressure in [PressureKind::Paper, PressureKind::Interaction] {
+        let pn = pressure_name(pressure);
+        let mut f = Form {
+            pressure,
+            tiling: None,
+            waves: Vec::new(),
+            refined: Vec::new(),
+            whole_box: None,
+        };
+        for (k, row) in waves.rows.iter().enumerate().filter(|(_, r)| r[wp] == pn) {
+            let q = [wqx[k], wqy[k]];
+            let pts = (0..points.rows.len())
+                .filter(|&j| points.rows[j][pp] == pn && pqx[j] == q[0] && pqy[j] == q[1])
+                .map(|j| stability::WavePoint {
+                    zeta: pz[j],
+                    sigma: ps[j],
+                    residual: pr[j],
+                })
+                .collect();
+            let cells = [row[sx].parse().unwrap_or(1), row[sy].parse().unwrap_or(1)];
+            let w = WaveThreshold::from_points(q, cells, pts);
+            if row[refined] == "true" {
+                f.refined.push(w);
+            } else {
+                f.waves.push(w);
+            }
+        }
+        f.whole_box = (0..th.rows.len())
+            .find(|&k| th.rows[k][tp] == pn && th.rows[k][what].contains("Arnoldi"))
+            .map(|k| (tz[k], te[k]));
+        forms.push(f);
+    }
+    Ok(forms)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bloch section of docs/reproduction.md states the verdicts of the figure's waves,
+    /// kept in `docs/data/bloch/quick/`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let forms = forms_from_tables(&root.join("docs/data/bloch/quick")).unwrap();
+        let want: Vec<(String, crate::Verdict)> = claims(&forms)
+            .into_iter()
+            .map(|c| (c.claim, c.verdict))
+            .collect();
+        assert_eq!(want.len(), 6);
+        crate::assert_doc_verdicts("bloch", "**Verdicts (quick):**", &want);
+    }
 
     /// The grid lies in the half zone, once each, and holds every wave of the boxes it is said
     /// to (k = 1, 2 at the quick scale; 1, 2, 4 at the paper scale), but not those of k = 3.
@@ -666,7 +750,7 @@ mod tests {
         )];
         Form {
             pressure,
-            tiling,
+            tiling: Some(tiling),
             waves,
             refined,
             whole_box: Some((6e-4, 1e-5)),

@@ -627,6 +627,7 @@ pub(crate) fn pm((m, s): (f64, f64)) -> String {
 
 /// One run of a sweep: its values on the axes, its seed, its directory and its summary over
 /// the window given.
+#[derive(Clone)]
 pub(crate) struct Rec {
     pub values: Vec<String>,
     pub seed: u64,

@@ -10,7 +10,7 @@
 
 use render::{Plot, Series};
 
-use super::pipeline::{cell, sci, Csv, Made};
+use super::pipeline::{cell, sci, Csv, Made, PointRuns};
 use super::{g, mean_se, Claim, ReproduceParams, Scale, SweepJob, Verdict};
 use study::threshold::{growth_threshold, RatePoint, Threshold};
 use study::SweepError;
@@ -287,7 +287,7 @@ impl Estimator {
 /// `(T, ζ_cr, s.e.)` where it is measured; each seed's threshold into `csv` and each mean
 /// into `means`.
 fn thresholds_by_length(
-    res: &super::SweepResult,
+    cut: &[(f64, Vec<PointRuns>)],
     estimator: Estimator,
     pressure: &str,
     seeds: &[u64],
@@ -295,9 +295,9 @@ fn thresholds_by_length(
     means: &mut Csv,
 ) -> Result<Vec<(f64, f64, f64)>, SweepError> {
     let mut pts = Vec::new();
-    for &t in &LENGTHS {
+    for (t, points) in cut {
+        let t = *t;
         // Each run cut at T.
-        let points = res.points(Some(t))?;
         let rates: Vec<(f64, u64, f64)> = points
             .iter()
             .filter(|pt| pt.values[0] == pressure)
@@ -360,32 +360,19 @@ fn thresholds_by_length(
     Ok(pts)
 }
 
-pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
+/// What the figure makes of its runs cut at each run length.
+struct Analysis {
+    claims: Vec<Claim>,
+    per_seed: Csv,
+    means: Csv,
+    fits: Csv,
+    plot: Plot,
+}
+
+/// The claims, tables and plot from the runs `cut` at each run length (its points' values
+/// `[pressure, ζ]`) of `seeds`.
+fn analyse(cut: &[(f64, Vec<PointRuns>)], seeds: &[u64]) -> Result<Analysis, SweepError> {
     let t_max = LENGTHS[LENGTHS.len() - 1];
-    let mut sets = vec![
-        format!("run.time={t_max}"),
-        format!("run.output_every={t_max}"),
-    ];
-    sets.extend(p.scale.integrator());
-    let res = super::sweep(
-        p,
-        SweepJob {
-            scene: super::PAPER_SCENE,
-            name: format!("run-length-{}", p.scale.name()),
-            sets,
-            varies: vec![
-                format!("model.pressure={}", PRESSURES.join(",")),
-                format!("model.zeta={ZETAS}"),
-            ],
-            analyze: None,
-            seeds: Some(seeds_of(p.scale)),
-        },
-    )?;
-    p.reporter.stage("run-length: ζ_cr against T");
-    let seeds: Vec<u64> = {
-        let s = seeds_of(p.scale);
-        (s.first..=s.last).collect()
-    };
     let mut csv = Csv::new(&[
         "estimator",
         "pressure",
@@ -434,7 +421,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .flat_map(|e| PRESSURES.map(|p| (e, p)))
     {
         let en = estimator.name();
-        let pts = thresholds_by_length(&res, estimator, pressure, &seeds, &mut csv, &mut means)?;
+        let pts = thresholds_by_length(cut, estimator, pressure, seeds, &mut csv, &mut means)?;
         let (t, y, e): (Vec<f64>, Vec<f64>, Vec<f64>) = (
             pts.iter().map(|p| p.0).collect(),
             pts.iter().map(|p| p.1).collect(),
@@ -492,6 +479,96 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         ));
     }
 
+    Ok(Analysis {
+        claims,
+        per_seed: csv,
+        means,
+        fits,
+        plot,
+    })
+}
+
+/// `run_length_runs.csv`: every run's summary at each run length (issue 54's raw table).
+fn runs_table(cut: &[(f64, Vec<PointRuns>)]) -> Csv {
+    let points: Vec<PointRuns> = cut
+        .iter()
+        .flat_map(|(t, pts)| {
+            pts.iter().map(move |pt| PointRuns {
+                values: std::iter::once(t.to_string())
+                    .chain(pt.values.iter().cloned())
+                    .collect(),
+                runs: pt.runs.clone(),
+            })
+        })
+        .collect();
+    super::pipeline::runs_table(&["run_time", "pressure", "zeta"], &points)
+}
+
+/// The runs of `run_length_runs.csv` in `dir`, cut at each run length as [`make`] had them,
+/// and their seeds.
+#[cfg(test)]
+type Cut = (Vec<(f64, Vec<PointRuns>)>, Vec<u64>);
+
+#[cfg(test)]
+fn cut_from_table(dir: &std::path::Path) -> Result<Cut, SweepError> {
+    let all = super::pipeline::points_from_runs_table(&dir.join("run_length_runs.csv"), 3)?;
+    let mut cut: Vec<(f64, Vec<PointRuns>)> = Vec::new();
+    let mut seeds: Vec<u64> = Vec::new();
+    for pt in all {
+        let t: f64 = pt.values[0].parse().unwrap_or(f64::NAN);
+        seeds.extend(pt.runs.iter().map(|r| r.seed));
+        let point = PointRuns {
+            values: pt.values[1..].to_vec(),
+            runs: pt.runs,
+        };
+        match cut.iter_mut().find(|c| c.0 == t) {
+            Some(c) => c.1.push(point),
+            None => cut.push((t, vec![point])),
+        }
+    }
+    seeds.sort_unstable();
+    seeds.dedup();
+    Ok((cut, seeds))
+}
+
+pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
+    let t_max = LENGTHS[LENGTHS.len() - 1];
+    let mut sets = vec![
+        format!("run.time={t_max}"),
+        format!("run.output_every={t_max}"),
+    ];
+    sets.extend(p.scale.integrator());
+    let res = super::sweep(
+        p,
+        SweepJob {
+            scene: super::PAPER_SCENE,
+            name: format!("run-length-{}", p.scale.name()),
+            sets,
+            varies: vec![
+                format!("model.pressure={}", PRESSURES.join(",")),
+                format!("model.zeta={ZETAS}"),
+            ],
+            analyze: None,
+            seeds: Some(seeds_of(p.scale)),
+        },
+    )?;
+    p.reporter.stage("run-length: ζ_cr against T");
+    let seeds: Vec<u64> = {
+        let s = seeds_of(p.scale);
+        (s.first..=s.last).collect()
+    };
+    // Each run cut at each run length T.
+    let cut: Vec<(f64, Vec<PointRuns>)> = LENGTHS
+        .iter()
+        .map(|&t| Ok((t, res.points(Some(t))?)))
+        .collect::<Result<_, SweepError>>()?;
+    let Analysis {
+        claims,
+        per_seed: csv,
+        means,
+        fits,
+        plot,
+    } = analyse(&cut, &seeds)?;
     let settings = format!(
         "- The paper's scene (L = 100, 60 cells, γ = 0.01, random packing relaxed 200 TU at ζ = 0), {}, both pressure forms, ζ ∈ {{{ZETAS}}}, seeds {}–{}, each run {t_max} TU of activity.\n\
          - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] (per TU), or its local exponent d ln v_rms / d ln t over [T/2, T] (t from the start of the activity; issue 54: scale-free, so a power-law relaxation keeps a negative exponent at every T where its rate tends to zero as ~1/T), first turns positive (linear interpolation between the activities around the crossing); seeds whose crossing lies below the lowest ζ are censored, not dropped: each lies in [0, lowest ζ], and the mean puts them at the middle with the half-width of the mean's range added to its standard error in quadrature; a run length where a seed's crossing lies above the grid is left out (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
@@ -503,6 +580,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         LENGTHS.map(|t| t.to_string()).join(", "),
     );
     Ok(Made::new(claims, settings)
+        .table("run_length_runs.csv", runs_table(&cut))
         .table("zeta_cr_per_seed.csv", csv)
         .table("zeta_cr_vs_run_length.csv", means)
         .table("fit.csv", fits)
@@ -512,6 +590,22 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The run-length section of docs/reproduction.md states the verdicts of the figure's
+    /// runs, kept in `docs/data/run-length/quick/run_length_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let (cut, seeds) = cut_from_table(&root.join("docs/data/run-length/quick")).unwrap();
+        let want: Vec<(String, Verdict)> = analyse(&cut, &seeds)
+            .unwrap()
+            .claims
+            .into_iter()
+            .map(|c| (c.claim, c.verdict))
+            .collect();
+        assert_eq!(want.len(), 4);
+        crate::assert_doc_verdicts("run-length", "**Verdicts (quick):**", &want);
+    }
 
     #[test]
     fn the_power_fit_recovers_its_parameters() {

@@ -178,6 +178,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         long_recs,
         compare,
         systematic,
+        mut runs,
     } = sweeps(p, t)?;
     p.reporter.stage("threshold: tables and plots");
     let mut made = Made::new(Vec::new(), String::new()).table(
@@ -199,12 +200,12 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     made.add_plot("threshold_vs_run_length.png", rl);
 
     // The same runs cut at T/2, for 9.1's test of whether ζ_cr has settled.
-    let mut half = Vec::new();
     for (lx, _, res) in &long_recs {
-        half.extend(groups(&res.records(Some(0.5 * t))?, *lx, &integ_name, true));
+        let recs = res.records(Some(0.5 * t))?;
+        runs.push(RunSet::new(Set::Half, *lx, &integ_name, true, recs));
     }
-    made.claims = verdicts(&all, &half, &compare);
-    made.claims.push(claim_discretisation(&all, &systematic));
+    made.add_table("threshold_runs.csv", runs_table(&runs));
+    made.claims = claims_of(&runs);
     made.settings = settings_text(p, t, &integ_name, !compare.is_empty());
     Ok(made)
 }
@@ -219,6 +220,186 @@ struct Sweeps {
     /// The systematics (issue 54): L = 100, γ = 0.01, both forms, at half the time step and
     /// on a grid twice as fine.
     systematic: Vec<Group>,
+    /// Every sweep's runs, for `threshold_runs.csv`.
+    runs: Vec<RunSet>,
+}
+
+/// Which of the threshold's sets of runs a [`RunSet`] is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Set {
+    /// Both boxes, every γ: the figure's runs.
+    Box,
+    /// The same runs summarised over the second half of T/2 (9.1's settling).
+    Half,
+    /// The paper's integrator on the small box (quick scale).
+    Compare,
+    /// The small box at half the time step or on a grid twice as fine.
+    Systematic,
+}
+
+impl Set {
+    #[cfg(test)]
+    const ALL: [Set; 4] = [Set::Box, Set::Half, Set::Compare, Set::Systematic];
+
+    fn name(self) -> &'static str {
+        match self {
+            Self::Box => "box",
+            Self::Half => "half",
+            Self::Compare => "compare",
+            Self::Systematic => "systematic",
+        }
+    }
+}
+
+/// One sweep's runs with their summaries, as [`groups`] reads them.
+struct RunSet {
+    set: Set,
+    lx: usize,
+    integrator: String,
+    /// Whether γ is an axis (values `[pressure, γ, ζ]`) or not (`[pressure, ζ]`, γ = 0.01).
+    gamma_axis: bool,
+    recs: Vec<Rec>,
+}
+
+impl RunSet {
+    fn new(set: Set, lx: usize, integrator: &str, gamma_axis: bool, recs: Vec<Rec>) -> Self {
+        Self {
+            set,
+            lx,
+            integrator: integrator.into(),
+            gamma_axis,
+            recs,
+        }
+    }
+
+    fn groups(&self) -> Vec<Group> {
+        groups(&self.recs, self.lx, &self.integrator, self.gamma_axis)
+    }
+}
+
+/// `threshold_runs.csv`: every run of every set with its summary, to every digit: the raw
+/// table from which [`claims_of`] gives the verdicts again (issue 54).
+fn runs_table(sets: &[RunSet]) -> Csv {
+    let mut columns = vec![
+        "set",
+        "lx",
+        "integrator",
+        "pressure",
+        "gamma",
+        "zeta",
+        "seed",
+    ];
+    columns.extend(study::summary::SUMMARY_COLUMNS.split(','));
+    let mut csv = Csv::new(&columns);
+    for rs in sets {
+        for r in &rs.recs {
+            let (gamma, zeta) = if rs.gamma_axis {
+                (r.values[1].clone(), r.values[2].clone())
+            } else {
+                ("-".to_string(), r.values[1].clone())
+            };
+            csv.row(
+                [
+                    cell(rs.set.name()),
+                    cell(rs.lx),
+                    cell(&rs.integrator),
+                    cell(&r.values[0]),
+                    gamma,
+                    zeta,
+                    cell(r.seed),
+                ]
+                .into_iter()
+                .chain(r.summary.csv().split(',').map(str::to_string)),
+            );
+        }
+    }
+    csv
+}
+
+/// The sets of a table that [`runs_table`] wrote, in its order.
+#[cfg(test)]
+fn run_sets_from_table(path: &std::path::Path) -> Result<Vec<RunSet>, SweepError> {
+    let t = super::Table::read(path)?;
+    let (set, lx, integ, seed) = (
+        t.col("set")?,
+        t.col("lx")?,
+        t.col("integrator")?,
+        t.col("seed")?,
+    );
+    let (pressure, gamma, zeta) = (t.col("pressure")?, t.col("gamma")?, t.col("zeta")?);
+    let num = |name: &str| t.f64s(name);
+    let (ws, we, v, sr, a, gr, ge) = (
+        num("window_start")?,
+        num("window_end")?,
+        num("v_rms")?,
+        num("s_rms")?,
+        num("area_mean")?,
+        num("growth_rate")?,
+        num("growth_exponent")?,
+    );
+    let rows_c = t.col("rows")?;
+    let bad = |k: usize, what: &str| SweepError::Reproduce {
+        why: format!("{}: row {}: {what}", path.display(), k + 1),
+    };
+    let mut sets: Vec<RunSet> = Vec::new();
+    for (k, row) in t.rows.iter().enumerate() {
+        let s = *Set::ALL
+            .iter()
+            .find(|s| s.name() == row[set])
+            .ok_or_else(|| bad(k, "no such set"))?;
+        let l: usize = row[lx].parse().map_err(|_| bad(k, "lx"))?;
+        let gamma_axis = row[gamma] != "-";
+        let values = if gamma_axis {
+            vec![row[pressure].clone(), row[gamma].clone(), row[zeta].clone()]
+        } else {
+            vec![row[pressure].clone(), row[zeta].clone()]
+        };
+        let rec = Rec {
+            values,
+            seed: row[seed].parse().map_err(|_| bad(k, "seed"))?,
+            run: std::path::PathBuf::new(),
+            summary: study::summary::RunSummary {
+                window_start: ws[k],
+                window_end: we[k],
+                rows: row[rows_c].parse().map_err(|_| bad(k, "rows"))?,
+                v_rms: v[k],
+                s_rms: sr[k],
+                area_mean: a[k],
+                growth_rate: gr[k],
+                growth_exponent: ge[k],
+            },
+        };
+        let same = |r: &RunSet| r.set == s && r.lx == l && r.integrator == row[integ];
+        match sets.last_mut().filter(|r| same(r)) {
+            Some(r) => r.recs.push(rec),
+            None => sets.push(RunSet::new(s, l, &row[integ], gamma_axis, vec![rec])),
+        }
+    }
+    Ok(sets)
+}
+
+/// The figure's claims from its sets of runs.
+fn claims_of(sets: &[RunSet]) -> Vec<Claim> {
+    let of = |set: Set| -> Vec<Group> {
+        sets.iter()
+            .filter(|r| r.set == set)
+            .flat_map(RunSet::groups)
+            .collect()
+    };
+    let (all, systematic) = (of(Set::Box), of(Set::Systematic));
+    let mut claims = verdicts(&all, &of(Set::Half), &of(Set::Compare));
+    claims.push(claim_discretisation(&all, &systematic));
+    claims
+}
+
+/// The claims of the figure's table kept in `dir` (`threshold_runs.csv`).
+#[cfg(test)]
+fn verdicts_from_tables(dir: &std::path::Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let sets = run_sets_from_table(&dir.join("threshold_runs.csv"))?;
+    Ok(claims_of(&sets)
+        .into_iter()
+        .map(|c| (c.claim, c.verdict))
+        .collect())
 }
 
 /// Runs (or reads) the threshold's sweeps.
@@ -226,6 +407,7 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
     let integ = p.scale.integrator();
     let integ_name = p.scale.integrator_name();
     let mut all: Vec<Group> = Vec::new();
+    let mut runs: Vec<RunSet> = Vec::new();
     let mut long_recs: Vec<(usize, Vec<Rec>, super::SweepResult)> = Vec::new();
     for (lx, count) in BOXES {
         let mut sets = vec![
@@ -253,6 +435,7 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
         )?;
         let recs = res.records(None)?;
         all.extend(groups(&recs, lx, &integ_name, true));
+        runs.push(RunSet::new(Set::Box, lx, &integ_name, true, recs.clone()));
         long_recs.push((lx, recs, res));
     }
     // The paper's integrator on the small box, to show the verdicts do not depend on it.
@@ -260,12 +443,15 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
     if p.scale == Scale::Quick {
         let mut sets = vec![format!("run.time={t}"), format!("run.output_every={t}")];
         sets.extend(Scale::Paper.integrator());
-        compare = small_box(
+        let set = small_box(
             p,
             "threshold-L100-paper-integrator".into(),
             sets,
             &Scale::Paper.integrator_name(),
+            Set::Compare,
         )?;
+        compare = set.groups();
+        runs.push(set);
     }
     // The systematics: the small box at half the time step and on a grid twice as fine.
     let mut systematic: Vec<Group> = Vec::new();
@@ -291,24 +477,29 @@ fn sweeps(p: &ReproduceParams, t: f64) -> Result<Sweeps, SweepError> {
         let mut sets = base.clone();
         sets.extend(extra);
         let name_of_sweep = format!("threshold-L{lx}-{tag}-{}", p.scale.name());
-        systematic.extend(small_box(p, name_of_sweep, sets, &name)?);
+        let set = small_box(p, name_of_sweep, sets, &name, Set::Systematic)?;
+        systematic.extend(set.groups());
+        runs.push(set);
     }
     Ok(Sweeps {
         all,
         long_recs,
         compare,
         systematic,
+        runs,
     })
 }
 
 /// The sweep `name` of the small box (L = 100, the scene's) with the overrides `sets`, over both
-/// pressure forms and every ζ at the scene's γ, as groups whose integrator reads `label`.
+/// pressure forms and every ζ at the scene's γ, as the set `set` whose integrator reads
+/// `label`.
 fn small_box(
     p: &ReproduceParams,
     name: String,
     sets: Vec<String>,
     label: &str,
-) -> Result<Vec<Group>, SweepError> {
+    set: Set,
+) -> Result<RunSet, SweepError> {
     let res = super::sweep(
         p,
         SweepJob {
@@ -323,7 +514,13 @@ fn small_box(
             seeds: None,
         },
     )?;
-    Ok(groups(&res.records(None)?, BOXES[0].0, label, false))
+    Ok(RunSet::new(
+        set,
+        BOXES[0].0,
+        label,
+        false,
+        res.records(None)?,
+    ))
 }
 
 /// The columns of a threshold's bracket and its excess's, as `csv_fields` writes them.
@@ -897,6 +1094,22 @@ fn claim_discretisation(all: &[Group], systematic: &[Group]) -> Claim {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The threshold section of docs/reproduction.md states the verdicts of the figure's runs
+    /// at both scales, kept in `docs/data/threshold/{quick,paper}/threshold_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        for (scale, heading, n) in [
+            ("quick", "**Verdicts (quick):**", 11),
+            ("paper", "**Verdicts:**", 10),
+        ] {
+            let dir = root.join("docs/data/threshold").join(scale);
+            let want = verdicts_from_tables(&dir).unwrap();
+            assert_eq!(want.len(), n, "{scale}");
+            crate::assert_doc_verdicts("threshold", heading, &want);
+        }
+    }
     use study::summary::RunSummary;
 
     /// Synthetic runs whose late growth rate is `r = 1.5 (ζ − ζ_cr(γ))` plus a seed offset that
