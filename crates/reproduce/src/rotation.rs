@@ -363,7 +363,8 @@ fn points_from_table(dir: &std::path::Path) -> Result<Vec<PointResult>, SweepErr
     );
     let (om, per) = (t.f64s("omega_mean")?, t.f64s("persistence")?);
     type Key = (u64, u64, String, String, String, String);
-    let mut keys: Vec<(Key, usize, Vec<(u64, f64, f64)>)> = Vec::new();
+    type Runs = Vec<(u64, f64, f64)>;
+    let mut keys: Vec<(Key, usize, Runs)> = Vec::new();
     for (k, row) in t.rows.iter().enumerate() {
         let key: Key = (
             rad[k].to_bits(),
