@@ -69,7 +69,14 @@ fn disc_mean(field: &[f64], r: f64) -> f64 {
 }
 
 /// Amplitudes `|c_m|`, m = 0..=4, of the radial velocity on the ring `r`.
+#[cfg(test)]
 fn ring_modes(vu: &[f64], vv: &[f64], r: f64) -> [f64; 5] {
+    ring_coefficients(vu, vv, r).map(|(a, b)| a.hypot(b))
+}
+
+/// The Fourier coefficients `c_m = (re, im)`, m = 0..=4, of the radial velocity on the ring
+/// `r`: linear in the field, so the pooled average's are the runs' weighted by their defects.
+fn ring_coefficients(vu: &[f64], vv: &[f64], r: f64) -> [(f64, f64); 5] {
     let n = 72;
     let mut c = [(0.0f64, 0.0f64); 5];
     for k in 0..n {
@@ -82,7 +89,136 @@ fn ring_modes(vu: &[f64], vv: &[f64], r: f64) -> [f64; 5] {
             cm.1 += vr * sm / n as f64;
         }
     }
-    c.map(|(a, b)| a.hypot(b))
+    c
+}
+
+/// What the claims read of one run's crops: a row of `defect_field_runs.csv` (the crops
+/// themselves, 3 MB a figure, are not kept in the docs). Every statistic the claims pool is
+/// linear in the crops, so the pooled ones are these weighted by the run's defects.
+#[derive(Debug, Clone, PartialEq)]
+struct RunStats {
+    seed: u64,
+    n_plus: f64,
+    n_minus: f64,
+    /// The mean core velocity (r ≤ R) around +½, along the axis and across it.
+    plus_core: [f64; 2],
+    /// The same around −½ (along an arm, across).
+    minus_core: [f64; 2],
+    /// P at the head and at the tail of +½ (u = ∓1.5R).
+    head_tail: [f64; 2],
+    /// ω(0, −1.5R) − ω(0, +1.5R) around +½.
+    vortex_pair: f64,
+    /// The Fourier coefficients of the radial velocity on the ring 1.5R around −½.
+    ring: [(f64, f64); 5],
+}
+
+/// The columns of `defect_field_runs.csv`.
+const RUN_COLUMNS: [&str; 22] = [
+    "pressure",
+    "seed",
+    "n_plus",
+    "n_minus",
+    "plus_core_u",
+    "plus_core_v",
+    "minus_core_u",
+    "minus_core_v",
+    "p_head",
+    "p_tail",
+    "vortex_pair",
+    "ring_re_0",
+    "ring_re_1",
+    "ring_re_2",
+    "ring_re_3",
+    "ring_re_4",
+    "ring_im_0",
+    "ring_im_1",
+    "ring_im_2",
+    "ring_im_3",
+    "ring_im_4",
+    "ring_radius",
+];
+
+impl RunStats {
+    fn of(seed: u64, c: &Crops) -> Self {
+        let (np, nm, plus, minus) = c;
+        Self {
+            seed,
+            n_plus: *np,
+            n_minus: *nm,
+            plus_core: [disc_mean(&plus[0], R), disc_mean(&plus[1], R)],
+            minus_core: [disc_mean(&minus[0], R), disc_mean(&minus[1], R)],
+            head_tail: [at(&plus[5], -1.5 * R, 0.0), at(&plus[5], 1.5 * R, 0.0)],
+            vortex_pair: vorticity_at(&plus[0], &plus[1], 0.0, -1.5 * R)
+                - vorticity_at(&plus[0], &plus[1], 0.0, 1.5 * R),
+            ring: ring_coefficients(&minus[0], &minus[1], 1.5 * R),
+        }
+    }
+
+    fn row(&self, pressure: &str) -> Vec<String> {
+        [
+            cell(pressure),
+            cell(self.seed),
+            cell(self.n_plus),
+            cell(self.n_minus),
+        ]
+        .into_iter()
+        .chain(
+            self.plus_core
+                .iter()
+                .chain(&self.minus_core)
+                .chain(&self.head_tail)
+                .chain([&self.vortex_pair])
+                .chain(self.ring.iter().map(|c| &c.0))
+                .chain(self.ring.iter().map(|c| &c.1))
+                .map(|v| sci(*v)),
+        )
+        .chain([cell(1.5 * R)])
+        .collect()
+    }
+
+    /// The runs of `pressure` in a table that [`RunStats::row`] wrote.
+    #[cfg(test)]
+    fn from_table(t: &super::Table, pressure: &str) -> Result<Vec<Self>, SweepError> {
+        let (pc, sc) = (t.col("pressure")?, t.col("seed")?);
+        let cols: Vec<Vec<f64>> = RUN_COLUMNS[2..21]
+            .iter()
+            .map(|c| t.f64s(c))
+            .collect::<Result<_, _>>()?;
+        Ok(t.rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r[pc] == pressure)
+            .map(|(k, r)| {
+                let v = |i: usize| cols[i][k];
+                Self {
+                    seed: r[sc].parse().unwrap_or(0),
+                    n_plus: v(0),
+                    n_minus: v(1),
+                    plus_core: [v(2), v(3)],
+                    minus_core: [v(4), v(5)],
+                    head_tail: [v(6), v(7)],
+                    vortex_pair: v(8),
+                    ring: std::array::from_fn(|m| (v(9 + m), v(14 + m))),
+                }
+            })
+            .collect())
+    }
+}
+
+/// The claims of the figure's table kept in `dir` (`defect_field_runs.csv`).
+#[cfg(test)]
+fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let t = super::Table::read(&dir.join("defect_field_runs.csv"))?;
+    let mut out = Vec::new();
+    for pressure in ["paper", "interaction"] {
+        let runs = RunStats::from_table(&t, pressure)?;
+        out.extend(
+            claims(pressure, &runs)
+                .into_iter()
+                .map(|c| (c.claim, c.verdict)),
+        );
+    }
+    Ok(out)
 }
 
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
@@ -97,9 +233,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .chain(["defects"])
         .collect();
     let mut csv = Csv::new(&columns);
+    let mut runs_csv = Csv::new(&RUN_COLUMNS);
     for pressure in ["paper", "interaction"] {
-        let runs: Vec<Crops> = point(&points, &[pressure])
-            .map_or(&[][..], |pt| &pt.runs)
+        let recs = point(&points, &[pressure]).map_or(&[][..], |pt| &pt.runs);
+        let runs: Vec<Crops> = recs
             .iter()
             .map(|r| read_crops(&r.run.join("analysis/defect_averages.npz")))
             .collect::<Result<_, _>>()?;
@@ -108,11 +245,21 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         for (name, picture) in pooled.pictures(pressure) {
             made = made.plot(name, picture);
         }
-        claims.extend(pooled.claims(pressure, &runs));
+        let stats: Vec<RunStats> = recs
+            .iter()
+            .zip(&runs)
+            .map(|(r, c)| RunStats::of(r.seed, c))
+            .collect();
+        for st in &stats {
+            runs_csv.row(st.row(pressure));
+        }
+        claims.extend(self::claims(pressure, &stats));
     }
     made.claims = claims;
     made.settings = settings(p, t, from);
-    Ok(made.table("defect_fields.csv", csv))
+    Ok(made
+        .table("defect_fields.csv", csv)
+        .table("defect_field_runs.csv", runs_csv))
 }
 
 /// The sweep: the paper's scene at ζ = 0.005, γ = 0.014, both pressure forms, with its
@@ -277,31 +424,58 @@ impl Pooled {
         }
         out
     }
+}
 
-    /// The claims of Fig. 4 at one pressure form, from the pooled averages and the runs'.
-    fn claims(&self, pressure: &str, runs: &[Crops]) -> Vec<Claim> {
-        let (vu, vv) = (
-            mean_std(&per_run(runs, true, 0)),
-            mean_std(&per_run(runs, true, 1)),
-        );
-        let plus_speed = vu.0.hypot(vv.0);
-        vec![
-            self.propulsion_claim(pressure, runs),
-            self.three_fold_claim(pressure, plus_speed),
-            self.stress_claim(pressure, runs),
-            self.vortex_claim(pressure, runs),
-            self.drift_claim(pressure, runs, plus_speed),
-            three_fold_each_claim(pressure, runs),
-        ]
-    }
+/// The statistics of the runs with +½ (`plus`) or −½ defects.
+fn with(runs: &[RunStats], plus: bool) -> impl Iterator<Item = &RunStats> {
+    runs.iter().filter(move |r| {
+        if plus {
+            r.n_plus > 0.0
+        } else {
+            r.n_minus > 0.0
+        }
+    })
+}
 
-    /// A +½ defect self-propels along its axis, towards its head.
-    fn propulsion_claim(&self, pressure: &str, runs: &[Crops]) -> Claim {
-        let np = self.np;
-        let per_run = |plus: bool, comp: usize| per_run(runs, plus, comp);
-        let (vu, vv) = (mean_std(&per_run(true, 0)), mean_std(&per_run(true, 1)));
-        let (v_dir, why_dir) = propulsion(&per_run(true, 0), &per_run(true, 1));
-        Claim::new(
+/// A per-run statistic pooled over every defect: weighted by each run's defects.
+fn pooled(runs: &[RunStats], plus: bool, f: impl Fn(&RunStats) -> f64) -> f64 {
+    let n = |r: &RunStats| if plus { r.n_plus } else { r.n_minus };
+    let total: f64 = runs.iter().map(n).sum();
+    with(runs, plus).map(|r| n(r) * f(r) / total).sum()
+}
+
+/// The claims of Fig. 4 at one pressure form, from its runs' statistics.
+fn claims(pressure: &str, runs: &[RunStats]) -> Vec<Claim> {
+    let core = |plus: bool, comp: usize| -> Vec<f64> {
+        with(runs, plus)
+            .map(|r| {
+                if plus {
+                    r.plus_core[comp]
+                } else {
+                    r.minus_core[comp]
+                }
+            })
+            .collect()
+    };
+    let (vu, vv) = (mean_std(&core(true, 0)), mean_std(&core(true, 1)));
+    let plus_speed = vu.0.hypot(vv.0);
+    let np: f64 = runs.iter().map(|r| r.n_plus).sum();
+    let nm: f64 = runs.iter().map(|r| r.n_minus).sum();
+    vec![
+        propulsion_claim(pressure, np, &core(true, 0), &core(true, 1)),
+        three_fold_claim(pressure, runs, nm, plus_speed),
+        stress_claim(pressure, runs, np),
+        vortex_claim(pressure, runs, np),
+        drift_claim(pressure, nm, &core(false, 0), &core(false, 1), plus_speed),
+        three_fold_each_claim(pressure, runs),
+    ]
+}
+
+/// A +½ defect self-propels along its axis, towards its head.
+fn propulsion_claim(pressure: &str, np: f64, pu: &[f64], pv: &[f64]) -> Claim {
+    let (vu, vv) = (mean_std(pu), mean_std(pv));
+    let (v_dir, why_dir) = propulsion(pu, pv);
+    Claim::new(
         format!("9.6 ({pressure} pressure): a +1/2 defect self-propels along its axis, towards its head"),
         format!(
             "core (r ≤ R) velocity over {np} defects: along the axis v_u = {}, across v_v = {} (per-run spread); v_u {} 0: towards the {}",
@@ -313,15 +487,17 @@ impl Pooled {
         if np == 0.0 { Verdict::Inconclusive } else { v_dir },
         why_dir,
     )
-    }
+}
 
-    /// The flow around a −½ defect is three-fold (pooled).
-    fn three_fold_claim(&self, pressure: &str, plus_speed: f64) -> Claim {
-        let (nm, minus) = (self.nm, &self.minus);
-        let modes = ring_modes(&minus[0], &minus[1], 1.5 * R);
-        let three = modes[3] > modes[1] && modes[3] > modes[2] && modes[3] > modes[4];
-        let core_minus = disc_mean(&minus[0], R).hypot(disc_mean(&minus[1], R));
-        Claim::new(
+/// The flow around a −½ defect is three-fold (pooled).
+fn three_fold_claim(pressure: &str, runs: &[RunStats], nm: f64, plus_speed: f64) -> Claim {
+    let modes: [f64; 5] = std::array::from_fn(|m| {
+        pooled(runs, false, |r| r.ring[m].0).hypot(pooled(runs, false, |r| r.ring[m].1))
+    });
+    let three = modes[3] > modes[1] && modes[3] > modes[2] && modes[3] > modes[4];
+    let core_minus =
+        pooled(runs, false, |r| r.minus_core[0]).hypot(pooled(runs, false, |r| r.minus_core[1]));
+    Claim::new(
         format!("9.6 ({pressure} pressure): the flow around a −1/2 defect is three-fold"),
         format!(
             "radial velocity on the ring r = 1.5R over {nm} defects, Fourier amplitudes m = 0..4: {}; core speed {} (against {} for +1/2)",
@@ -336,20 +512,20 @@ impl Pooled {
             "another mode than m = 3 dominates"
         },
     )
-    }
+}
 
-    /// The isotropic stress −P at the head and the tail of +½ (u = ∓1.5R), pooled and per
-    /// run (the verdict reads the runs' signs).
-    fn stress_claim(&self, pressure: &str, runs: &[Crops]) -> Claim {
-        let (np, plus) = (self.np, &self.plus);
-        let (head, tail) = (at(&plus[5], -1.5 * R, 0.0), at(&plus[5], 1.5 * R, 0.0));
-        let diffs: Vec<f64> = runs
-            .iter()
-            .filter(|r| r.0 > 0.0)
-            .map(|r| at(&r.2[5], -1.5 * R, 0.0) - at(&r.2[5], 1.5 * R, 0.0))
-            .collect();
-        let (v_head, why_head) = same_sign(&diffs);
-        Claim::new(
+/// The isotropic stress −P at the head and the tail of +½ (u = ∓1.5R), pooled and per run
+/// (the verdict reads the runs' signs).
+fn stress_claim(pressure: &str, runs: &[RunStats], np: f64) -> Claim {
+    let (head, tail) = (
+        pooled(runs, true, |r| r.head_tail[0]),
+        pooled(runs, true, |r| r.head_tail[1]),
+    );
+    let diffs: Vec<f64> = with(runs, true)
+        .map(|r| r.head_tail[0] - r.head_tail[1])
+        .collect();
+    let (v_head, why_head) = same_sign(&diffs);
+    Claim::new(
         format!("9.6 ({pressure} pressure): the isotropic stress around +1/2 follows the continuum and experimental pattern"),
         format!(
             "pressure P (isotropic stress −P) at 1.5R from the core along the axis, pooled: head side {} vs tail side {}; head − tail per run: {}",
@@ -360,26 +536,18 @@ impl Pooled {
         if np == 0.0 { Verdict::Inconclusive } else { v_head },
         why_head,
     )
-    }
+}
 
-    /// The vortex pair of +½: per run, ω below the axis minus ω above it, at v = ∓1.5R.
-    fn vortex_claim(&self, pressure: &str, runs: &[Crops]) -> Claim {
-        let np = self.np;
-        let pair: Vec<f64> = runs
-            .iter()
-            .filter(|r| r.0 > 0.0)
-            .map(|r| {
-                vorticity_at(&r.2[0], &r.2[1], 0.0, -1.5 * R)
-                    - vorticity_at(&r.2[0], &r.2[1], 0.0, 1.5 * R)
-            })
-            .collect();
-        let (v_pair, why_pair) = sign_rule(
+/// The vortex pair of +½: per run, ω below the axis minus ω above it, at v = ∓1.5R.
+fn vortex_claim(pressure: &str, runs: &[RunStats], np: f64) -> Claim {
+    let pair: Vec<f64> = with(runs, true).map(|r| r.vortex_pair).collect();
+    let (v_pair, why_pair) = sign_rule(
         &pair,
         &format!("counter-rotating vortices on the two sides of the axis in every one of {} runs, clear of 0 by two s.e.", pair.len()),
         "the vortices turn the other way round, by more than two standard errors: flow towards the tail along the axis",
         "runs have the pair turning as extensile self-propulsion makes it",
     );
-        Claim::new(
+    Claim::new(
         format!("9.6 ({pressure} pressure): a +1/2 defect carries a vortex pair, one on each side of its axis"),
         format!(
             "ω(0, −1.5R) − ω(0, +1.5R) per run: {}",
@@ -388,15 +556,12 @@ impl Pooled {
         if np == 0.0 { Verdict::Inconclusive } else { v_pair },
         why_pair,
     )
-    }
+}
 
-    /// −½: no drift of the core (three-fold symmetry forbids one).
-    fn drift_claim(&self, pressure: &str, runs: &[Crops], plus_speed: f64) -> Claim {
-        let nm = self.nm;
-        let per_run = |plus: bool, comp: usize| per_run(runs, plus, comp);
-        let (du, dv) = (per_run(false, 0), per_run(false, 1));
-        let (v_drift, why_drift) = no_drift(&du, &dv, plus_speed);
-        Claim::new(
+/// −½: no drift of the core (three-fold symmetry forbids one).
+fn drift_claim(pressure: &str, nm: f64, du: &[f64], dv: &[f64], plus_speed: f64) -> Claim {
+    let (v_drift, why_drift) = no_drift(du, dv, plus_speed);
+    Claim::new(
         format!("9.6 ({pressure} pressure): a −1/2 defect does not self-propel (its three-fold symmetry forbids a drift)"),
         format!(
             "core (r ≤ R) velocity per run along an arm {}, across {}; +1/2 core speed {}",
@@ -407,24 +572,12 @@ impl Pooled {
         if nm == 0.0 { Verdict::Inconclusive } else { v_drift },
         why_drift,
     )
-    }
-}
-
-/// Each run's mean core velocity (r ≤ R) component `comp` around its +½ (`plus`) or −½
-/// defects, for the runs that have one.
-fn per_run(runs: &[Crops], plus: bool, comp: usize) -> Vec<f64> {
-    runs.iter()
-        .filter(|r| if plus { r.0 > 0.0 } else { r.1 > 0.0 })
-        .map(|r| disc_mean(if plus { &r.2[comp] } else { &r.3[comp] }, R))
-        .collect()
 }
 
 /// The −½ flow is three-fold in every run: m = 3 run by run.
-fn three_fold_each_claim(pressure: &str, runs: &[Crops]) -> Claim {
-    let per_run_modes: Vec<[f64; 5]> = runs
-        .iter()
-        .filter(|r| r.1 > 0.0)
-        .map(|r| ring_modes(&r.3[0], &r.3[1], 1.5 * R))
+fn three_fold_each_claim(pressure: &str, runs: &[RunStats]) -> Claim {
+    let per_run_modes: Vec<[f64; 5]> = with(runs, false)
+        .map(|r| r.ring.map(|(a, b)| a.hypot(b)))
         .collect();
     let three_each = per_run_modes
         .iter()
@@ -571,6 +724,52 @@ fn sign_rule(d: &[f64], holds: &str, fails: &str, counted: &str) -> (Verdict, St
 
 #[cfg(test)]
 mod tests {
+    /// The defect-fields section of docs/reproduction.md states the verdicts of the figure's
+    /// runs, kept in `docs/data/defect-fields/quick/defect_field_runs.csv`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let dir = root.join("docs/data/defect-fields/quick");
+        let want = super::verdicts_from_tables(&dir).unwrap();
+        assert_eq!(want.len(), 12);
+        crate::assert_doc_verdicts("defect-fields", "**Verdicts (quick):**", &want);
+    }
+
+    /// The pooled statistics read from the runs' equal those of the pooled crops: the ring's
+    /// Fourier amplitudes and the pressure at the head, on synthetic crops of two runs.
+    #[test]
+    fn pooling_the_runs_statistics_pools_the_crops() {
+        use super::*;
+        let field = |a: f64, b: f64| -> Vec<f64> {
+            (0..CROP * CROP)
+                .map(|k| {
+                    let (u, v) = ((k / CROP) as f64 - 30.0, (k % CROP) as f64 - 30.0);
+                    a * (0.3 * u).sin() * (0.2 * v).cos() + b * u * v / 900.0
+                })
+                .collect()
+        };
+        let crops = |a: f64, b: f64, n: f64| -> Crops {
+            let comps: Vec<Vec<f64>> = (0..COMPONENTS.len())
+                .map(|c| field(a + c as f64, b - c as f64))
+                .collect();
+            (n, n + 1.0, comps.clone(), comps)
+        };
+        let runs = [crops(1.0, 0.5, 3.0), crops(-0.4, 2.0, 7.0)];
+        let stats: Vec<RunStats> = runs.iter().map(|c| RunStats::of(1, c)).collect();
+        let pool = Pooled::of(&runs);
+        let direct = ring_modes(&pool.minus[0], &pool.minus[1], 1.5 * R);
+        for (m, d) in direct.iter().enumerate() {
+            let from_runs =
+                pooled(&stats, false, |r| r.ring[m].0)
+                    .hypot(pooled(&stats, false, |r| r.ring[m].1));
+            assert!(
+                (from_runs - d).abs() <= 1e-12 * d.abs().max(1e-3),
+                "m = {m}"
+            );
+        }
+        let head = at(&pool.plus[5], -1.5 * R, 0.0);
+        assert!((pooled(&stats, true, |r| r.head_tail[0]) - head).abs() < 1e-12);
+    }
     /// The +½ rule gives each outcome on synthetic per-run core velocities.
     #[test]
     fn the_propulsion_rule_gives_each_outcome() {

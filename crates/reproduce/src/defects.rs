@@ -5,6 +5,7 @@ use render::{Plot, Series};
 
 use super::lengths::{by_value, times, trend, turbulence, PRESSURES, ZETAS};
 use super::pipeline::{cell, sci, Csv, Made, PointRuns};
+use super::rule::Rule;
 use super::{
     g, mean_se, mean_std, AtValue, Claim, Rec, ReproduceParams, SweepResult, Table, Verdict,
 };
@@ -81,9 +82,8 @@ fn map_correlations<S: PartialEq>(maps: &[(S, [f64; BINS * BINS])]) -> Vec<f64> 
 const PAIRING_EFFECT: f64 = 0.1;
 
 /// The verdict on "±½ defects annihilate in pairs" from each run's paired fraction of deaths
-/// `f` and its null expectation `q`: holds when `f − q` exceeds 0 by two s.e.; does not hold when
-/// `f − q` lies below [`PAIRING_EFFECT`] within two s.e.; inconclusive otherwise, and with fewer
-/// than three runs.
+/// `f` and its null expectation `q`: the rule of an effect (issue 54's `Rule`) on the mean of
+/// `f − q` over runs, with [`PAIRING_EFFECT`] counting; inconclusive with fewer than three runs.
 fn annihilate_in_pairs(f: &[f64], q: &[f64]) -> (Verdict, String) {
     if f.len() < 3 {
         return (
@@ -96,34 +96,17 @@ fn annihilate_in_pairs(f: &[f64], q: &[f64]) -> (Verdict, String) {
     }
     let excess: Vec<f64> = f.iter().zip(q).map(|(f, q)| f - q).collect();
     let (e, se) = mean_se(&excess);
-    let what = format!(
-        "the paired fraction of deaths exceeds chance by {} ± {} (s.e.)",
-        g(e),
-        g(se)
-    );
-    if e + 2.0 * se < PAIRING_EFFECT {
-        (
-            Verdict::DoesNotHold,
-            format!("{what}: below {PAIRING_EFFECT} within two s.e."),
-        )
-    } else if e - 2.0 * se > 0.0 {
-        (Verdict::Holds, format!("{what}: more than two s.e."))
-    } else {
-        (Verdict::Inconclusive, what)
-    }
+    let o = Rule::effect("paired fraction of deaths − chance", PAIRING_EFFECT).decide(e, se);
+    (o.verdict, o.why)
 }
 
 /// The verdict on "±½ defects appear in pairs at random places" from each run's paired
 /// fraction of births `f` and its null expectation `q`, and the correlations `r` of the
-/// creation maps of pairs of runs. Pairs: the mean of `f − q` over runs against twice its
-/// standard error, and its upper bound (mean + 2 s.e.) against [`PAIRING_EFFECT`]. Places: the
-/// mean of `r` against twice its standard error (an upper bound
-/// below 0.5 is needed to call them random: with it the test could have seen a strong shared
-/// preference). Holds when births are paired beyond chance and no shared place shows; does not
-/// hold when births are not paired beyond chance (`f − q` below [`PAIRING_EFFECT`] within two
-/// s.e.) or runs
-/// share places (`r` above 0 by two s.e.); inconclusive otherwise, and with fewer than three
-/// runs or three pairs of runs.
+/// creation maps of pairs of runs: the rule of an effect on the mean of `f − q` with
+/// [`PAIRING_EFFECT`] counting (pairs), and the rule of an absence on the mean of `r` with
+/// [`SHARED_PLACES`] counting (random places); holds when both hold, does not hold when one
+/// does not ([`super::rules::all_hold`]); inconclusive with fewer than three runs or three pairs
+/// of runs.
 fn pairs_at_random_places(f: &[f64], q: &[f64], r: &[f64]) -> (Verdict, String) {
     if f.len() < 3 || r.len() < 3 {
         return (
@@ -138,47 +121,24 @@ fn pairs_at_random_places(f: &[f64], q: &[f64], r: &[f64]) -> (Verdict, String) 
     let excess: Vec<f64> = f.iter().zip(q).map(|(f, q)| f - q).collect();
     let (e, e_se) = mean_se(&excess);
     let (rm, r_se) = mean_se(r);
-    let paired = e - 2.0 * e_se > 0.0;
-    let unpaired = e + 2.0 * e_se < PAIRING_EFFECT;
-    let shared = rm - 2.0 * r_se > 0.0;
-    let random = !shared && rm + 2.0 * r_se < 0.5;
-    let pairs = format!(
-        "the paired fraction exceeds chance by {} ± {} (s.e.)",
-        g(e),
-        g(e_se)
-    );
-    let places = format!(
-        "the creation maps of two runs correlate by {} ± {} (s.e.)",
-        g(rm),
-        g(r_se)
-    );
-    if unpaired {
-        (
-            Verdict::DoesNotHold,
-            format!("births are not paired beyond chance: {pairs}, below {PAIRING_EFFECT} within two s.e."),
-        )
-    } else if shared {
-        (
-            Verdict::DoesNotHold,
-            format!("runs share preferred places: {places}, above 0 by more than two s.e."),
-        )
-    } else if paired && random {
-        (
-            Verdict::Holds,
-            format!("{pairs}, more than two s.e.; {places}, within two s.e. of 0 and below 0.5"),
-        )
-    } else {
-        (
-            Verdict::Inconclusive,
-            format!("{pairs}; {places}: not beyond two s.e. either way"),
-        )
-    }
+    let pairs = Rule::effect("paired fraction of births − chance", PAIRING_EFFECT).decide(e, e_se);
+    let places =
+        Rule::absence("correlation of two runs' creation maps", SHARED_PLACES).decide(rm, r_se);
+    let verdict = super::rules::all_hold([pairs.verdict, places.verdict]);
+    (
+        verdict,
+        format!("pairs: {}; places: {}", pairs.why, places.why),
+    )
 }
+
+/// The correlation of two runs' creation maps that counts as shared places: ½.
+const SHARED_PLACES: f64 = 0.5;
 
 /// The figure's tables, plots and claims for one pressure form.
 fn one_form(
     p: &ReproduceParams,
     made: &mut Made,
+    runs_csv: &mut Csv,
     zeta: &SweepResult,
     points: &[PointRuns],
     pressure: &str,
@@ -223,22 +183,16 @@ fn one_form(
     for &(x, y) in &events.creations {
         counts[bin(x, y)] += 1;
     }
-    let correlations = map_correlations(&events.maps);
-    let (v_pairs, why_pairs) =
-        pairs_at_random_places(&events.fractions, &events.nulls, &correlations);
     let mut pos_csv = Csv::new(&["bin_x", "bin_y", "creations"]);
     for (k, c) in counts.iter().enumerate() {
         pos_csv.row([cell(k / BINS), cell(k % BINS), cell(c)]);
     }
     made.add_table(format!("creation_positions_{pressure}.csv"), pos_csv);
 
-    Ok(events.claims(
-        pressure,
-        &density,
-        &rate,
-        &correlations,
-        (v_pairs, why_pairs),
-    ))
+    for run in &events.runs {
+        runs_csv.row(run.row(pressure));
+    }
+    Ok(events.claims(pressure, &density, &rate))
 }
 
 /// The defect density and the creation rate against ζ at one pressure form: their table and
@@ -294,7 +248,9 @@ struct Events {
     frames: usize,
     charged: usize,
     max_charge: f64,
+    /// Where the pairs were created (for the table of positions).
     creations: Vec<(f64, f64)>,
+    n_creations: usize,
     unpaired: f64,
     fractions: Vec<f64>,
     nulls: Vec<f64>,
@@ -302,9 +258,158 @@ struct Events {
     d_fractions: Vec<f64>,
     d_nulls: Vec<f64>,
     annihilations: usize,
+    /// Each run's events, for `defect_runs.csv`.
+    runs: Vec<RunEvents>,
+}
+
+/// What one run adds to [`Events`]: a row of `defect_runs.csv`.
+#[derive(Debug, Clone, PartialEq)]
+struct RunEvents {
+    zeta: String,
+    seed: u64,
+    frames: usize,
+    charged: usize,
+    max_charge: f64,
+    unpaired: f64,
+    /// ζ > 0: its creations, annihilations, pairing and map count.
+    active: bool,
+    creations: usize,
+    annihilations: usize,
+    /// The paired fraction of births and its null, where it had births.
+    births: Option<(f64, f64)>,
+    /// The same of deaths.
+    deaths: Option<(f64, f64)>,
+    map: [f64; BINS * BINS],
+}
+
+/// The columns of `defect_runs.csv`.
+const RUN_COLUMNS: [&str; 16] = [
+    "pressure",
+    "zeta",
+    "seed",
+    "frames",
+    "charged_frames",
+    "max_charge",
+    "unpaired",
+    "active",
+    "creations",
+    "annihilations",
+    "births_paired",
+    "births_chance",
+    "deaths_paired",
+    "deaths_chance",
+    "map",
+    "bins",
+];
+
+impl RunEvents {
+    fn row(&self, pressure: &str) -> Vec<String> {
+        let pair = |p: Option<(f64, f64)>| {
+            let (f, q) = p.unwrap_or((f64::NAN, f64::NAN));
+            [sci(f), sci(q)]
+        };
+        [
+            cell(pressure),
+            cell(&self.zeta),
+            cell(self.seed),
+            cell(self.frames),
+            cell(self.charged),
+            cell(self.max_charge),
+            cell(self.unpaired),
+            cell(self.active),
+            cell(self.creations),
+            cell(self.annihilations),
+        ]
+        .into_iter()
+        .chain(pair(self.births))
+        .chain(pair(self.deaths))
+        .chain([
+            self.map
+                .iter()
+                .map(|v| v.to_string())
+                .collect::<Vec<_>>()
+                .join(" "),
+            cell(BINS),
+        ])
+        .collect()
+    }
+
+    /// The runs of `pressure` in a table that [`RunEvents::row`] wrote.
+    #[cfg(test)]
+    fn from_table(t: &Table, pressure: &str) -> Result<Vec<Self>, SweepError> {
+        let c = |n: &str| t.col(n);
+        let bad = |k: usize, what: &str| SweepError::Reproduce {
+            why: format!("{}: row {}: {what}", t.path.display(), k + 1),
+        };
+        let (pc, zc, sc, fc, cc, mc, uc, ac) = (
+            c("pressure")?,
+            c("zeta")?,
+            c("seed")?,
+            c("frames")?,
+            c("charged_frames")?,
+            c("max_charge")?,
+            c("unpaired")?,
+            c("active")?,
+        );
+        let (crc, anc, mapc) = (c("creations")?, c("annihilations")?, c("map")?);
+        let (bf, bq, df, dq) = (
+            t.f64s("births_paired")?,
+            t.f64s("births_chance")?,
+            t.f64s("deaths_paired")?,
+            t.f64s("deaths_chance")?,
+        );
+        let pair = |f: f64, q: f64| f.is_finite().then_some((f, q));
+        let mut out = Vec::new();
+        for (k, row) in t.rows.iter().enumerate().filter(|(_, r)| r[pc] == pressure) {
+            let n = |col: usize, what: &str| -> Result<f64, SweepError> {
+                row[col].parse().map_err(|_| bad(k, what))
+            };
+            let mut map = [0.0; BINS * BINS];
+            for (m, v) in map.iter_mut().zip(row[mapc].split(' ')) {
+                *m = v.parse().map_err(|_| bad(k, "map"))?;
+            }
+            out.push(Self {
+                zeta: row[zc].clone(),
+                seed: n(sc, "seed")? as u64,
+                frames: n(fc, "frames")? as usize,
+                charged: n(cc, "charged_frames")? as usize,
+                max_charge: n(mc, "max_charge")?,
+                unpaired: n(uc, "unpaired")?,
+                active: row[ac] == "true",
+                creations: n(crc, "creations")? as usize,
+                annihilations: n(anc, "annihilations")? as usize,
+                births: pair(bf[k], bq[k]),
+                deaths: pair(df[k], dq[k]),
+                map,
+            });
+        }
+        Ok(out)
+    }
 }
 
 impl Events {
+    /// Adds one run's events.
+    fn push(&mut self, e: RunEvents) {
+        self.frames += e.frames;
+        self.charged += e.charged;
+        self.max_charge = self.max_charge.max(e.max_charge);
+        self.unpaired += e.unpaired;
+        if e.active {
+            self.n_creations += e.creations;
+            self.annihilations += e.annihilations;
+            if let Some((f, q)) = e.births {
+                self.fractions.push(f);
+                self.nulls.push(q);
+            }
+            if let Some((f, q)) = e.deaths {
+                self.d_fractions.push(f);
+                self.d_nulls.push(q);
+            }
+            self.maps.push((e.seed, e.map));
+        }
+        self.runs.push(e);
+    }
+
     /// Adds the run `r`: its rows of the table in time, its series of the density (seed 1)
     /// and net-charge plots, and its events.
     fn add(
@@ -314,19 +419,6 @@ impl Events {
         time_csv: &mut Csv,
         [pt, pq]: [&mut Plot; 2],
     ) -> Result<(), SweepError> {
-        let Self {
-            frames,
-            charged,
-            max_charge,
-            creations,
-            unpaired,
-            fractions,
-            nulls,
-            maps,
-            d_fractions,
-            d_nulls,
-            annihilations,
-        } = self;
         let t = Table::read(&r.run.join("analysis/observables.csv"))?;
         let (time, np, nm, dens, net, un) = (
             t.f64s("time")?,
@@ -336,6 +428,20 @@ impl Events {
             t.f64s("net_charge")?,
             t.f64s("unpaired")?,
         );
+        let mut run = RunEvents {
+            zeta: r.values[1].clone(),
+            seed: r.seed,
+            frames: 0,
+            charged: 0,
+            max_charge: 0.0,
+            unpaired: un.iter().filter(|x| x.is_finite()).sum::<f64>(),
+            active: r.values[1].parse::<f64>().unwrap_or(0.0) > 0.0,
+            creations: 0,
+            annihilations: 0,
+            births: None,
+            deaths: None,
+            map: [0.0; BINS * BINS],
+        };
         for k in 0..time.len() {
             time_csv.row([
                 cell(&r.values[1]),
@@ -346,13 +452,12 @@ impl Events {
                 sci(dens[k]),
                 cell(net[k]),
             ]);
-            *frames += 1;
+            run.frames += 1;
             if net[k] != 0.0 {
-                *charged += 1;
+                run.charged += 1;
             }
-            *max_charge = max_charge.max(net[k].abs());
+            run.max_charge = run.max_charge.max(net[k].abs());
         }
-        *unpaired += un.iter().filter(|x| x.is_finite()).sum::<f64>();
         if r.seed == p.scale.seeds().first {
             pt.series
                 .push(Series::new(format!("ζ = {}", r.values[1])).with_points(
@@ -370,50 +475,39 @@ impl Events {
             .with_points(&time, &net, &vec![0.0; time.len()])
             .markers_only(),
         );
-        if r.values[1].parse::<f64>().unwrap_or(0.0) > 0.0 {
+        if run.active {
             let ev = Table::read(&r.run.join("analysis/defect_events.csv"))?;
             let (kind, x, y) = (ev.strs("kind")?, ev.f64s("x")?, ev.f64s("y")?);
-            let mut map = [0.0f64; BINS * BINS];
             let (mut born, mut ended) = (0.0, 0.0);
             for k in 0..kind.len() {
                 if kind[k] == "creation" {
-                    creations.push((x[k], y[k]));
-                    map[bin(x[k], y[k])] += 1.0;
+                    self.creations.push((x[k], y[k]));
+                    run.map[bin(x[k], y[k])] += 1.0;
+                    run.creations += 1;
                     born += 1.0;
                 } else if kind[k] == "annihilation" {
                     ended += 1.0;
-                    *annihilations += 1;
+                    run.annihilations += 1;
                 }
             }
-            let run_unpaired: f64 = un.iter().filter(|x| x.is_finite()).sum();
-            if let Some((f, q)) = pairing(born, run_unpaired, time.len(), BOX * BOX, RADIUS) {
-                fractions.push(f);
-                nulls.push(q);
-            }
+            run.births = pairing(born, run.unpaired, time.len(), BOX * BOX, RADIUS);
             // Deaths: half of the unpaired events are deaths, as for births.
-            if let Some((f, q)) = pairing(ended, run_unpaired, time.len(), BOX * BOX, RADIUS) {
-                d_fractions.push(f);
-                d_nulls.push(q);
-            }
-            maps.push((r.seed, map));
+            run.deaths = pairing(ended, run.unpaired, time.len(), BOX * BOX, RADIUS);
         }
+        self.push(run);
         Ok(())
     }
 
     /// The claims of §9.5 at one pressure form.
-    fn claims(
-        &self,
-        pressure: &str,
-        density: &[AtValue],
-        rate: &[AtValue],
-        correlations: &[f64],
-        (v_pairs, why_pairs): (Verdict, String),
-    ) -> Vec<Claim> {
+    fn claims(&self, pressure: &str, density: &[AtValue], rate: &[AtValue]) -> Vec<Claim> {
+        let correlations = &map_correlations(&self.maps)[..];
+        let (v_pairs, why_pairs) =
+            pairs_at_random_places(&self.fractions, &self.nulls, correlations);
         let Self {
             frames,
             charged,
             max_charge,
-            creations,
+            n_creations,
             unpaired,
             fractions,
             nulls,
@@ -447,7 +541,7 @@ impl Events {
             format!("9.5 ({pressure} pressure): ±1/2 defects appear in pairs at random places"),
             format!(
                 "{} pair creations at ζ > 0, {} births or deaths without a partner within 2R; paired fraction of births {} ± {} (s.e. over {} runs) against {} ± {} for independent births at the same rate; creation maps ({BINS}×{BINS} bins) of two runs of different seeds correlate by r = {} ± {} (s.e. over {} pairs of runs, an underestimate, since the pairs share runs)",
-                creations.len(),
+                n_creations,
                 unpaired,
                 g(mean_se(fractions).0),
                 g(mean_se(fractions).1),
@@ -504,15 +598,24 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let points = zeta.points(None)?;
     let mut made = Made::new(Vec::new(), String::new());
     let mut claims = Vec::new();
+    let mut runs_csv = Csv::new(&RUN_COLUMNS);
     for pressure in PRESSURES {
-        claims.extend(one_form(p, &mut made, &zeta, &points, pressure)?);
+        claims.extend(one_form(
+            p,
+            &mut made,
+            &mut runs_csv,
+            &zeta,
+            &points,
+            pressure,
+        )?);
     }
+    made.add_table("defect_runs.csv", runs_csv);
     let (t, from) = times(p.scale);
     let settings = format!(
         "- The ζ sweep of `reproduce lengths` (L = 200, 240 cells, γ = 0.01, both pressure forms, ζ ∈ {{{}}}, seeds {}), 200 TU of relaxation then {t} TU; frames every 10 TU analysed from t = {from}.\n\
          - Defects: ±1/2 of the box-smoothed Q (3R box); tracked between frames (links within R), births and deaths paired within 2R into creations and annihilations. Density = defects per node; creation rate = pair creations per node per TU, averaged over the frames.\n\
          - In pairs at random places (per active run, then over runs): the paired fraction of births `2C / (2C + U/2)` (C creations, U unpaired births and deaths, half of them births) against independent births at the same rate, `1 − exp(−(b/2) π (2R)² / L²)` with b births per frame; and the Pearson correlation of the creation counts in {BINS}×{BINS} bins between every two runs of different seeds (runs of one seed share their starting packing; near 0 for random places, positive for places the runs share). Holds: the paired excess above 0 by two s.e. and the correlation within two s.e. of 0 and below 0.5; does not hold: the paired excess below 0.1 within two s.e., or the correlation above 0 by two s.e.; otherwise inconclusive.\n\
-         - Files (one of each per pressure form, `_paper` and `_interaction`): `defects_vs_zeta_*.csv`, `defects_in_time_*.csv`, `creation_positions_*.csv`, `defect_density_vs_zeta_*.png`, `creation_rate_vs_zeta_*.png`, `defect_density_in_time_*.png`, `net_charge_in_time_*.png`.",
+         - Files (one of each per pressure form, `_paper` and `_interaction`): `defects_vs_zeta_*.csv`, `defects_in_time_*.csv`, `defect_runs.csv` (each run's frames, charges and events, both forms), `creation_positions_*.csv`, `defect_density_vs_zeta_*.png`, `creation_rate_vs_zeta_*.png`, `defect_density_in_time_*.png`, `net_charge_in_time_*.png`.",
         ZETAS.join(", "),
         p.scale.seeds()
     );
@@ -521,9 +624,52 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     Ok(made)
 }
 
+/// The claims of the figure's tables kept in `dir` (`defect_runs.csv` and
+/// `defects_vs_zeta_*.csv`), as [`make`] gives them.
+#[cfg(test)]
+fn verdicts_from_tables(dir: &std::path::Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let runs = Table::read(&dir.join("defect_runs.csv"))?;
+    let mut out = Vec::new();
+    for pressure in PRESSURES {
+        let t = Table::read(&dir.join(format!("defects_vs_zeta_{pressure}.csv")))?;
+        let (z, seeds) = (t.f64s("zeta")?, t.f64s("seeds")?);
+        let at = |m: &str, s: &str| -> Result<Vec<AtValue>, SweepError> {
+            let (m, s) = (t.f64s(m)?, t.f64s(s)?);
+            Ok((0..z.len())
+                .map(|k| (z[k], (m[k], s[k]), seeds[k] as usize))
+                .collect())
+        };
+        let (density, rate) = (
+            at("defect_density", "defect_density_std")?,
+            at("creation_rate", "creation_rate_std")?,
+        );
+        let mut events = Events::default();
+        for run in RunEvents::from_table(&runs, pressure)? {
+            events.push(run);
+        }
+        out.extend(
+            events
+                .claims(pressure, &density, &rate)
+                .into_iter()
+                .map(|c| (c.claim, c.verdict)),
+        );
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The defects section of docs/reproduction.md states the verdicts of the figure's runs,
+    /// kept in `docs/data/defects/quick/`.
+    #[test]
+    fn the_docs_state_the_verdicts_of_the_stored_tables() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let want = verdicts_from_tables(&root.join("docs/data/defects/quick")).unwrap();
+        assert_eq!(want.len(), 10);
+        crate::assert_doc_verdicts("defects", "**Verdicts (quick):**", &want);
+    }
 
     /// The 9.5 rule gives each outcome on synthetic statistics.
     #[test]
