@@ -121,6 +121,9 @@ struct Form {
     refined: Vec<WaveThreshold>,
     /// The 83 × 120 box's threshold by Arnoldi on the whole box (the stability figure's way).
     whole_box: Option<(f64, f64)>,
+    /// The infinite tissue's wave at half the time step and on a grid twice as fine, as
+    /// `(ζ_cr, error, unstable at rest)`.
+    systematics: Option<[(f64, f64, bool); 2]>,
 }
 
 impl Form {
@@ -181,17 +184,82 @@ fn waves_kept(
     pressure: PressureKind,
     qs: &[[f64; 2]],
 ) -> Result<Vec<WaveThreshold>, SweepError> {
-    let opts = wave_opts(pressure);
     let file = dir.join(format!("{name}-{}.toml", pressure_name(pressure)));
+    let (params, opts) = (params(pressure), wave_opts(pressure));
+    waves_kept_with(&file, tiling, &params, &opts, qs, pressure_name(pressure))
+}
+
+/// The waves of `qs` on `tiling` with `params` and `opts`, kept in `file`.
+fn waves_kept_with(
+    file: &Path,
+    tiling: &BlochTiling,
+    params: &ModelParams,
+    opts: &WaveOptions,
+    qs: &[[f64; 2]],
+    what: &str,
+) -> Result<Vec<WaveThreshold>, SweepError> {
     let fingerprint = format!("{qs:?} {opts:?} {:?} {:?}", tiling.primitive, tiling.reps);
-    let w = match kept::<Vec<WaveThreshold>>(&file, &fingerprint) {
+    let w = match kept::<Vec<WaveThreshold>>(file, &fingerprint) {
         // Completed by today's refinement (nothing to do for a wave it would leave as it is),
         // and rebuilt from the points, so that the threshold and its error are today's rule's.
-        Some(w) => refine_waves(tiling, &params(pressure), w, &opts),
-        None => wave_thresholds(tiling, &params(pressure), qs, &opts),
+        Some(w) => refine_waves(tiling, params, w, opts),
+        None => wave_thresholds(tiling, params, qs, opts),
     }
-    .map_err(|e| failed(pressure_name(pressure), e))?;
-    keep(&file, &fingerprint, w)
+    .map_err(|e| failed(what, e))?;
+    keep(file, &fingerprint, w)
+}
+
+/// Discretisation (issue 54): the infinite tissue's wave `q` again at half the time step (the
+/// same τ) and on a grid twice as fine (every length 2× in nodes,
+/// [`super::systematics::finer_params`], the rest state relaxed again with margin 32), each
+/// kept in `dir`: `(dt/2, grid/2)`.
+fn systematics(
+    dir: &Path,
+    tiling: &BlochTiling,
+    pressure: PressureKind,
+    q: [f64; 2],
+) -> Result<(WaveThreshold, WaveThreshold), SweepError> {
+    let pn = pressure_name(pressure);
+    let opts = wave_opts(pressure);
+    let half = WaveOptions {
+        step: StepParams::new(opts.step.dt / 2.0, 1),
+        steps: 2 * opts.steps,
+        ..opts
+    };
+    let dt = waves_kept_with(
+        &dir.join(format!("dt-half-{pn}.toml")),
+        tiling,
+        &params(pressure),
+        &half,
+        &[q],
+        &format!("{pn} form at dt/2"),
+    )?;
+    let fine_params = super::systematics::finer_params(&params(pressure));
+    let coarse = primitive();
+    let fine_box = HexBox {
+        lx: 2 * coarse.lx,
+        ly: 2 * coarse.ly,
+        ..coarse
+    };
+    let relax = Relaxation {
+        margin: 32,
+        ..Relaxation::default()
+    };
+    let fine = BlochTiling::relax(fine_box, tiling.reps, &fine_params, &relax)
+        .map_err(|e| failed(&format!("{pn} form on the finer grid"), e))?;
+    let grid = waves_kept_with(
+        &dir.join(format!("grid-half-{pn}.toml")),
+        &fine,
+        &fine_params,
+        &opts,
+        &[q],
+        &format!("{pn} form on the finer grid"),
+    )?;
+    let one = |mut v: Vec<WaveThreshold>| {
+        v.pop()
+            .ok_or_else(|| failed(pn, StabilityError::Packing("no wave".into())))
+    };
+    Ok((one(dt)?, one(grid)?))
 }
 
 /// The longest waves along each axis, at half the grid's spacing from q = 0: where the
@@ -250,13 +318,25 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> 
         p.reporter
             .stage(&format!("bloch, {pn} form: the 83 × 120 box by Arnoldi"));
         let whole_box = whole_box(&done, &tiling, pressure)?;
-        forms.push(Form {
+        let mut form = Form {
             pressure,
-            tiling: Some(tiling),
+            tiling: None,
             waves,
             refined,
             whole_box,
-        });
+            systematics: None,
+        };
+        if let Some((w, _)) = infinite(&form) {
+            p.reporter.stage(&format!(
+                "bloch, {pn} form: the wave q = {:?} at dt/2 and on a grid twice as fine",
+                w.q
+            ));
+            let (a, b) = systematics(&done, &tiling, pressure, w.q)?;
+            let of = |w: &WaveThreshold| (w.zeta_cr, w.err, w.unstable_at_rest());
+            form.systematics = Some([of(&a), of(&b)]);
+        }
+        form.tiling = Some(tiling);
+        forms.push(form);
     }
     let mut made = Made::new(Vec::new(), String::new());
     tables(&mut made, &forms);
@@ -398,6 +478,74 @@ fn tables(made: &mut Made, forms: &[Form]) {
         }
     }
     made.add_table("thresholds.csv", th);
+    let mut sys = Csv::new(&[
+        "pressure",
+        "case",
+        "zeta_cr",
+        "zeta_cr_err",
+        "unstable_at_rest",
+    ]);
+    for f in forms {
+        for (case, (z, e, u)) in SYSTEMATIC_CASES.iter().zip(f.systematics.iter().flatten()) {
+            sys.row([
+                cell(pressure_name(f.pressure)),
+                cell(case),
+                sci(*z),
+                sci(*e),
+                cell(u),
+            ]);
+        }
+    }
+    made.add_table("systematics.csv", sys);
+}
+
+/// The cases of `systematics.csv`, in the order of [`Form::systematics`].
+const SYSTEMATIC_CASES: [&str; 2] = ["dt/2", "grid/2"];
+
+/// Discretisation (issue 54): the infinite tissue's wave at half the time step and on a grid
+/// twice as fine, each shift of its ζ_cr over the 83 × 120 box's threshold (the scale of this
+/// figure's thresholds; the infinite tissue's is near 0) by the rule of an absence with
+/// [`super::systematics::SHIFT`] counting; holds when both hold.
+fn discretisation_claim(f: &Form) -> Option<Claim> {
+    let pn = pressure_name(f.pressure);
+    let (w, _) = infinite(f)?;
+    let sys = f.systematics?;
+    let scale = f.box_threshold(1)?.zeta_cr;
+    let rule = Rule::absence(
+        "shift of the wave's ζ_cr over ζ_cr(83 × 120)",
+        super::systematics::SHIFT,
+    );
+    let mut outcomes = Vec::new();
+    let mut text = Vec::new();
+    let rest = |u: bool| if u { "grows at rest" } else { "stable at rest" };
+    for (case, (z, e, u)) in SYSTEMATIC_CASES.iter().zip(sys) {
+        let o = rule.decide((z - w.zeta_cr) / scale, e.hypot(w.err) / 2.0 / scale);
+        outcomes.push(super::rule::Outcome {
+            verdict: o.verdict,
+            why: format!("{case}: {}", o.why),
+        });
+        text.push(format!("{case}: {} ± {} ({})", g(z), g(e), rest(u)));
+    }
+    let (v, why) = super::rules::all_of(&outcomes);
+    let total = super::systematics::Systematics {
+        value: w.zeta_cr,
+        stat: w.err / 2.0,
+        dt: sys[0].0 - w.zeta_cr,
+        grid: sys[1].0 - w.zeta_cr,
+    };
+    Some(Claim::new(
+        format!("Discretisation (issue 54, {pn} form): the infinite tissue's threshold moves by less than 20 % of the 83 × 120 box's at half the time step and on a grid twice as fine"),
+        format!(
+            "the wave q = {:?}: {} ({}); {}; ζ_cr(∞) = {}",
+            w.q,
+            g(w.zeta_cr),
+            rest(w.unstable_at_rest()),
+            text.join("; "),
+            total.describe()
+        ),
+        v,
+        why,
+    ))
 }
 
 /// The infinite tissue's threshold: the lowest wave over the grid and its refinement, with an
@@ -567,6 +715,7 @@ fn claims(forms: &[Form]) -> Vec<Claim> {
             let d = (b.zeta_cr - a.zeta_cr) / a.zeta_cr;
             let e = a.err.hypot(b.err) / a.zeta_cr / 2.0;
             let o = rule.decide(d, e);
+            out.extend(discretisation_claim(f));
             out.push(Claim::new(
                 format!("9.2b ({pn} form): ζ_cr does not depend on the box (83 × 120 against 166 × 240, by their waves)"),
                 format!(
@@ -648,6 +797,7 @@ fn forms_from_tables(dir: &Path) -> Result<Vec<Form>, SweepError> {
             waves: Vec::new(),
             refined: Vec::new(),
             whole_box: None,
+            systematics: None,
         };
         for (k, row) in waves.rows.iter().enumerate().filter(|(_, r)| r[wp] == pn) {
             let q = [wqx[k], wqy[k]];
@@ -670,6 +820,22 @@ fn forms_from_tables(dir: &Path) -> Result<Vec<Form>, SweepError> {
         f.whole_box = (0..th.rows.len())
             .find(|&k| th.rows[k][tp] == pn && th.rows[k][what].contains("Arnoldi"))
             .map(|k| (tz[k], te[k]));
+        let sys = super::Table::read(&dir.join("systematics.csv"))?;
+        let (sp, sc, sz, se, su) = (
+            sys.col("pressure")?,
+            sys.col("case")?,
+            sys.f64s("zeta_cr")?,
+            sys.f64s("zeta_cr_err")?,
+            sys.col("unstable_at_rest")?,
+        );
+        let case = |name: &str| {
+            (0..sys.rows.len())
+                .find(|&k| sys.rows[k][sp] == pn && sys.rows[k][sc] == name)
+                .map(|k| (sz[k], se[k], sys.rows[k][su] == "true"))
+        };
+        f.systematics = case(SYSTEMATIC_CASES[0])
+            .zip(case(SYSTEMATIC_CASES[1]))
+            .map(|(a, b)| [a, b]);
         forms.push(f);
     }
     Ok(forms)
@@ -689,7 +855,7 @@ mod tests {
             .into_iter()
             .map(|c| (c.claim, c.verdict))
             .collect();
-        assert_eq!(want.len(), 6);
+        assert_eq!(want.len(), 8);
         crate::assert_doc_verdicts("bloch", "**Verdicts (quick):**", &want);
     }
 
@@ -748,12 +914,20 @@ mod tests {
             if at_rest { -5e-4 } else { 3.5e-4 },
             0.03,
         )];
+        // The infinite tissue's wave again: a shift of 1e-6 at dt/2, and on the finer grid
+        // 1e-6 (the paper form) or 2e-4, half the box's threshold (the interaction form).
+        let lowest = lowest(waves.iter().chain(&refined)).map_or(0.0, |w| w.zeta_cr);
+        let grid_shift = if at_rest { 1e-6 } else { 2e-4 };
         Form {
             pressure,
             tiling: Some(tiling),
             waves,
             refined,
             whole_box: Some((6e-4, 1e-5)),
+            systematics: Some([
+                (lowest + 1e-6, 1e-6, at_rest),
+                (lowest + grid_shift, 1e-6, at_rest),
+            ]),
         }
     }
 
@@ -771,7 +945,7 @@ mod tests {
         let mut made = Made::new(Vec::new(), String::new());
         tables(&mut made, &forms);
         draw(&mut made, &forms);
-        assert_eq!(made.tables.len(), 3);
+        assert_eq!(made.tables.len(), 4);
         assert_eq!(made.plots.len(), 4);
         let claims = claims(&forms);
         let verdict = |what: &str, form: &str| {
@@ -792,6 +966,9 @@ mod tests {
         assert!((inf.zeta_cr - 3.5e-4).abs() < 1e-12, "{}", inf.zeta_cr);
         // Both boxes have q = 0, their lowest wave here: the same threshold, so no box effect.
         assert_eq!(verdict("9.2b", "paper"), Verdict::Holds);
+        // Discretisation: shifts of 1e-6 against the box's 4e-4 hold; 2e-4 does not.
+        assert_eq!(verdict("Discretisation", "paper"), Verdict::Holds);
+        assert_eq!(verdict("Discretisation", "interaction"), Verdict::DoesNotHold);
     }
 
     /// `q` and `−q`, and `q` plus a reciprocal vector, fold to the same wave.

@@ -281,7 +281,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> 
     translations(dir, &mut made, &rows, &rests, &key)?;
     p.reporter
         .stage("stability: convergence in dt, margin, Krylov dimension and ε");
-    let convergence = convergence(dir, &mut made, &rows, &plan, &rests, &key)?;
+    let (convergence, discretisation) = convergence(dir, &mut made, &rows, &plan, &rests, &key)?;
     p.reporter.stage("stability: pictures");
     draw(&mut made, &rows);
     if let Some(row) = rows
@@ -299,6 +299,7 @@ pub(super) fn make(p: &ReproduceParams, dir: &Path) -> Result<Made, SweepError> 
         .stage("stability: an isolated cell under activity");
     let measured: Vec<Measured> = rows.iter().map(Measured::of).collect();
     let mut claims = claims(&measured);
+    claims.extend(discretisation);
     claims.push(isolated_cell()?);
     made.settings = settings(p.scale, &plan, &rests, &convergence);
     made.claims = claims;
@@ -494,7 +495,8 @@ struct Conv {
 }
 
 /// σ at the Arnoldi ζ_cr of γ = 0.01, 6 × 10, paper form, as each numerical parameter changes;
-/// the shift of ζ_cr it implies is Δσ over the slope dσ/dζ.
+/// the shift of ζ_cr it implies is −Δσ over the slope dσ/dζ (σ ≈ slope·(ζ − ζ_cr): a σ lower
+/// by Δ at the same ζ puts the threshold higher by Δ/slope).
 fn convergence(
     dir: &Path,
     made: &mut Made,
@@ -502,7 +504,7 @@ fn convergence(
     plan: &Plan,
     rests: &BTreeMap<String, RestState>,
     key: &dyn Fn(&Config) -> String,
-) -> Result<Vec<Conv>, SweepError> {
+) -> Result<(Vec<Conv>, Option<Claim>), SweepError> {
     let reference = rows.iter().find(|r| {
         r.method == "arnoldi"
             && r.config.gamma == 0.01
@@ -510,7 +512,7 @@ fn convergence(
             && r.config.pressure == PressureKind::Paper
     });
     let Some((config, Ok(t))) = reference.map(|r| (r.config, &r.result)) else {
-        return Ok(Vec::new());
+        return Ok((Vec::new(), None));
     };
     let zeta = t.zeta_cr;
     let base = plan.arnoldi_opts;
@@ -561,6 +563,14 @@ fn convergence(
                 eps: base.eps * 10.0,
                 ..base
             },
+        ), // Half the time step (issue 54's systematics); last, so that the kept cases above keep
+        // their files.
+        (
+            format!("dt {} (τ the same)", DT / 2.0),
+            DT / 2.0,
+            16,
+            STEPS * 2,
+            base,
         ),
     ];
     let done = dir.join("configurations");
@@ -598,19 +608,116 @@ fn convergence(
         };
         out.push(keep(&file, &fingerprint, conv)?);
     }
-    let mut csv = Csv::new(&["case", "zeta", "sigma", "sigma_err", "zeta_shift"]);
+    // A grid twice as fine (issue 54): every length doubled in nodes (docs/model.md §12's
+    // scaling, `systematics::finer_params`), the rest state relaxed again on it.
+    let what = "grid twice as fine (R = 16, every length 2× in nodes, margin 32)".to_string();
+    let fine_params = super::systematics::finer_params(&config.params());
+    let fine_hex = HexBox {
+        lx: 2 * config.hex.lx,
+        ly: 2 * config.hex.ly,
+        ..config.hex
+    };
+    let fingerprint =
+        format!("{fine_hex:?} {fine_params:?} ζ {zeta:e} dt {DT} margin 32 steps {STEPS} {base:?}");
+    let file = done.join("convergence-grid.toml");
+    let conv = match kept(&file, &fingerprint) {
+        Some(c) => c,
+        None => {
+            let relax = Relaxation {
+                margin: 32,
+                ..Relaxation::default()
+            };
+            let rest =
+                rest_state(&fine_hex, &fine_params, &relax).map_err(|e| failed(&config, e))?;
+            let mut map = StepMap::new(
+                &rest.tissue,
+                &fine_params.with_zeta(zeta),
+                StepParams::new(DT, 1),
+                STEPS,
+            )
+            .map_err(|e| failed(&config, e))?;
+            let s = stability::arnoldi(&mut map, &base, None).map_err(|e| failed(&config, e))?;
+            keep(
+                &file,
+                &fingerprint,
+                Conv {
+                    what,
+                    sigma: s.sigma(),
+                    err: s.ritz[0].residual,
+                },
+            )?
+        }
+    };
+    out.push(conv);
+    let mut csv = Csv::new(&[
+        "case",
+        "zeta",
+        "sigma",
+        "sigma_err",
+        "zeta_shift",
+        "zeta_shift_err",
+        "slope",
+    ]);
     let reference = out[0].sigma;
+    let ref_err = out[0].err;
     for c in &out {
         csv.row([
-            format!("\"{}\"", c.what),
+            // Without commas: a case is one cell of the table.
+            c.what.replace(", ", "; "),
             sci(zeta),
             sci(c.sigma),
             sci(c.err),
-            sci((c.sigma - reference) / t.slope),
+            sci((reference - c.sigma) / t.slope),
+            sci(c.err.hypot(ref_err) / t.slope.abs()),
+            sci(t.slope),
         ]);
     }
     made.add_table("convergence.csv", csv);
-    Ok(out)
+    let shifts: Vec<(String, f64, f64)> = out
+        .iter()
+        .map(|c| {
+            (
+                c.what.clone(),
+                (reference - c.sigma) / t.slope,
+                c.err.hypot(ref_err) / t.slope.abs(),
+            )
+        })
+        .collect();
+    let claim = claim_discretisation(zeta, t.err, &shifts);
+    Ok((out, claim))
+}
+
+/// The discretisation claim (issue 54) on the reference configuration's ζ_cr (`zeta` ± `stat`)
+/// from the convergence table's shifts `(case, shift, its error)`: the rule of an absence on
+/// each relative shift at the smaller time step and on the grid twice as fine, with
+/// [`super::systematics::SHIFT`] counting; holds when both hold. `None` without both cases.
+fn claim_discretisation(zeta: f64, stat: f64, shifts: &[(String, f64, f64)]) -> Option<Claim> {
+    let find = |prefix: &str| shifts.iter().find(|s| s.0.starts_with(prefix));
+    let (dt, grid) = (find(&format!("dt {} ", DT / 2.0))?, find("grid ")?);
+    let rule = super::rule::Rule::absence("relative shift of ζ_cr", super::systematics::SHIFT);
+    let outcomes: Vec<super::rule::Outcome> = [dt, grid]
+        .iter()
+        .map(|(what, m, e)| {
+            let o = rule.decide(m / zeta, e / zeta);
+            super::rule::Outcome {
+                verdict: o.verdict,
+                why: format!("{what}: {}", o.why),
+            }
+        })
+        .collect();
+    let (v, why) = super::rules::all_of(&outcomes);
+    let sys = super::systematics::Systematics {
+        value: zeta,
+        stat,
+        dt: dt.1,
+        grid: grid.1,
+    };
+    Some(Claim::new(
+        "Discretisation (issue 54): ζ_cr of the 83 × 120 box (γ = 0.01, paper form) moves by less than 20 % at half the time step and on a grid twice as fine",
+        format!("ζ_cr = {}", sys.describe()),
+        v,
+        why,
+    ))
 }
 
 fn draw(made: &mut Made, rows: &[Row]) {
@@ -1176,8 +1283,29 @@ mod tests {
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let rows = measured_from_table(&root.join("docs/data/stability/quick")).unwrap();
+        let dir = root.join("docs/data/stability/quick");
+        let rows = measured_from_table(&dir).unwrap();
         let mut claims = claims(&rows);
+        let reference = rows
+            .iter()
+            .find(|r| {
+                r.method == "arnoldi"
+                    && r.gamma == 0.01
+                    && r.lx == 83
+                    && r.pressure == PressureKind::Paper
+            })
+            .and_then(|r| r.zeta)
+            .unwrap();
+        let conv = crate::Table::read(&dir.join("convergence.csv")).unwrap();
+        let (case, shift, err) = (
+            conv.col("case").unwrap(),
+            conv.f64s("zeta_shift").unwrap(),
+            conv.f64s("zeta_shift_err").unwrap(),
+        );
+        let shifts: Vec<(String, f64, f64)> = (0..conv.rows.len())
+            .map(|k| (conv.rows[k][case].clone(), shift[k], err[k]))
+            .collect();
+        claims.extend(claim_discretisation(reference.0, reference.1, &shifts));
         claims.push(isolated_cell().unwrap());
         let want: Vec<(String, Verdict)> =
             claims.into_iter().map(|c| (c.claim, c.verdict)).collect();

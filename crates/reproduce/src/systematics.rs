@@ -91,6 +91,27 @@ pub(crate) fn finer_grid(text: &str, sets: &[String]) -> Result<Vec<String>, Swe
     Ok(out)
 }
 
+/// The model's parameters on a grid twice as fine, by the table above: the lengths (R, λ) and
+/// γ, κ, ω doubled, μ four times, ξ and ζ kept. For the figures that build a tissue from
+/// [`mechanics::ModelParams`] rather than a scene (`stability`, `bloch`); a box, its cells'
+/// patches (the margin) and the rest state's relaxation double their lengths beside it.
+pub(crate) fn finer_params(p: &mechanics::ModelParams) -> mechanics::ModelParams {
+    let mut f = *p;
+    let e = &mut f.energy;
+    e.radius *= 2.0;
+    e.lambda *= 2.0;
+    e.gamma *= 2.0;
+    e.kappa *= 2.0;
+    e.mu *= 4.0;
+    f.omega *= 2.0;
+    f
+}
+
+/// The smallest relative shift of a critical value at half the time step or on a grid twice
+/// as fine that counts (the rule of an absence): 20 %, below the 30–50 % by which the two
+/// pressure forms' thresholds differ, so that a shift under it leaves the comparisons standing.
+pub(crate) const SHIFT: f64 = 0.2;
+
 /// The override that halves the time step of the scene `text` with `sets`.
 ///
 /// # Errors
@@ -211,6 +232,21 @@ mod tests {
         // the finer one (0.4 %): the refinement converges towards the same physical speed.
         let (e1, e2) = ((v1 / 0.01 - 1.0).abs(), (v2 / 0.02 - 1.0).abs());
         assert!(e1 < 0.02 && e2 < e1, "{v1} {v2}");
+    }
+
+    /// The parameters' scaling is the scenes': the paper scene put on a grid twice as fine
+    /// builds the parameters that [`finer_params`] makes of its own.
+    #[test]
+    fn finer_params_scale_as_finer_scenes() {
+        let sets = vec!["model.gamma=0.006".to_string()];
+        let fine = finer_grid(PAPER_SCENE, &sets).unwrap();
+        let params = |s: &[String]| {
+            scene::Scene::parse(PAPER_SCENE, s)
+                .unwrap()
+                .model_params(0.005)
+        };
+        let coarse = params(&sets);
+        assert_eq!(finer_params(&coarse), params(&[sets, fine].concat()));
     }
 
     #[test]

@@ -987,9 +987,9 @@ fn claim_pressure_form(all: &[Group]) -> Claim {
 
 /// The integrator (issue 11): ζ_cr at L = 100, γ = 0.01 of each form with the default
 /// integrator against the paper's (dt 0.2, margin 12), the relative shift paired by seed
-/// ([`paired_shift`]) by the rule of an absence with [`DISCRETISATION`] counting; holds when both forms hold.
+/// ([`paired_shift`]) by the rule of an absence with [`super::systematics::SHIFT`] counting; holds when both forms hold.
 fn claim_integrator(all: &[Group], compare: &[Group]) -> Claim {
-    let rule = super::rule::Rule::absence("relative shift of ζ_cr", DISCRETISATION);
+    let rule = super::rule::Rule::absence("relative shift of ζ_cr", super::systematics::SHIFT);
     let (mut text, mut outcomes) = (Vec::new(), Vec::new());
     for c in compare {
         let Some(d) = all
@@ -1039,18 +1039,14 @@ fn paired_shift(base: &Group, other: &Group) -> (f64, f64, usize) {
     (m, se, diffs.len())
 }
 
-/// The largest shift of ζ_cr that counts, relative to ζ_cr: 20 %, below the 30–50 % by which
-/// the two pressure forms differ, so that a shift under it leaves the comparisons standing.
-const DISCRETISATION: f64 = 0.2;
-
 /// Systematics (issue 54): ζ_cr at L = 100, γ = 0.01 of each form (the seed mean of the
 /// per-seed thresholds) against the same at half the time step and on a grid twice as fine,
-/// each shift paired by seed ([`paired_shift`]). Each relative shift by the rule of an absence with [`DISCRETISATION`] counting; holds when
+/// each shift paired by seed ([`paired_shift`]). Each relative shift by the rule of an absence with [`super::systematics::SHIFT`] counting; holds when
 /// every shift holds, does not hold when one does not, inconclusive otherwise. ζ_cr is given
 /// with the shifts added to its error. Common to every group, a relative shift leaves the
 /// comparisons between boxes and γ (ratios, slopes through the origin, linearity) as they are.
 fn claim_discretisation(all: &[Group], systematic: &[Group]) -> Claim {
-    let rule = super::rule::Rule::absence("relative shift of ζ_cr", DISCRETISATION);
+    let rule = super::rule::Rule::absence("relative shift of ζ_cr", super::systematics::SHIFT);
     let (mut text, mut outcomes) = (Vec::new(), Vec::new());
     for pressure in PRESSURES {
         let Some(base) = all
