@@ -968,7 +968,10 @@ mod tests {
         assert_eq!(verdict("9.2b", "paper"), Verdict::Holds);
         // Discretisation: shifts of 1e-6 against the box's 4e-4 hold; 2e-4 does not.
         assert_eq!(verdict("Discretisation", "paper"), Verdict::Holds);
-        assert_eq!(verdict("Discretisation", "interaction"), Verdict::DoesNotHold);
+        assert_eq!(
+            verdict("Discretisation", "interaction"),
+            Verdict::DoesNotHold
+        );
     }
 
     /// `q` and `−q`, and `q` plus a reciprocal vector, fold to the same wave.

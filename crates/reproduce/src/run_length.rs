@@ -148,12 +148,11 @@ pub(crate) fn chi2_99(dof: usize) -> f64 {
 /// the limit zero `a T^(−b)`, and the smallest threshold measured `floor`:
 /// - inconclusive when the free fit fails its goodness of fit (χ² above its 99 % point) or
 ///   there is no fit;
-/// - holds (a finite limit) when `ζ_∞ − 2 err > 0` and the zero-limit fit is worse by
-///   `Δχ² ≥ 4` (the limit 0 excluded at two standard errors);
-/// - does not hold (the limit is zero) when `ζ_∞ + 2 err ≤ 0`, or when the zero-limit fit
-///   passes its goodness of fit, the free fit improves on it by `Δχ² < 1`, and the free fit
-///   bounds the limit below half the smallest threshold measured (`ζ_∞ + 2 err < floor/2`);
-/// - inconclusive otherwise.
+/// - otherwise the rule of an effect (issue 54's `Rule`) on `ζ_∞ ± err` with `floor/2`
+///   counting: holds (a finite limit) when `ζ_∞` is resolved by two errors and at least
+///   `floor/2`, and the zero-limit fit is worse by `Δχ² ≥ 4` (inconclusive when it is not);
+///   does not hold (the limit is at most half the smallest threshold measured, zero for this
+///   protocol) when `ζ_∞ + 2 err < floor/2`; inconclusive otherwise.
 pub(crate) fn rule_finite(
     fit: Option<&PowerFit>,
     zero: Option<&ZeroFit>,
@@ -193,30 +192,36 @@ pub(crate) fn rule_finite(
             format!("{what}: the free fit fails its goodness of fit (or has no degree of freedom left), so its ζ_∞ says nothing"),
         );
     }
-    let zero_fits = zero.is_some_and(|z| z.dof > 0 && z.chi2 <= chi2_99(z.dof));
-    if f.zeta_inf - 2.0 * f.zeta_inf_err > 0.0 && delta >= 4.0 {
-        (
+    // The limit by the rule of an effect (issue 54's `Rule`): ζ_∞ with its error as the
+    // standard error, half the smallest threshold measured counting.
+    let o = super::rule::Rule::effect("ζ_∞ of the free fit", floor / 2.0)
+        .decide(f.zeta_inf, f.zeta_inf_err);
+    match o.verdict {
+        Verdict::Holds if delta >= 4.0 => (
             Verdict::Holds,
-            format!("{what}: ζ_∞ > 0 by more than 2 errors, and the limit 0 fits worse by Δχ² ≥ 4"),
-        )
-    } else if f.zeta_inf + 2.0 * f.zeta_inf_err <= 0.0 {
-        (
-            Verdict::DoesNotHold,
-            format!("{what}: ζ_∞ ≤ 0 by more than 2 errors"),
-        )
-    } else if zero_fits && delta < 1.0 && f.zeta_inf + 2.0 * f.zeta_inf_err < floor / 2.0 {
-        (
+            format!("{what}: {}; and the limit 0 fits worse by Δχ² ≥ 4", o.why),
+        ),
+        Verdict::Holds => (
+            Verdict::Inconclusive,
+            format!(
+                "{what}: {}; but the limit 0 fits nearly as well (Δχ² < 4)",
+                o.why
+            ),
+        ),
+        Verdict::DoesNotHold => (
             Verdict::DoesNotHold,
             format!(
-                "{what}: the limit 0 fits as well (Δχ² < 1), and the free fit bounds ζ_∞ below half the smallest threshold measured ({})",
-                g(floor)
+                "{what}: {}: the limit is at most half the smallest threshold measured",
+                o.why
             ),
-        )
-    } else {
-        (
+        ),
+        Verdict::Inconclusive => (
             Verdict::Inconclusive,
-            format!("{what}: neither a positive limit nor the limit 0 is established"),
-        )
+            format!(
+                "{what}: {}: neither a positive limit nor the limit 0 is established",
+                o.why
+            ),
+        ),
     }
 }
 
@@ -531,6 +536,119 @@ fn cut_from_table(dir: &std::path::Path) -> Result<Cut, SweepError> {
     Ok((cut, seeds))
 }
 
+/// Seeds of the systematic sweeps: the first three.
+const SYSTEMATIC_SEEDS: study::Seeds = study::Seeds { first: 1, last: 3 };
+
+/// The systematics (issue 54): the same sweep (overrides `sets`) at half the time step and on
+/// a grid twice as fine, for the first three seeds, each run summarised over the second half of
+/// the longest run length: `(case, points)`.
+fn systematic_runs(
+    p: &ReproduceParams,
+    sets: &[String],
+) -> Result<Vec<(String, Vec<PointRuns>)>, SweepError> {
+    let t_max = LENGTHS[LENGTHS.len() - 1];
+    let half = super::systematics::half_dt(super::PAPER_SCENE, sets)?;
+    let finer = super::systematics::finer_grid(super::PAPER_SCENE, sets)?;
+    let mut out = Vec::new();
+    for (tag, extra) in [("dt-half", vec![half]), ("grid-half", finer)] {
+        let res = super::sweep(
+            p,
+            SweepJob {
+                scene: super::PAPER_SCENE,
+                name: format!("run-length-{tag}-{}", p.scale.name()),
+                sets: [sets.to_vec(), extra].concat(),
+                varies: vec![
+                    format!("model.pressure={}", PRESSURES.join(",")),
+                    format!("model.zeta={ZETAS}"),
+                ],
+                analyze: None,
+                seeds: Some(SYSTEMATIC_SEEDS),
+            },
+        )?;
+        out.push((tag.to_string(), res.points(Some(t_max))?));
+    }
+    Ok(out)
+}
+
+/// Each seed's growth-rate threshold in `points` (values `[pressure, ζ]`) of `pressure`.
+fn seed_thresholds(points: &[PointRuns], pressure: &str) -> Vec<(u64, Option<f64>)> {
+    let rates: Vec<(f64, u64, f64)> = points
+        .iter()
+        .filter(|pt| pt.values[0] == pressure)
+        .flat_map(|pt| &pt.runs)
+        .map(|r| {
+            (
+                r.values[1].parse().unwrap_or(f64::NAN),
+                r.seed,
+                r.summary.growth_rate,
+            )
+        })
+        .collect();
+    let mut seeds: Vec<u64> = rates.iter().map(|r| r.1).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    seeds
+        .into_iter()
+        .map(|s| match per_seed(&rates, s) {
+            Threshold::Bracketed { zeta_cr, .. } => (s, Some(zeta_cr)),
+            _ => (s, None),
+        })
+        .collect()
+}
+
+/// Discretisation (issue 54): the growth-rate ζ_cr at the longest run length, paired by seed
+/// between the figure's runs (`base`) and the systematic sweeps, each relative shift by the
+/// rule of an absence with [`super::systematics::SHIFT`] counting; holds when every one holds.
+fn claim_discretisation(base: &[PointRuns], systematic: &[(String, Vec<PointRuns>)]) -> Claim {
+    let t_max = LENGTHS[LENGTHS.len() - 1];
+    let rule = super::rule::Rule::absence("relative shift of ζ_cr", super::systematics::SHIFT);
+    let (mut outcomes, mut text) = (Vec::new(), Vec::new());
+    for pressure in PRESSURES {
+        let b = seed_thresholds(base, pressure);
+        let mut shifts = [f64::NAN; 2];
+        let mut stat = (f64::NAN, f64::NAN);
+        for (k, (tag, pts)) in systematic.iter().enumerate().take(2) {
+            let v = seed_thresholds(pts, pressure);
+            let pairs: Vec<(f64, f64)> = v
+                .iter()
+                .filter_map(|(s, z)| {
+                    let zb = b.iter().find(|x| x.0 == *s)?.1?;
+                    Some((zb, (*z)?))
+                })
+                .collect();
+            let zb: Vec<f64> = pairs.iter().map(|p| p.0).collect();
+            let d: Vec<f64> = pairs.iter().map(|p| p.1 - p.0).collect();
+            let (m, se) = mean_se(&d);
+            stat = mean_se(&zb);
+            shifts[k] = m;
+            let o = rule.decide(m / stat.0, se / stat.0);
+            outcomes.push(super::rule::Outcome {
+                verdict: o.verdict,
+                why: format!("{pressure}, {tag} ({} seeds): {}", pairs.len(), o.why),
+            });
+        }
+        let sys = super::systematics::Systematics {
+            value: stat.0,
+            stat: stat.1,
+            dt: shifts[0],
+            grid: shifts[1],
+        };
+        text.push(format!(
+            "{pressure} form: ζ_cr({t_max}) over seeds {}–{} = {}",
+            SYSTEMATIC_SEEDS.first,
+            SYSTEMATIC_SEEDS.last,
+            sys.describe()
+        ));
+    }
+    let (v, why) = super::rules::all_of(&outcomes);
+    Claim::new(
+        format!("Discretisation (issue 54): the growth-rate ζ_cr at T = {t_max} moves by less than 20 % at half the time step and on a grid twice as fine"),
+        text.join("; "),
+        v,
+        why,
+    )
+}
+
 pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let t_max = LENGTHS[LENGTHS.len() - 1];
     let mut sets = vec![
@@ -543,7 +661,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         SweepJob {
             scene: super::PAPER_SCENE,
             name: format!("run-length-{}", p.scale.name()),
-            sets,
+            sets: sets.clone(),
             varies: vec![
                 format!("model.pressure={}", PRESSURES.join(",")),
                 format!("model.zeta={ZETAS}"),
@@ -563,24 +681,47 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .map(|&t| Ok((t, res.points(Some(t))?)))
         .collect::<Result<_, SweepError>>()?;
     let Analysis {
-        claims,
+        mut claims,
         per_seed: csv,
         means,
         fits,
         plot,
     } = analyse(&cut, &seeds)?;
+    p.reporter
+        .stage("run-length: the systematics, at dt/2 and on a grid twice as fine");
+    let systematic = systematic_runs(p, &sets)?;
+    let base_last = &cut.last().expect("run lengths").1;
+    claims.push(claim_discretisation(base_last, &systematic));
     let settings = format!(
         "- The paper's scene (L = 100, 60 cells, γ = 0.01, random packing relaxed 200 TU at ζ = 0), {}, both pressure forms, ζ ∈ {{{ZETAS}}}, seeds {}–{}, each run {t_max} TU of activity.\n\
          - ζ_cr(T): each run cut at T ∈ {{{}}} TU; per seed, where its growth rate of ln v_rms over [T/2, T] (per TU), or its local exponent d ln v_rms / d ln t over [T/2, T] (t from the start of the activity; issue 54: scale-free, so a power-law relaxation keeps a negative exponent at every T where its rate tends to zero as ~1/T), first turns positive (linear interpolation between the activities around the crossing); seeds whose crossing lies below the lowest ζ are censored, not dropped: each lies in [0, lowest ζ], and the mean puts them at the middle with the half-width of the mean's range added to its standard error in quadrature; a run length where a seed's crossing lies above the grid is left out (`zeta_cr_per_seed.csv`, `zeta_cr_vs_run_length.csv`).\n\
-         - Fit: `ζ_cr(T) = ζ_∞ + a T^(−b)`, weighted by the standard errors, b on a grid over (0, 3]; the error of ζ_∞ is the widest reach of ζ_∞ ± its standard error over the b within Δχ² ≤ 1 (`fit.csv`). Also fitted: the limit zero, `ζ_cr(T) = a T^(−b)`. Verdict: inconclusive when the free fit's χ² exceeds its 99 % point; holds when ζ_∞ − 2 err > 0 and the zero-limit fit is worse by Δχ² ≥ 4; does not hold (the limit is zero) when ζ_∞ + 2 err ≤ 0, or when the zero-limit fit passes its goodness of fit, improves on the free fit by less than Δχ² = 1 and the free fit bounds ζ_∞ below half the smallest threshold measured; inconclusive otherwise.\n\
-         - Files: `zeta_cr_vs_run_length.png`, the CSVs above.",
+         - Fit: `ζ_cr(T) = ζ_∞ + a T^(−b)`, weighted by the standard errors, b on a grid over (0, 3]; the error of ζ_∞ is the widest reach of ζ_∞ ± its standard error over the b within Δχ² ≤ 1 (`fit.csv`). Also fitted: the limit zero, `ζ_cr(T) = a T^(−b)`. Verdict: inconclusive when the free fit's χ² exceeds its 99 % point; otherwise the rule of an effect (issue 54) on ζ_∞ ± err with half the smallest threshold measured counting: holds when ζ_∞ − 2 err > 0, ζ_∞ is at least that, and the zero-limit fit is worse by Δχ² ≥ 4 (inconclusive when it is not); does not hold (the limit is at most half the smallest threshold measured) when ζ_∞ + 2 err is below it; inconclusive otherwise.\n\
+         - Systematics (issue 54): seeds {}–{} again at half the time step and on a grid twice as fine (every length doubled in nodes), each run's summary at T = {t_max} in `run_length_systematics.csv`; the growth-rate ζ_cr at T = {t_max} paired by seed, each relative shift by the rule of an absence with 20 % counting.\n\
+         - Files: `zeta_cr_vs_run_length.png`, the CSVs above, `run_length_runs.csv` (every run's summary at every T).",
+        SYSTEMATIC_SEEDS.first,
+        SYSTEMATIC_SEEDS.last,
         p.scale.integrator_name(),
         seeds.first().copied().unwrap_or(1),
         seeds.last().copied().unwrap_or(1),
         LENGTHS.map(|t| t.to_string()).join(", "),
     );
+    let mut sys_points: Vec<PointRuns> = Vec::new();
+    for (tag, pts) in &systematic {
+        sys_points.extend(pts.iter().map(|pt| {
+            PointRuns {
+                values: std::iter::once(tag.clone())
+                    .chain(pt.values.iter().cloned())
+                    .collect(),
+                runs: pt.runs.clone(),
+            }
+        }));
+    }
     Ok(Made::new(claims, settings)
         .table("run_length_runs.csv", runs_table(&cut))
+        .table(
+            "run_length_systematics.csv",
+            super::pipeline::runs_table(&["case", "pressure", "zeta"], &sys_points),
+        )
         .table("zeta_cr_per_seed.csv", csv)
         .table("zeta_cr_vs_run_length.csv", means)
         .table("fit.csv", fits)
@@ -596,14 +737,27 @@ mod tests {
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let (cut, seeds) = cut_from_table(&root.join("docs/data/run-length/quick")).unwrap();
-        let want: Vec<(String, Verdict)> = analyse(&cut, &seeds)
-            .unwrap()
-            .claims
-            .into_iter()
-            .map(|c| (c.claim, c.verdict))
-            .collect();
-        assert_eq!(want.len(), 4);
+        let dir = root.join("docs/data/run-length/quick");
+        let (cut, seeds) = cut_from_table(&dir).unwrap();
+        let mut claims = analyse(&cut, &seeds).unwrap().claims;
+        let sys =
+            crate::pipeline::points_from_runs_table(&dir.join("run_length_systematics.csv"), 3)
+                .unwrap();
+        let mut systematic: Vec<(String, Vec<PointRuns>)> = Vec::new();
+        for pt in sys {
+            let point = PointRuns {
+                values: pt.values[1..].to_vec(),
+                runs: pt.runs,
+            };
+            match systematic.iter_mut().find(|s| s.0 == pt.values[0]) {
+                Some(s) => s.1.push(point),
+                None => systematic.push((pt.values[0].clone(), vec![point])),
+            }
+        }
+        claims.push(claim_discretisation(&cut.last().unwrap().1, &systematic));
+        let want: Vec<(String, Verdict)> =
+            claims.into_iter().map(|c| (c.claim, c.verdict)).collect();
+        assert_eq!(want.len(), 5);
         crate::assert_doc_verdicts("run-length", "**Verdicts (quick):**", &want);
     }
 
@@ -651,6 +805,10 @@ mod tests {
         let (t, y, e) = data(|t| 0.04 * t.powf(-0.5), 2e-5);
         let z = fit_zero(&t, &y, &e).unwrap();
         assert!((z.b - 0.5).abs() < 0.05, "{z:?}");
+        assert_eq!(judge(&t, &y, &e), Verdict::DoesNotHold);
+        // A positive limit resolved from zero but below half the smallest threshold measured:
+        // it does not count as the finite threshold of this protocol.
+        let (t, y, e) = data(|t| 1e-4 + 0.05 * t.powf(-0.5), 1e-6);
         assert_eq!(judge(&t, &y, &e), Verdict::DoesNotHold);
         // A negative limit, well measured: does not hold either.
         let (t, y, e) = data(|t| -2e-4 + 0.02 * t.powf(-0.5), 1e-6);
