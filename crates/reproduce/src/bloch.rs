@@ -663,11 +663,20 @@ fn claims(forms: &[Form]) -> Vec<Claim> {
                 o.why,
             ));
         }
-        // The infinite tissue's threshold is finite: not where a wave grows at rest.
+        // The infinite tissue's threshold is finite: not where a wave grows at rest (unless, on
+        // the grid twice as fine, the lowest wave is stable at rest: then the growth at rest is
+        // the grid's, and the threshold is judged with the systematics in its error).
         if let Some((w, err)) = infinite(f) {
             let rule = Rule::effect("ζ_cr of the infinite tissue", 5e-5);
             let at_rest: Vec<&WaveThreshold> = f.all().filter(|w| w.unstable_at_rest()).collect();
-            let (o, measured) = if let Some(u) = at_rest.first() {
+            let fine_grows = f.systematics.is_none_or(|s| s[1].2);
+            let total = f.systematics.map(|s| super::systematics::Systematics {
+                value: w.zeta_cr,
+                stat: err / 2.0,
+                dt: s[0].0 - w.zeta_cr,
+                grid: s[1].0 - w.zeta_cr,
+            });
+            let (o, measured) = if let (Some(u), true) = (at_rest.first(), fine_grows) {
                 let s0 = u
                     .points
                     .iter()
@@ -691,14 +700,28 @@ fn claims(forms: &[Form]) -> Vec<Claim> {
                     ),
                 )
             } else {
+                let se = total.map_or(err / 2.0, |t| t.total());
+                let grid_note = match (at_rest.first(), f.systematics) {
+                    (Some(u), Some(sys)) => format!(
+                        "; the wave q = {:?} grows at rest on this grid but not on one twice as fine (ζ_cr = {} ± {} there): its growth at rest is the lattice's",
+                        u.q,
+                        g(sys[1].0),
+                        g(sys[1].1)
+                    ),
+                    _ => String::new(),
+                };
                 (
-                    rule.decide(w.zeta_cr, err / 2.0),
+                    rule.decide(w.zeta_cr, se),
                     format!(
-                        "ζ_cr(∞) = {} ± {} at q = {:?}{}",
+                        "ζ_cr(∞) = {} ± {} at q = {:?}{}{}{grid_note}",
                         g(w.zeta_cr),
                         g(err),
                         w.q,
-                        if w.bracketed { "" } else { " (extrapolated)" }
+                        if w.bracketed { "" } else { " (extrapolated)" },
+                        total.map_or(String::new(), |t| format!(
+                            "; with the systematics, {} (s.e.)",
+                            t.describe()
+                        )),
                     ),
                 )
             };
@@ -884,7 +907,7 @@ mod tests {
 
     /// A form with synthetic waves on straight lines σ = s (ζ − z(q)): every box's wave and
     /// the longest along the rows, one of which (if `at_rest`) grows at ζ = 0.
-    fn form(pressure: PressureKind, at_rest: bool) -> Form {
+    fn form(pressure: PressureKind, at_rest: bool, grid_shift: f64) -> Form {
         let relax = Relaxation {
             margin: 11,
             ..Relaxation::default()
@@ -914,10 +937,9 @@ mod tests {
             if at_rest { -5e-4 } else { 3.5e-4 },
             0.03,
         )];
-        // The infinite tissue's wave again: a shift of 1e-6 at dt/2, and on the finer grid
-        // 1e-6 (the paper form) or 2e-4, half the box's threshold (the interaction form).
+        // The infinite tissue's wave again: a shift of 1e-6 at dt/2, and `grid_shift` on the
+        // finer grid, where it grows at rest as on this one.
         let lowest = lowest(waves.iter().chain(&refined)).map_or(0.0, |w| w.zeta_cr);
-        let grid_shift = if at_rest { 1e-6 } else { 2e-4 };
         Form {
             pressure,
             tiling: Some(tiling),
@@ -938,8 +960,8 @@ mod tests {
     #[test]
     fn the_figure_s_tables_and_claims_follow_its_waves() {
         let forms = [
-            form(PressureKind::Paper, true),
-            form(PressureKind::Interaction, false),
+            form(PressureKind::Paper, true, 1e-6),
+            form(PressureKind::Interaction, false, 1e-6),
         ];
         assert!(forms[0].refined[0].unstable_at_rest());
         let mut made = Made::new(Vec::new(), String::new());
@@ -966,12 +988,29 @@ mod tests {
         assert!((inf.zeta_cr - 3.5e-4).abs() < 1e-12, "{}", inf.zeta_cr);
         // Both boxes have q = 0, their lowest wave here: the same threshold, so no box effect.
         assert_eq!(verdict("9.2b", "paper"), Verdict::Holds);
-        // Discretisation: shifts of 1e-6 against the box's 4e-4 hold; 2e-4 does not.
+        // Discretisation: shifts of 1e-6 against the box's 4e-4 hold.
         assert_eq!(verdict("Discretisation", "paper"), Verdict::Holds);
-        assert_eq!(
-            verdict("Discretisation", "interaction"),
-            Verdict::DoesNotHold
-        );
+        assert_eq!(verdict("Discretisation", "interaction"), Verdict::Holds);
+        // A shift of 2e-4 on the finer grid does not, and enters 9.1's error: undecided.
+        let shifted = [form(PressureKind::Interaction, false, 2e-4)];
+        let c = super::claims(&shifted);
+        let of = |what: &str| {
+            c.iter()
+                .find(|c| c.claim.starts_with(what))
+                .unwrap()
+                .verdict
+        };
+        assert_eq!(of("Discretisation"), Verdict::DoesNotHold);
+        assert_eq!(of("9.1"), Verdict::Inconclusive);
+        // A wave that grows at rest on this grid but not on the finer one: 9.1 is judged on the
+        // threshold with the systematics, not on the growth at rest.
+        let mut freed = form(PressureKind::Paper, true, 1e-6);
+        let lowest = freed.systematics.unwrap()[1].0;
+        freed.systematics = Some([(lowest, 1e-6, true), (8e-4, 1e-5, false)]);
+        let c = super::claims(std::slice::from_ref(&freed));
+        let nine = c.iter().find(|c| c.claim.starts_with("9.1")).unwrap();
+        assert_eq!(nine.verdict, Verdict::Inconclusive, "{}", nine.reason);
+        assert!(nine.measured.contains("the lattice's"), "{}", nine.measured);
     }
 
     /// `q` and `−q`, and `q` plus a reciprocal vector, fold to the same wave.

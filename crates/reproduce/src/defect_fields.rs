@@ -713,9 +713,13 @@ fn sign_rule(d: &[f64], holds: &str, fails: &str, counted: &str) -> (Verdict, St
     }
     let (m, se) = mean_se(d);
     let positive = d.iter().filter(|x| **x > 0.0).count();
-    if positive == d.len() && m > 2.0 * se {
+    // A sign: the rule of an effect whose smallest size that counts is any (the least positive
+    // number), so that it holds when the mean is above 0 by two s.e. and does not hold when it
+    // is below 0 by two.
+    let o = super::rule::Rule::effect("the per-run mean", f64::MIN_POSITIVE).decide(m, se);
+    if o.verdict == Verdict::Holds && positive == d.len() {
         (Verdict::Holds, holds.to_string())
-    } else if m < -2.0 * se {
+    } else if o.verdict == Verdict::DoesNotHold {
         (Verdict::DoesNotHold, fails.to_string())
     } else {
         (Verdict::Inconclusive, format!("{positive} of {} {counted}: the runs disagree, or the mean is within two standard errors of 0", d.len()))

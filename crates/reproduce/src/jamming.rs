@@ -98,15 +98,14 @@ impl Phase {
 
 /// A point's phase from the mean and standard error over seeds of the long-lag MSD exponent.
 pub(crate) fn phase((m, se): (f64, f64)) -> Phase {
-    let cage = CAGE_EXPONENT;
-    if !se.is_finite() {
-        Phase::NotEstablished
-    } else if m - 2.0 * se > cage {
-        Phase::Fluid
-    } else if m + 2.0 * se < cage {
-        Phase::Solid
-    } else {
-        Phase::NotEstablished
+    // Which side of ½: the rule of an effect on β − ½ whose smallest size that counts is any
+    // (the least positive number): fluid when it holds (above ½ by two s.e.), solid when it
+    // does not (below ½ by two), not established otherwise and without an error.
+    let rule = super::rule::Rule::effect("β − ½", f64::MIN_POSITIVE);
+    match rule.decide(m - CAGE_EXPONENT, se).verdict {
+        Verdict::Holds => Phase::Fluid,
+        Verdict::DoesNotHold => Phase::Solid,
+        Verdict::Inconclusive => Phase::NotEstablished,
     }
 }
 
