@@ -1,6 +1,7 @@
 //! The `monolayer` binary end to end: one test executable (one link), a module per topic.
 
 mod adaptive;
+mod adhesion;
 mod cli;
 mod common;
 mod division;

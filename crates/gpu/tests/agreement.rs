@@ -950,3 +950,21 @@ fn wall_friction_is_refused_by_name() {
     let err = GpuBackend::check(&held, &sp).unwrap_err().to_string();
     assert!(err.contains("[walls] friction = 0.5"), "{err}");
 }
+
+/// Adhesion by pair of populations (issue 49) is not on the GPU yet: refused by its key.
+#[test]
+fn pair_adhesion_is_refused_by_name() {
+    let sp = StepParams::paper();
+    let pops = |m: Option<Vec<f64>>| {
+        let p = Populations::new(vec![Population::new(); 2], &[30, 30], 3);
+        match m {
+            Some(m) => p.with_adhesion(m),
+            None => p,
+        }
+    };
+    let plain = paper_tissue(0.0).with(pops(None));
+    assert!(GpuBackend::check(&plain, &sp).is_ok());
+    let paired = paper_tissue(0.0).with(pops(Some(vec![0.004, 0.0, 0.0, 0.004])));
+    let err = GpuBackend::check(&paired, &sp).unwrap_err().to_string();
+    assert!(err.contains("[adhesion] pairs"), "{err}");
+}

@@ -131,6 +131,9 @@ impl Extensions {
                     if params.omega != 0.0 {
                         add(part, "[adhesion] omega".into(), params.omega.to_string());
                     }
+                    if let Some(m) = self.populations.adhesion() {
+                        add(part, "[adhesion] pairs".into(), format!("{m:?}"));
+                    }
                 }
                 Part::Populations => {
                     for (k, kind) in self.populations.kinds().iter().enumerate() {
@@ -219,11 +222,12 @@ impl Extensions {
             .collect()
     }
 
-    /// Whether `part` is there (adhesion: `params.omega ≠ 0`).
+    /// Whether `part` is there (adhesion: `params.omega ≠ 0`, or an ω for each pair of
+    /// populations).
     pub fn has(&self, part: Part, params: &ModelParams) -> bool {
         match part {
             Part::Terms => !self.terms.is_empty(),
-            Part::Adhesion => params.omega != 0.0,
+            Part::Adhesion => params.omega != 0.0 || self.populations.adhesion().is_some(),
             Part::Populations => !self.populations.is_empty(),
             Part::Walls => self.walls.is_some(),
             Part::Division => self.proliferation.is_some(),
@@ -268,7 +272,7 @@ impl Extensions {
                         || self.terms.variables() != other.terms.variables()
                         || seen(&self.terms) != seen(&other.terms)
                 }
-                Part::Adhesion => false,
+                Part::Adhesion => self.populations.adhesion() != other.populations.adhesion(),
                 Part::Populations => {
                     self.populations.of_cell() != other.populations.of_cell()
                         || format!("{:?}", self.populations.kinds())

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use crate::equations::{adhesion_coefficient, heun_corrector, heun_predictor, wall_coefficients};
 use crate::evaluation::{CellState, N_SUMS};
 use crate::kernels::{evaluate, EvalInput, EvalScratch, Post};
-use crate::node_terms::{Adhesion, NodeTerm, WallTerm};
+use crate::node_terms::{Adhesion, NodeTerm, PairAdhesion, WallTerm};
 use crate::params::StepParams;
 use crate::scatter::LatticeSums;
 use crate::terms::CellsView;
@@ -572,12 +572,22 @@ impl<T: Real> Tissue<T> {
         } = scratch;
         // The node terms of this evaluation, in a fixed order (adhesion, then walls: the
         // order their pressures and coefficients are added in).
+        // Adhesion: one ω for every pair, or an ω for each pair of populations (the scene
+        // gives one or the other).
         let adhesion = (self.params.omega != 0.0).then(|| Adhesion {
             c: adhesion_coefficient(self.params.omega, self.params.energy.lambda),
         });
+        let pair_adhesion = self.ext.populations.adhesion().map(|m| {
+            PairAdhesion::new(
+                m,
+                self.ext.populations.kinds().len(),
+                self.params.energy.lambda,
+            )
+        });
         let walls = self.wall_term();
-        let node_terms: [Option<&dyn NodeTerm>; 2] = [
+        let node_terms: [Option<&dyn NodeTerm>; 3] = [
             adhesion.as_ref().map(|t| t as &dyn NodeTerm),
+            pair_adhesion.as_ref().map(|t| t as &dyn NodeTerm),
             walls.as_ref().map(|t| t as &dyn NodeTerm),
         ];
         // Their lattice scratch, made on its first use (the one allocation of a run with

@@ -270,8 +270,14 @@ pub struct PolaritySpec {
 #[serde(deny_unknown_fields)]
 pub struct AdhesionSpec {
     /// The adhesion strength ω (the reference code's cluster example: 0.01): the energy
-    /// `ωλ Σ_{i≠j} ∫∇φ_i·∇φ_j` of shared interfaces.
+    /// `ωλ Σ_{i≠j} ∫∇φ_i·∇φ_j` of shared interfaces (default 0 when `pairs` is given).
+    #[serde(default)]
     pub omega: f64,
+    /// The adhesion ω_pq of each pair of populations, one row per `[[population]]` in order
+    /// (symmetric): the energy `λ Σ_{i≠j} ω_{p_i p_j} ∫∇φ_i·∇φ_j`, so that an unlike contact's
+    /// adhesion is free of the like ones (differential adhesion). In place of `omega`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pairs: Option<Vec<Vec<f64>>>,
 }
 
 /// `[walls] kind`.
@@ -629,7 +635,11 @@ impl SceneFile {
             return Populations::default();
         }
         let counts: Vec<usize> = self.population.iter().map(|p| p.count).collect();
-        Populations::new(self.population_kinds(), &counts, self.run.seed)
+        let pops = Populations::new(self.population_kinds(), &counts, self.run.seed);
+        match self.adhesion.as_ref().and_then(|a| a.pairs.as_ref()) {
+            Some(rows) => pops.with_adhesion(rows.iter().flatten().copied().collect()),
+            None => pops,
+        }
     }
 
     /// The parameters each `[[population]]` overrides, in order.

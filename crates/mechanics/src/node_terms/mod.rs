@@ -36,7 +36,6 @@ pub(crate) mod pair_adhesion;
 pub(crate) mod walls;
 
 pub(crate) use adhesion::Adhesion;
-#[cfg_attr(not(test), allow(unused_imports))]
 pub(crate) use pair_adhesion::PairAdhesion;
 pub(crate) use walls::WallTerm;
 

@@ -10,8 +10,8 @@
 //! ∇²s1_q` and the Laplacian coefficient `c_pp`. Its pressure, the φ-weighted sum of the
 //! derivative, is `c_pp φ_i ∇²φ_i` per cell in the scatter and `Σ_p s1_p b_p` on the lattice.
 //! With every `ω_pq = ω` it is [`super::Adhesion`] of `c = 2ωλ`, to round-off (the sums are
-//! grouped by population). Built only from Rust for now; the scene's `[adhesion]` table is
-//! the uniform term.
+//! grouped by population). The scene key `[adhesion] pairs` builds it
+//! (`Populations::with_adhesion`); `[adhesion] omega` is the uniform term.
 
 use super::{laplacian_into, NodeTerm, PopulationSums};
 use crate::equations::{adhesion_coefficient, adhesion_derivative, adhesion_pressure};
@@ -20,14 +20,12 @@ use crate::scatter::LatticeSums;
 
 /// Adhesion with the coefficient `c_pq = 2 ω_pq λ` for each pair of populations.
 #[derive(Debug, Clone)]
-#[cfg_attr(not(test), allow(dead_code))]
 pub(crate) struct PairAdhesion {
     /// `c_pq` at `p * n + q`.
     c: Vec<f64>,
     n: usize,
 }
 
-#[cfg_attr(not(test), allow(dead_code))]
 impl PairAdhesion {
     /// The term of the symmetric matrix `omega` (`n × n`, row by row) at the gradient
     /// coefficient `lambda`. Panics unless `omega` is square and symmetric: a scene validates

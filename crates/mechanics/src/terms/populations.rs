@@ -87,6 +87,9 @@ impl Population {
 pub struct Populations {
     kinds: Vec<Population>,
     of_cell: Vec<u16>,
+    /// The adhesion ω_pq of each pair of populations, `n × n` row by row (symmetric), when it
+    /// depends on the pair (`[adhesion] pairs`, docs/model.md §11.2).
+    adhesion: Option<Vec<f64>>,
 }
 
 /// A cell's constants in one evaluation (one set per population), as the step uses them and
@@ -130,7 +133,38 @@ impl Populations {
             let j = ((u * (i + 1) as f64) as usize).min(i);
             of_cell.swap(i, j);
         }
-        Self { kinds, of_cell }
+        Self {
+            kinds,
+            of_cell,
+            adhesion: None,
+        }
+    }
+
+    /// These populations with the adhesion `omega` of each pair (`n × n` row by row, `n` the
+    /// number of populations): the energy `λ Σ_{i≠j} ω_{p_i p_j} ∫∇φ_i·∇φ_j` in place of one ω
+    /// for every pair, so that an unlike contact's adhesion is free of the like ones
+    /// (differential adhesion).
+    ///
+    /// # Panics
+    /// Unless `omega` is `n × n` and symmetric, every entry finite: a scene checks its matrix
+    /// before this (naming the pair).
+    pub fn with_adhesion(mut self, omega: Vec<f64>) -> Self {
+        let n = self.kinds.len();
+        assert_eq!(omega.len(), n * n, "ω_pq is n × n for n populations");
+        for p in 0..n {
+            for q in 0..n {
+                assert!(omega[p * n + q].is_finite(), "ω_pq is finite");
+                assert_eq!(omega[p * n + q], omega[q * n + p], "ω_pq is symmetric");
+            }
+        }
+        self.adhesion = Some(omega);
+        self
+    }
+
+    /// The adhesion of each pair of populations (`n × n` row by row), when it depends on the
+    /// pair.
+    pub fn adhesion(&self) -> Option<&[f64]> {
+        self.adhesion.as_deref()
     }
 
     /// Populations with the given population of every cell, by identity.
@@ -139,7 +173,11 @@ impl Populations {
     /// If a cell names a population that is not there.
     pub fn from_assignment(kinds: Vec<Population>, of_cell: Vec<u16>) -> Self {
         assert!(of_cell.iter().all(|&k| (k as usize) < kinds.len()));
-        Self { kinds, of_cell }
+        Self {
+            kinds,
+            of_cell,
+            adhesion: None,
+        }
     }
 
     /// The same populations with the assignment `of_cell` as a saved file holds it (one
@@ -160,10 +198,13 @@ impl Populations {
                 of_cell.len()
             ));
         }
-        Ok(Self::from_assignment(
-            self.kinds.clone(),
-            of_cell.iter().map(|&v| v as u16).collect(),
-        ))
+        Ok(Self {
+            adhesion: self.adhesion.clone(),
+            ..Self::from_assignment(
+                self.kinds.clone(),
+                of_cell.iter().map(|&v| v as u16).collect(),
+            )
+        })
     }
 
     /// Whether there are none (every cell has the tissue's parameters).

@@ -3,9 +3,13 @@
 use crate::error::{invalid, SceneError};
 use crate::file::SceneFile;
 
-/// `[adhesion]`: ω in range, below γ.
+/// `[adhesion]`: ω in range, below γ; `pairs` a symmetric matrix over the populations, each
+/// ω_pq below the γ of both populations.
 pub(crate) fn adhesion(file: &SceneFile) -> Result<(), SceneError> {
     if let Some(a) = &file.adhesion {
+        if let Some(rows) = &a.pairs {
+            return pairs(file, a.omega, rows);
+        }
         if !(a.omega.is_finite() && a.omega >= 0.0) {
             return Err(invalid(
                 "adhesion",
@@ -30,6 +34,78 @@ pub(crate) fn adhesion(file: &SceneFile) -> Result<(), SceneError> {
                 format!("adhesion at or above the interface stiffness (gamma = {gamma}) makes the interface between two cells cost nothing, and contacts break into stripes at the lattice scale"),
                 format!("use omega below gamma, e.g. {}", gamma * 0.75),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// `[adhesion] pairs`: one row per `[[population]]`, square, symmetric, finite and not
+/// negative, each ω_pq below min(γ_p, γ_q) (the single ω's limit for the two cells of the
+/// pair); not with `omega`.
+fn pairs(file: &SceneFile, omega: f64, rows: &[Vec<f64>]) -> Result<(), SceneError> {
+    let n = file.population.len();
+    let shown = format!("{rows:?}");
+    if omega != 0.0 {
+        return Err(invalid(
+            "adhesion",
+            "pairs",
+            shown,
+            "`pairs` gives the adhesion of every pair of populations, and `omega` one for every pair: only one can hold",
+            "remove `omega` (or set it to 0), or remove `pairs`",
+        ));
+    }
+    if n == 0 || rows.len() != n || rows.iter().any(|r| r.len() != n) {
+        return Err(invalid(
+            "adhesion",
+            "pairs",
+            shown,
+            format!("`pairs` needs one row of {n} values for each of the scene's {n} [[population]] tables (in their order)"),
+            if n == 0 {
+                "add [[population]] tables, or use `omega` for one adhesion between every pair".to_string()
+            } else {
+                format!("give a {n} × {n} matrix, such as [[0.004, 0.0], [0.0, 0.004]] for two populations")
+            },
+        ));
+    }
+    let name = |p: usize| {
+        file.population[p]
+            .name
+            .clone()
+            .unwrap_or_else(|| ((b'A' + (p % 26) as u8) as char).to_string())
+    };
+    let gamma = |p: usize| file.population[p].gamma.unwrap_or(file.model.gamma);
+    for p in 0..n {
+        for q in 0..n {
+            let w = rows[p][q];
+            let pair = format!("{}–{}", name(p), name(q));
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(invalid(
+                    "adhesion",
+                    "pairs",
+                    shown,
+                    format!("ω of the pair {pair} (row {}, column {}) is {w}: adhesion must be zero or positive", p + 1, q + 1),
+                    "use values of order 0.01 or 0",
+                ));
+            }
+            if rows[q][p] != w {
+                return Err(invalid(
+                    "adhesion",
+                    "pairs",
+                    shown,
+                    format!("ω of the pair {pair} is {w} in row {}, column {} but {} in row {}, column {}: the matrix must be symmetric", p + 1, q + 1, rows[q][p], q + 1, p + 1),
+                    "give the same value on both sides of the diagonal",
+                ));
+            }
+            let limit = gamma(p).min(gamma(q));
+            if w >= limit {
+                return Err(invalid(
+                    "adhesion",
+                    "pairs",
+                    shown,
+                    format!("ω of the pair {pair} is {w}, at or above the interface stiffness of its cells (gamma = {limit}): their shared interface would cost nothing, and contacts break into stripes at the lattice scale"),
+                    format!("use a value below {limit}, e.g. {}", limit * 0.75),
+                ));
+            }
         }
     }
     Ok(())
