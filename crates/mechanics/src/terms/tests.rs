@@ -487,9 +487,10 @@ fn a_doublet_adheres_more_with_omega() {
 ///   doublet without adhesion: its overlap `Σ φ₀φ₁` moves by less than 10 % of what ω = 0.015
 ///   adds (measured: −7.6 %), where the like doublet gets all of it (the unlike value is free of
 ///   the like ones). Not to round-off: adhesion's part of a cell's own field,
-///   `c(∇²φ_i − ∇²s1_p)`, is not exactly zero on patches, for the uniform term too (a lone
-///   cell's φ moves by 1.2e-4 in one step of 0.2 at ω = 0.015; with patches as large as the
-///   lattice it cancels to 1e-17). That residual is the uniform term's, noted for issue 49.
+///   `c(∇²φ_i − ∇²s1_p)`, cancels only up to the patch's truncation, for the uniform term too.
+///   The patch (side 2m + 1 = 33) wraps its own rows where the lattice does not, and the tail
+///   of this cell (R = 8, λ = 3) is 5e-3 at its edge: a lone cell's φ moves by 1.2e-4 in one
+///   step of 0.2 at ω = 0.015, and by 1e-17 on a patch as large as the lattice.
 #[test]
 fn pair_adhesion_steps_as_the_adhesion_of_each_pair() {
     let doublet = |omega: f64, pairs: Option<(&[u16], Vec<f64>)>| {
