@@ -326,7 +326,7 @@ fn claims(late: &[PerSeed]) -> (Vec<Claim>, Csv) {
             "sorting (issue 41): the differential adhesion hypothesis: a more cohesive population gathers inside a less cohesive one",
             "not run",
             Verdict::Inconclusive,
-            "not testable in this model: `[adhesion] omega` is one ω for every pair of cells, so a heterotypic contact is as adhesive as a homotypic one, and each cell's interface energy γ_i ∫|∇φ_i|² does not depend on its neighbour, so a heterotypic contact costs γ_a + γ_b, exactly the mean of the two homotypic ones (2γ_a, 2γ_b): the driving force of differential adhesion or interfacial tension is zero by construction. A pair-dependent ω is needed",
+            "not testable in this model: `[adhesion] omega` is one ω for every pair of cells, so a heterotypic contact is as adhesive as a homotypic one, and each cell's interface energy γ_i ∫|∇φ_i|² does not depend on its neighbour, so a heterotypic contact costs γ_a + γ_b, exactly the mean of the two homotypic ones (2γ_a, 2γ_b): the driving force of differential adhesion or interfacial tension is zero by construction. `[adhesion] pairs` (issue 49) now gives each pair of populations its own ω; this figure does not run it yet (issue 49's sorting figure)",
         ),
         Claim::new(
             "sorting (issue 54's control): two identical populations sort (must not hold)",
