@@ -237,3 +237,22 @@ def test_an_edit_changes_the_parameters_as_a_fix_would(root):
     assert np.array_equal(a.phi()[0], b.phi()[0])
     c = ml.Simulation(scene, threads=1).run(progress=False)
     assert not np.array_equal(a.phi()[0], c.phi()[0]), "the edit made a difference"
+
+
+def test_adhesion_by_pair_of_populations_is_a_scene_key(root):
+    """`[adhesion] pairs` (issue 49) from Python: set as a nested list, run, and refused with
+    the pair named when it is not symmetric or not one row per population."""
+    text = (root / "scenes" / "sorting.toml").read_text()
+    scene = (
+        ml.Scene.from_text(text)
+        .set("run.relax_time", 0.0)
+        .set("run.time", 2.0)
+        .set("adhesion.pairs", [[0.006, 0.0], [0.0, 0.003]])
+    )
+    assert "pairs" in scene.to_toml()
+    sim = ml.Simulation(scene, threads=1)
+    sim.run(progress=False)
+    with pytest.raises(ValueError, match="extensile–contractile.*symmetric"):
+        scene.set("adhesion.pairs", [[0.006, 0.001], [0.0, 0.0]])
+    with pytest.raises(ValueError, match="one row of 2 values"):
+        scene.set("adhesion.pairs", [[0.006]])
