@@ -872,8 +872,7 @@ mod tests {
     /// kept in `docs/data/bloch/quick/`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let forms = forms_from_tables(&root.join("docs/data/bloch/quick")).unwrap();
+        let forms = forms_from_tables(&crate::stored_tables("bloch/quick")).unwrap();
         let want: Vec<(String, crate::Verdict)> = claims(&forms)
             .into_iter()
             .map(|c| (c.claim, c.verdict))

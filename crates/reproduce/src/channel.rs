@@ -807,8 +807,7 @@ mod tests {
     /// runs give, kept in `docs/data/channel/quick/channel_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let want = verdicts_from_tables(&root.join("docs/data/channel/quick")).unwrap();
+        let want = verdicts_from_tables(&crate::stored_tables("channel/quick")).unwrap();
         assert_eq!(want.len(), 4);
         crate::assert_doc_verdicts("channel", "**Verdicts (quick):**", &want);
     }

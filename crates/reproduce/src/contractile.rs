@@ -253,8 +253,7 @@ mod tests {
     /// runs, kept in `docs/data/contractile/quick/contractile_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let want = verdicts_from_tables(&root.join("docs/data/contractile/quick")).unwrap();
+        let want = verdicts_from_tables(&crate::stored_tables("contractile/quick")).unwrap();
         assert_eq!(want.len(), 2);
         crate::assert_doc_verdicts("contractile", "**Verdicts (quick):**", &want);
     }

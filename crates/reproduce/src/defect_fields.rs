@@ -732,8 +732,7 @@ mod tests {
     /// runs, kept in `docs/data/defect-fields/quick/defect_field_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let dir = root.join("docs/data/defect-fields/quick");
+        let dir = crate::stored_tables("defect-fields/quick");
         let want = super::verdicts_from_tables(&dir).unwrap();
         assert_eq!(want.len(), 12);
         crate::assert_doc_verdicts("defect-fields", "**Verdicts (quick):**", &want);

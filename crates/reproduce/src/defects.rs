@@ -665,8 +665,7 @@ mod tests {
     /// kept in `docs/data/defects/quick/`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let want = verdicts_from_tables(&root.join("docs/data/defects/quick")).unwrap();
+        let want = verdicts_from_tables(&crate::stored_tables("defects/quick")).unwrap();
         assert_eq!(want.len(), 10);
         crate::assert_doc_verdicts("defects", "**Verdicts (quick):**", &want);
     }

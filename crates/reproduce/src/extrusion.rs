@@ -267,10 +267,9 @@ mod tests {
     /// that [`verdict`] gives on the figure's own tables kept in `docs/data/extrusion/`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         for scale in ["quick", "paper"] {
             let want =
-                verdicts_from_tables(&root.join(format!("docs/data/extrusion/{scale}"))).unwrap();
+                verdicts_from_tables(&crate::stored_tables(&format!("extrusion/{scale}"))).unwrap();
             crate::assert_doc_verdicts("extrusion", &format!("**Verdicts ({scale}):**"), &want);
         }
     }

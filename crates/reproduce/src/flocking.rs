@@ -773,8 +773,7 @@ mod tests {
     /// runs give, kept in `docs/data/flocking/quick/flocking_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let runs = runs_from_table(&root.join("docs/data/flocking/quick")).unwrap();
+        let runs = runs_from_table(&crate::stored_tables("flocking/quick")).unwrap();
         let want: Vec<(String, Verdict)> = analyse(&runs)
             .unwrap()
             .claims

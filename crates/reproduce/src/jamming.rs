@@ -324,39 +324,19 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
     let res = sweep(p, t)?;
     p.reporter.stage("jamming: tables and plots");
     let points = res.points(None)?;
-    let alphas: Vec<f64> = ALPHAS
-        .iter()
-        .map(|a| a.parse().expect("a number"))
-        .collect();
-    let gammas: Vec<f64> = GAMMAS
-        .iter()
-        .map(|a| a.parse().expect("a number"))
-        .collect();
     let runs = PerRun::read(&points, 200.0 + t / 2.0)?;
-    let mut lines = Lines::new(runs.lag_l);
-    for (gi, gamma) in GAMMAS.iter().enumerate() {
-        lines.add(gamma, &alphas, &runs, gi);
-    }
     p.reporter
         .stage("jamming: the control, a dilute gas of cells");
     let gas_points = sweep_gas(p, t)?.points(None)?;
     let gas = PerRun::read(&gas_points, 200.0 + t / 2.0)?;
-    let gas_gi = GAMMAS
-        .iter()
-        .position(|v| *v == GAS_GAMMA)
-        .expect("the gas's γ is one of the sweep's");
-    let mut gas_lines = Lines::new(gas.lag_l);
-    gas_lines.add(GAS_GAMMA, &alphas, &gas, gas_gi);
-    let gas_claim = gas_claim(&gas_lines.rows, &gas, gas_gi);
+    let (lines, gas_lines, claims) = analyse(&runs, &gas);
     let Lines {
         points_csv,
-        rows,
         ac_pts,
-        q_at,
         plot,
         qplot,
         bplot,
-        line_text,
+        ..
     } = lines;
     let mut made = Made::new(Vec::new(), String::new())
         .table("jamming_runs.csv", runs.runs_csv)
@@ -366,11 +346,9 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .plot("jamming_msd.png", plot)
         .plot("jamming_exponent.png", bplot)
         .plot("jamming_shape_index.png", qplot);
-    if let Some(lplot) = line_plot(&gammas, &ac_pts) {
+    if let Some(lplot) = line_plot(&gammas(), &ac_pts) {
         made = made.plot("jamming_line.png", lplot);
     }
-    let mut claims = claims(&rows, &gammas, &ac_pts, &q_at, &line_text);
-    claims.push(gas_claim);
     let lag_l = runs.lag_l;
     let settings = settings(p.scale, t, lag_l);
     made.claims = claims;
@@ -620,38 +598,53 @@ impl PerRun {
     }
 }
 
-/// The claims of the figure's tables kept in `dir` (`jamming_runs.csv`,
-/// `jamming_gas_runs.csv`), as [`make`] gives them.
-#[cfg(test)]
-fn verdicts_from_tables(dir: &std::path::Path) -> Result<Vec<(String, Verdict)>, SweepError> {
-    let alphas: Vec<f64> = ALPHAS
+/// The scan's propulsions and stiffnesses as numbers.
+fn alphas() -> Vec<f64> {
+    ALPHAS
         .iter()
         .map(|a| a.parse().expect("a number"))
-        .collect();
-    let gammas: Vec<f64> = GAMMAS
+        .collect()
+}
+
+fn gammas() -> Vec<f64> {
+    GAMMAS
         .iter()
         .map(|a| a.parse().expect("a number"))
-        .collect();
-    let runs = PerRun::from_table(&dir.join("jamming_runs.csv"))?;
+        .collect()
+}
+
+/// Each γ's line of the tissue's runs, the gas control's line, and the figure's claims: what
+/// [`make`] draws and writes, and what the stored tables give back.
+fn analyse(runs: &PerRun, gas: &PerRun) -> (Lines, Lines, Vec<Claim>) {
+    let alphas = alphas();
     let mut lines = Lines::new(runs.lag_l);
     for (gi, gamma) in GAMMAS.iter().enumerate() {
-        lines.add(gamma, &alphas, &runs, gi);
+        lines.add(gamma, &alphas, runs, gi);
     }
-    let gas = PerRun::from_table(&dir.join("jamming_gas_runs.csv"))?;
     let gi = GAMMAS
         .iter()
         .position(|v| *v == GAS_GAMMA)
-        .expect("a γ of the sweep");
+        .expect("the gas's γ is one of the sweep's");
     let mut gas_lines = Lines::new(gas.lag_l);
-    gas_lines.add(GAS_GAMMA, &alphas, &gas, gi);
+    gas_lines.add(GAS_GAMMA, &alphas, gas, gi);
     let mut claims = claims(
         &lines.rows,
-        &gammas,
+        &gammas(),
         &lines.ac_pts,
         &lines.q_at,
         &lines.line_text,
     );
-    claims.push(gas_claim(&gas_lines.rows, &gas, gi));
+    claims.push(gas_claim(&gas_lines.rows, gas, gi));
+    (lines, gas_lines, claims)
+}
+
+/// The claims of the figure's tables kept in `dir` (`jamming_runs.csv`,
+/// `jamming_gas_runs.csv`), as [`make`] gives them.
+#[cfg(test)]
+fn verdicts_from_tables(dir: &std::path::Path) -> Result<Vec<(String, Verdict)>, SweepError> {
+    let runs = PerRun::from_table(&dir.join("jamming_runs.csv"))?;
+    let gas = PerRun::from_table(&dir.join("jamming_gas_runs.csv"))?;
+    let (_, _, claims) = analyse(&runs, &gas);
     Ok(claims.into_iter().map(|c| (c.claim, c.verdict)).collect())
 }
 
@@ -822,8 +815,7 @@ mod tests {
     /// kept in `docs/data/jamming/quick/jamming_runs.csv` and `jamming_gas_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let want = verdicts_from_tables(&root.join("docs/data/jamming/quick")).unwrap();
+        let want = verdicts_from_tables(&crate::stored_tables("jamming/quick")).unwrap();
         assert_eq!(want.len(), 4);
         crate::assert_doc_verdicts("jamming", "**Verdicts (quick):**", &want);
     }

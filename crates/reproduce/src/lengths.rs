@@ -693,8 +693,7 @@ mod tests {
     /// section shows): a rule changed without its docs, or docs edited by hand, fail here.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let want = verdicts_from_tables(&root.join("docs/data/lengths")).unwrap();
+        let want = verdicts_from_tables(&crate::stored_tables("lengths")).unwrap();
         crate::assert_doc_verdicts("lengths", "**Verdicts (quick):**", &want);
     }
 

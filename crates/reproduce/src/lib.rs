@@ -741,6 +741,15 @@ pub(crate) fn column_stats(
 /// Checks that the verdict table after the line `heading` in the section of `figure` in
 /// docs/reproduction.md states, row by row, the claims and verdicts `want` (what the figure's
 /// rules give on its stored tables, issue 54); panics naming the first claim that differs.
+/// The directory of a figure's raw tables kept in the docs, `docs/data/PATH` (`FIGURE/SCALE`),
+/// for the tests that compare the docs' verdicts with them.
+#[cfg(test)]
+pub(crate) fn stored_tables(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../docs/data")
+        .join(path)
+}
+
 #[cfg(test)]
 pub(crate) fn assert_doc_verdicts(figure: &str, heading: &str, want: &[(String, Verdict)]) {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");

@@ -220,30 +220,16 @@ pub(crate) fn points_from_runs_table(
     axes: usize,
 ) -> Result<Vec<PointRuns>, SweepError> {
     let t = Table::read(path)?;
-    let bad = |k: usize, what: &str| SweepError::Reproduce {
-        why: format!("{}: row {}: {what} is not a number", path.display(), k + 1),
-    };
-    let col = |name: &str| t.col(name);
-    let (seed, rows) = (col("seed")?, col("rows")?);
-    let f = |row: &[String], k: usize, name: &str| -> Result<f64, SweepError> {
-        row[col(name)?].parse().map_err(|_| bad(k, name))
-    };
+    let seed = t.col("seed")?;
     let mut points: Vec<PointRuns> = Vec::new();
     for (k, row) in t.rows.iter().enumerate() {
         let values: Vec<String> = row[..axes].to_vec();
-        let summary = study::summary::RunSummary {
-            window_start: f(row, k, "window_start")?,
-            window_end: f(row, k, "window_end")?,
-            rows: row[rows].parse().map_err(|_| bad(k, "rows"))?,
-            v_rms: f(row, k, "v_rms")?,
-            s_rms: f(row, k, "s_rms")?,
-            area_mean: f(row, k, "area_mean")?,
-            growth_rate: f(row, k, "growth_rate")?,
-            growth_exponent: f(row, k, "growth_exponent")?,
-        };
+        let summary = summary_of_row(&t, k)?;
         let rec = Rec {
             values: values.clone(),
-            seed: row[seed].parse().map_err(|_| bad(k, "seed"))?,
+            seed: row[seed].parse().map_err(|_| SweepError::Reproduce {
+                why: format!("{}: row {}: seed is not a number", path.display(), k + 1),
+            })?,
             run: std::path::PathBuf::new(),
             summary,
         };
@@ -259,6 +245,41 @@ pub(crate) fn points_from_runs_table(
         p.runs.sort_by_key(|r| r.seed);
     }
     Ok(points)
+}
+
+/// The run summary in row `k` of a table with the columns of
+/// `study::summary::SUMMARY_COLUMNS` (as [`runs_table`] writes them).
+///
+/// # Errors
+/// When a column is missing or a field is not a number, naming the file, the row and the
+/// column.
+#[cfg(test)]
+pub(crate) fn summary_of_row(
+    t: &Table,
+    k: usize,
+) -> Result<study::summary::RunSummary, SweepError> {
+    let row = &t.rows[k];
+    let f = |name: &str| -> Result<f64, SweepError> {
+        row[t.col(name)?]
+            .parse()
+            .map_err(|_| SweepError::Reproduce {
+                why: format!(
+                    "{}: row {}: {name} is not a number",
+                    t.path.display(),
+                    k + 1
+                ),
+            })
+    };
+    Ok(study::summary::RunSummary {
+        window_start: f("window_start")?,
+        window_end: f("window_end")?,
+        rows: f("rows")? as usize,
+        v_rms: f("v_rms")?,
+        s_rms: f("s_rms")?,
+        area_mean: f("area_mean")?,
+        growth_rate: f("growth_rate")?,
+        growth_exponent: f("growth_exponent")?,
+    })
 }
 
 /// The point whose values are `values`, if the sweep has it.

@@ -872,8 +872,7 @@ mod tests {
     /// kept in `docs/data/rotation/quick/` (`rotation_runs.csv`, `rotation_saturation.csv`).
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let dir = root.join("docs/data/rotation/quick");
+        let dir = crate::stored_tables("rotation/quick");
         let want = verdicts_from_tables(&dir, Scale::Quick).unwrap();
         assert_eq!(want.len(), 4);
         crate::assert_doc_verdicts("rotation", "**Verdicts (quick):**", &want);

@@ -303,18 +303,7 @@ fn thresholds_by_length(
     for (t, points) in cut {
         let t = *t;
         // Each run cut at T.
-        let rates: Vec<(f64, u64, f64)> = points
-            .iter()
-            .filter(|pt| pt.values[0] == pressure)
-            .flat_map(|pt| &pt.runs)
-            .map(|r| {
-                (
-                    r.values[1].parse().unwrap_or(f64::NAN),
-                    r.seed,
-                    estimator.of(&r.summary),
-                )
-            })
-            .collect();
+        let rates = rates(points, pressure, estimator);
         let (mut found, mut below, mut above) = (Vec::new(), Vec::new(), 0usize);
         for &s in seeds {
             let (value, censored) = match per_seed(&rates, s) {
@@ -570,10 +559,10 @@ fn systematic_runs(
     Ok(out)
 }
 
-/// Each seed's growth-rate threshold in `points` (values `[pressure, ζ]`) of `pressure`: where
-/// it crosses, half the lowest ζ where it crosses below the grid, `None` above it.
-fn seed_thresholds(points: &[PointRuns], pressure: &str) -> Vec<(u64, Option<f64>)> {
-    let rates: Vec<(f64, u64, f64)> = points
+/// Every run of `pressure` in `points` (values `[pressure, ζ]`) as `(ζ, seed, statistic)`, the
+/// statistic read by `estimator`: what [`per_seed`] finds each seed's threshold in.
+fn rates(points: &[PointRuns], pressure: &str, estimator: Estimator) -> Vec<(f64, u64, f64)> {
+    points
         .iter()
         .filter(|pt| pt.values[0] == pressure)
         .flat_map(|pt| &pt.runs)
@@ -581,10 +570,16 @@ fn seed_thresholds(points: &[PointRuns], pressure: &str) -> Vec<(u64, Option<f64
             (
                 r.values[1].parse().unwrap_or(f64::NAN),
                 r.seed,
-                r.summary.growth_rate,
+                estimator.of(&r.summary),
             )
         })
-        .collect();
+        .collect()
+}
+
+/// Each seed's growth-rate threshold in `points` (values `[pressure, ζ]`) of `pressure`: where
+/// it crosses, half the lowest ζ where it crosses below the grid, `None` above it.
+fn seed_thresholds(points: &[PointRuns], pressure: &str) -> Vec<(u64, Option<f64>)> {
+    let rates = rates(points, pressure, Estimator::Rate);
     let mut seeds: Vec<u64> = rates.iter().map(|r| r.1).collect();
     seeds.sort_unstable();
     seeds.dedup();
@@ -750,8 +745,7 @@ mod tests {
     /// runs, kept in `docs/data/run-length/quick/run_length_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let dir = root.join("docs/data/run-length/quick");
+        let dir = crate::stored_tables("run-length/quick");
         let (cut, seeds) = cut_from_table(&dir).unwrap();
         let mut claims = analyse(&cut, &seeds).unwrap().claims;
         let sys =

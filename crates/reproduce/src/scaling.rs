@@ -330,8 +330,7 @@ mod tests {
     /// kept in `docs/data/scaling/quick/scaling.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let rows = rows_from_table(&root.join("docs/data/scaling/quick")).unwrap();
+        let rows = rows_from_table(&crate::stored_tables("scaling/quick")).unwrap();
         let want: Vec<(String, Verdict)> = claims(&rows)
             .into_iter()
             .map(|c| (c.claim, c.verdict))

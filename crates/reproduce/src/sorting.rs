@@ -429,8 +429,7 @@ mod tests {
     /// kept in `docs/data/sorting/quick/sorting_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let late = late_from_table(&root.join("docs/data/sorting/quick")).unwrap();
+        let late = late_from_table(&crate::stored_tables("sorting/quick")).unwrap();
         let want: Vec<(String, Verdict)> = claims(&late)
             .0
             .into_iter()

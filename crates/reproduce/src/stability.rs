@@ -1282,8 +1282,7 @@ mod tests {
     /// computed again here.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let dir = root.join("docs/data/stability/quick");
+        let dir = crate::stored_tables("stability/quick");
         let rows = measured_from_table(&dir).unwrap();
         let mut claims = claims(&rows);
         let reference = rows

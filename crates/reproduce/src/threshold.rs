@@ -327,17 +327,6 @@ fn run_sets_from_table(path: &std::path::Path) -> Result<Vec<RunSet>, SweepError
         t.col("seed")?,
     );
     let (pressure, gamma, zeta) = (t.col("pressure")?, t.col("gamma")?, t.col("zeta")?);
-    let num = |name: &str| t.f64s(name);
-    let (ws, we, v, sr, a, gr, ge) = (
-        num("window_start")?,
-        num("window_end")?,
-        num("v_rms")?,
-        num("s_rms")?,
-        num("area_mean")?,
-        num("growth_rate")?,
-        num("growth_exponent")?,
-    );
-    let rows_c = t.col("rows")?;
     let bad = |k: usize, what: &str| SweepError::Reproduce {
         why: format!("{}: row {}: {what}", path.display(), k + 1),
     };
@@ -358,16 +347,7 @@ fn run_sets_from_table(path: &std::path::Path) -> Result<Vec<RunSet>, SweepError
             values,
             seed: row[seed].parse().map_err(|_| bad(k, "seed"))?,
             run: std::path::PathBuf::new(),
-            summary: study::summary::RunSummary {
-                window_start: ws[k],
-                window_end: we[k],
-                rows: row[rows_c].parse().map_err(|_| bad(k, "rows"))?,
-                v_rms: v[k],
-                s_rms: sr[k],
-                area_mean: a[k],
-                growth_rate: gr[k],
-                growth_exponent: ge[k],
-            },
+            summary: super::pipeline::summary_of_row(&t, k)?,
         };
         let same = |r: &RunSet| r.set == s && r.lx == l && r.integrator == row[integ];
         match sets.last_mut().filter(|r| same(r)) {
@@ -1095,12 +1075,11 @@ mod tests {
     /// at both scales, kept in `docs/data/threshold/{quick,paper}/threshold_runs.csv`.
     #[test]
     fn the_docs_state_the_verdicts_of_the_stored_tables() {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         for (scale, heading, n) in [
             ("quick", "**Verdicts (quick):**", 11),
             ("paper", "**Verdicts:**", 10),
         ] {
-            let dir = root.join("docs/data/threshold").join(scale);
+            let dir = crate::stored_tables(&format!("threshold/{scale}"));
             let want = verdicts_from_tables(&dir).unwrap();
             assert_eq!(want.len(), n, "{scale}");
             crate::assert_doc_verdicts("threshold", heading, &want);

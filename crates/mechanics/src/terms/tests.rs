@@ -425,19 +425,25 @@ fn adhesion_is_the_derivative_of_its_discrete_energy() {
 /// ω = γ, where the gradient energy `λ(γ ± ω)` of the difference of the two fields vanishes and
 /// the contact breaks into stripes at the lattice scale; scenes refuse ω ≥ γ.) An isolated
 /// cell with adhesion feels no force.
+/// Two cells of `scenes/doublet.toml` (R = 8, centres 15 apart on 64 × 48, γ = 0.02, μ = 5,
+/// λ = 3, κ = 0.1, ξ = 1) with the uniform adhesion `omega`.
+fn doublet(omega: f64) -> Tissue {
+    let lattice = Lattice::new(64, 48);
+    let shape = PatchShape::new(lattice, 16).unwrap();
+    let cells = init::discs(lattice, shape, &[[24.5, 24.0], [39.5, 24.0]], 8.0, 3.0);
+    let mut energy = phasefield::EnergyParams::paper();
+    (energy.gamma, energy.mu, energy.lambda, energy.kappa) = (0.02, 5.0, 3.0, 0.1);
+    let params = ModelParams::paper(0.0)
+        .with_energy(energy)
+        .with_xi(1.0)
+        .with_adhesion(omega);
+    Tissue::new(cells, params)
+}
+
 #[test]
 fn a_doublet_adheres_more_with_omega() {
     let measure = |omega: f64| {
-        let lattice = Lattice::new(64, 48);
-        let shape = PatchShape::new(lattice, 16).unwrap();
-        let cells = init::discs(lattice, shape, &[[24.5, 24.0], [39.5, 24.0]], 8.0, 3.0);
-        let mut energy = phasefield::EnergyParams::paper();
-        (energy.gamma, energy.mu, energy.lambda, energy.kappa) = (0.02, 5.0, 3.0, 0.1);
-        let params = ModelParams::paper(0.0)
-            .with_energy(energy)
-            .with_xi(1.0)
-            .with_adhesion(omega);
-        let mut t = Tissue::new(cells, params);
+        let mut t = doublet(omega);
         let mut ws = Workspace::new(t.cells());
         for _ in 0..2000 {
             t.step(&mut ws, &StepParams::new(0.2, 1)).expect("stable");
@@ -494,16 +500,7 @@ fn a_doublet_adheres_more_with_omega() {
 #[test]
 fn pair_adhesion_steps_as_the_adhesion_of_each_pair() {
     let doublet = |omega: f64, pairs: Option<(&[u16], Vec<f64>)>| {
-        let lattice = Lattice::new(64, 48);
-        let shape = PatchShape::new(lattice, 16).unwrap();
-        let cells = init::discs(lattice, shape, &[[24.5, 24.0], [39.5, 24.0]], 8.0, 3.0);
-        let mut energy = phasefield::EnergyParams::paper();
-        (energy.gamma, energy.mu, energy.lambda, energy.kappa) = (0.02, 5.0, 3.0, 0.1);
-        let params = ModelParams::paper(0.0)
-            .with_energy(energy)
-            .with_xi(1.0)
-            .with_adhesion(omega);
-        let mut t = Tissue::new(cells, params);
+        let mut t = doublet(omega);
         if let Some((of_cell, m)) = pairs {
             let pops = Populations::from_assignment(vec![Population::new(); 2], of_cell.to_vec())
                 .with_adhesion(m);
