@@ -68,4 +68,11 @@ pub struct CellState {
     pub phi_min: f64,
     /// Largest `φ_i` on the patch.
     pub phi_max: f64,
+    /// With a cell nematic whose dynamics read it (`crate::terms::CellNematic`), the mean
+    /// over the cell of the nematic field `M = Σ_j φ_j q_j`, `⟨M⟩_i = Σ_x φ_i M / Σ_x φ_i`
+    /// (`[xx, xy]`); zero otherwise.
+    pub nematic_field: [f64; 2],
+    /// With a cell nematic whose dynamics read it, the mean rotation rate of the flow over the
+    /// cell, `⟨½ ∇ × u⟩_i` with `u = Σ_j φ_j v_j / max(Σ_j φ_j, ½)`; zero otherwise.
+    pub vorticity: f64,
 }

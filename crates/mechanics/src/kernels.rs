@@ -131,6 +131,9 @@ pub(crate) struct EvalInput<'a, T: Real> {
     /// Whether to compute the deformation tensors and `Q` (see [`evaluate`]).
     pub shapes: bool,
     pub cell_force: Option<&'a [[f64; 2]]>,
+    /// Each slot's active tensor `T_i` beside `ζ_i S_i` (the cell nematic's `ζ_Q q_i`), which
+    /// the stress takes as `−Σ_j φ_j T_j`; `None` without.
+    pub cell_stress: Option<&'a [[f64; 2]]>,
     pub populations: &'a Populations,
     pub ids: &'a [usize],
     pub active: bool,
@@ -228,6 +231,7 @@ pub(crate) fn evaluate<T: Real>(
         phi,
         shapes,
         cell_force,
+        cell_stress,
         populations: pops,
         ids,
         active,
@@ -249,7 +253,9 @@ pub(crate) fn evaluate<T: Real>(
     let energy = params.energy;
     // With populations of their own ζ the scatter weights each S_i by ζ_i and the force takes
     // the weighted sum as it is; otherwise the sum is Q and the force multiplies it by ζ.
-    let mixed = pops.mixed_zeta(params, active);
+    // A cell's own active tensor (`cell_stress`) is added to its weighted `S_i`, so the sum
+    // is weighted then too.
+    let mixed = pops.mixed_zeta(params, active) || cell_stress.is_some();
     let zeta = if mixed { 1.0 } else { params.zeta };
     // Each population's constants, computed once per evaluation (the scatter asks for a
     // cell's once per patch column).
@@ -301,6 +307,7 @@ pub(crate) fn evaluate<T: Real>(
         &constants,
         &class,
         node_constants,
+        cell_stress,
     );
 
     // Each population's `s1_p`, for the node terms that read them; then the terms' lattice
@@ -483,6 +490,7 @@ fn lattice_sums<T: Real>(
     constants: &(impl Fn(usize) -> CellConstants + Sync),
     class: &(impl Fn(usize) -> usize + Sync),
     node_constants: &[[f64; 2]],
+    cell_stress: Option<&[[f64; 2]]>,
 ) {
     let coef = *coef;
     // Whether a node term has a single-cell pressure `k_p φ ∇²φ` (adhesion's).
@@ -493,7 +501,10 @@ fn lattice_sums<T: Real>(
     let per_cell = |i: usize| {
         let k = constants(i);
         let [sxx, sxy] = cs[i].shape.components();
-        let sh = [k.zeta_weight * sxx, k.zeta_weight * sxy];
+        let sh = match cell_stress {
+            None => [k.zeta_weight * sxx, k.zeta_weight * sxy],
+            Some(t) => [k.zeta_weight * sxx + t[i][0], k.zeta_weight * sxy + t[i][1]],
+        };
         let k_node = node_constants[class(i)][0];
         (k.coef, k.coef.area_factor(cs[i].area), sh, k_node)
     };

@@ -63,6 +63,7 @@ pub mod extensions;
 mod fields;
 mod geometry;
 mod kernels;
+mod nematic_fields;
 mod node_terms;
 mod observables;
 mod params;

@@ -547,7 +547,7 @@ impl<T: Real> Tissue<T> {
     /// Whether a step computes the deformation tensors and `Q`: only the active force uses
     /// them (see [`evaluate`]).
     fn step_needs_shapes(&self) -> bool {
-        self.ext.populations.any_activity(&self.params, self.active)
+        self.ext.populations.any_activity(&self.params, self.active) || self.ext.terms.need_shapes()
     }
 
     /// [`evaluate`] of the current fields, into `out` and the workspace parts given.
@@ -569,7 +569,31 @@ impl<T: Real> Tissue<T> {
             node_constants,
             population_sums,
             kind_constants,
+            nematic: nematic_scratch,
         } = scratch;
+        // The cell nematic (docs/model.md §11.4): each slot's tensor `q_i` from the terms'
+        // state of this stage (in a corrector, the predicted angles), and its active tensor
+        // `ζ_Q q_i` while the activity is on.
+        let nematic = self.ext.terms.nematic();
+        let cell_stress = match nematic {
+            Some((nem, theta)) => {
+                let n = self.cell_id.len();
+                let crate::workspace::NematicScratch { q, stress, .. } = nematic_scratch;
+                q.clear();
+                q.extend(self.cell_id.iter().map(|&id| nem.tensor(theta[id])));
+                if nem.is_active() && self.active {
+                    stress.clear();
+                    stress.extend((0..n).map(|slot| {
+                        let z = nem.zeta_of(self.ext.populations.population(self.cell_id[slot]));
+                        [z * q[slot][0], z * q[slot][1]]
+                    }));
+                    Some(&stress[..])
+                } else {
+                    None
+                }
+            }
+            None => None,
+        };
         // The node terms of this evaluation, in a fixed order (adhesion, then walls: the
         // order their pressures and coefficients are added in).
         // Adhesion: one ω for every pair, or an ω for each pair of populations (the scene
@@ -645,6 +669,7 @@ impl<T: Real> Tissue<T> {
             phi: self.cells.phi(),
             shapes,
             cell_force,
+            cell_stress,
             populations: &self.ext.populations,
             ids: &self.cell_id,
             active: self.active,
@@ -666,6 +691,20 @@ impl<T: Real> Tissue<T> {
             kind_constants,
         };
         evaluate(&input, out, scratch, post);
+        // What the nematic's dynamics read of the fields just evaluated (the corrector wrote
+        // the new state elsewhere: the fields are still those evaluated).
+        if nematic.is_some_and(|(n, _)| n.reads_fields()) {
+            let fields = nematic_scratch.fields.get_or_insert_with(|| {
+                LatticeSums::for_cells(self.lattice(), self.cells.n_cells(), self.cells.shape().nx)
+            });
+            crate::nematic_fields::measure(
+                &self.cells,
+                self.cells.phi(),
+                &nematic_scratch.q,
+                cell_state,
+                fields,
+            );
+        }
         Ok(())
     }
 

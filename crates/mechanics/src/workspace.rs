@@ -49,6 +49,24 @@ pub(crate) struct TermScratch {
     pub(crate) population_sums: crate::node_terms::PopulationSums,
     /// Each population's constants in the current evaluation (one entry without populations).
     pub(crate) kind_constants: Vec<crate::terms::CellConstants>,
+    /// With a cell nematic, each slot's nematic tensor `q_i`, its active tensor `ζ_Q q_i`,
+    /// and the lattice fields its dynamics read (`crate::nematic_fields`), made on first use.
+    pub(crate) nematic: NematicScratch,
+}
+
+/// The cell nematic's buffers ([`TermScratch::nematic`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct NematicScratch {
+    pub(crate) q: Vec<[f64; 2]>,
+    pub(crate) stress: Vec<[f64; 2]>,
+    pub(crate) fields: Option<crate::scatter::LatticeSums<{ crate::nematic_fields::N_FIELDS }>>,
+}
+
+impl NematicScratch {
+    fn heap_bytes(&self) -> usize {
+        (self.q.capacity() + self.stress.capacity()) * std::mem::size_of::<[f64; 2]>()
+            + self.fields.as_ref().map_or(0, |f| f.heap_bytes())
+    }
 }
 
 impl TermScratch {
@@ -60,6 +78,7 @@ impl TermScratch {
             + self.node_constants.capacity() * std::mem::size_of::<[f64; 2]>()
             + self.population_sums.heap_bytes()
             + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
+            + self.nematic.heap_bytes()
     }
 }
 
@@ -105,6 +124,7 @@ impl<T: Real> Workspace<T> {
                 node_constants: Vec::with_capacity(4),
                 population_sums: Default::default(),
                 kind_constants: Vec::with_capacity(4),
+                nematic: NematicScratch::default(),
             },
         }
     }

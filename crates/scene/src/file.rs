@@ -2,7 +2,7 @@
 //! completely, with `deny_unknown_fields` on every table and `--set section.key=value`
 //! overrides (ripgrep's low-level arguments: close to the file, checked only for syntax).
 
-use mechanics::terms::{Align, Polarity, Population, Populations, Propulsion, Terms};
+use mechanics::terms::{Align, CellNematic, Polarity, Population, Populations, Propulsion, Terms};
 use mechanics::{ModelParams, Precision, PressureKind, StepParams};
 use phasefield::PatchShape;
 use serde::{Deserialize, Serialize};
@@ -265,6 +265,63 @@ pub struct PolaritySpec {
     pub contact_inhibition: f64,
 }
 
+/// `[nematic]`: a nematic inside each cell, with its own activity and dynamics
+/// (docs/model.md §11.4, `mechanics::terms::CellNematic`); absent: none.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NematicSpec {
+    /// The activity ζ_Q of the cells' nematics (> 0 extensile, < 0 contractile): the stress
+    /// `−ζ_Q Σ_j φ_j q_j` beside the shape activity's `−ζ Σ_j φ_j S_j`, switched on after the
+    /// relaxation like ζ.
+    pub zeta: f64,
+    /// The magnitude S of each cell's nematic `q = S (cos 2θ, sin 2θ)` (default 1).
+    #[serde(default = "one")]
+    pub order: f64,
+    /// What the nematic's axis turns towards (default `"none"`): the cell's velocity, its
+    /// interface force or its long axis.
+    #[serde(default)]
+    pub align: AlignKind,
+    /// The alignment rate J per unit of the target's magnitude (default 0): near alignment θ
+    /// relaxes at `J |target|` (the reference code's `J-nem` is J/2).
+    #[serde(default)]
+    pub align_rate: f64,
+    /// The elastic constant K (default 0): the rate `K ⟨q_i × M⟩_i` that turns a cell's
+    /// nematic towards its neighbours', `M = Σ_j φ_j q_j`.
+    #[serde(default)]
+    pub elastic: f64,
+    /// The coupling W to the flow's rotation rate (default 0; 1 corotates the nematic with
+    /// the flow).
+    #[serde(default)]
+    pub vorticity: f64,
+    /// The rotational diffusion constant D_r per time unit (default 0; the reference code's
+    /// `D-nem` is `√(2 D_r)`).
+    #[serde(default)]
+    pub rotational_diffusion: f64,
+    /// Every cell's initial angle in radians (0 along +x); absent: uniform, from `[run] seed`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle: Option<f64>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl NematicSpec {
+    /// The term these keys describe (without the populations' own ζ_Q).
+    pub fn term(&self) -> CellNematic {
+        let n = CellNematic::new(self.zeta)
+            .with_order(self.order)
+            .with_alignment(self.align.align(), self.align_rate)
+            .with_elastic(self.elastic)
+            .with_vorticity(self.vorticity)
+            .with_rotational_diffusion(self.rotational_diffusion);
+        match self.angle {
+            Some(theta) => n.with_initial_angle(theta),
+            None => n,
+        }
+    }
+}
+
 /// `[adhesion]`: cell–cell adhesion (docs/model.md §11.2); absent: none.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -438,6 +495,9 @@ pub struct PopulationSpec {
     /// Alignment rate J (default `[polarity] align_rate`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub align_rate: Option<f64>,
+    /// The activity ζ_Q of the cells' nematics (default `[nematic] zeta`; needs `[nematic]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zeta_nematic: Option<f64>,
 }
 
 impl PopulationSpec {
@@ -480,15 +540,22 @@ pub enum PropulsionKind {
     Density,
 }
 
-impl PolaritySpec {
-    /// The term these keys describe.
-    pub fn term(&self) -> Polarity {
-        let align = match self.align {
+impl AlignKind {
+    /// The alignment target it names.
+    pub fn align(self) -> Align {
+        match self {
             AlignKind::None => Align::None,
             AlignKind::Velocity => Align::Velocity,
             AlignKind::Force => Align::Force,
             AlignKind::Shape => Align::Shape,
-        };
+        }
+    }
+}
+
+impl PolaritySpec {
+    /// The term these keys describe.
+    pub fn term(&self) -> Polarity {
+        let align = self.align.align();
         let propulsion = match self.propulsion {
             PropulsionKind::Cell => Propulsion::Cell,
             PropulsionKind::Density => Propulsion::Density,
@@ -526,6 +593,9 @@ pub struct SceneFile {
     /// `[polarity]`, when the cells are self-propelled.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarity: Option<PolaritySpec>,
+    /// `[nematic]`, when the cells carry a nematic of their own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nematic: Option<NematicSpec>,
     /// `[adhesion]`, when the cells adhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adhesion: Option<AdhesionSpec>,
@@ -622,6 +692,15 @@ impl SceneFile {
                         pop.rotational_diffusion,
                         pop.align_rate,
                     );
+                }
+            }
+            terms = terms.with(term);
+        }
+        if let Some(n) = &self.nematic {
+            let mut term = n.term();
+            for (k, pop) in self.population.iter().enumerate() {
+                if pop.zeta_nematic.is_some() {
+                    term = term.with_population(k, pop.zeta_nematic);
                 }
             }
             terms = terms.with(term);

@@ -45,8 +45,8 @@ mod walls;
 pub use error::{SceneError, MAX_SIDE, MAX_STEPS};
 pub use file::{
     AdhesionSpec, AlignKind, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain,
-    InitKind, Integrator, Model, PolaritySpec, PopulationSpec, PropulsionKind, Run, SceneFile,
-    WallKind, WallsSpec,
+    InitKind, Integrator, Model, NematicSpec, PolaritySpec, PopulationSpec, PropulsionKind, Run,
+    SceneFile, WallKind, WallsSpec,
 };
 pub use paths::absolute_paths;
 pub use registry::{register_term, registered_terms, TermBuilder, TermError};
@@ -427,7 +427,7 @@ impl Scene {
         self.file.populations()
     }
 
-    /// The physics terms beyond the minimal model (`[polarity]`), with the run's seed.
+    /// The physics terms beyond the minimal model (`[polarity]`, `[nematic]`), with the run's seed.
     pub fn terms(&self) -> mechanics::terms::Terms {
         let mut terms = self.file.terms();
         for term in &self.user_terms {

@@ -38,6 +38,7 @@ impl SceneFile {
         crate::check::population(&self)?;
         crate::check::adhesion(&self)?;
         crate::check::polarity(&self)?;
+        crate::check::nematic(&self)?;
         crate::check::integrator(&self)?;
         crate::check::run(&self)?;
         if let Some(spec) = &self.division {

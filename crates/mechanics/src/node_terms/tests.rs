@@ -58,6 +58,7 @@ fn evaluate_with(
         phi: cells.phi(),
         shapes: true,
         cell_force: None,
+        cell_stress: None,
         populations: pops,
         ids: &ids,
         active: true,

@@ -24,6 +24,7 @@
 //! Noise is counter-based ([`NoiseKey`]): a deviate is a function of (seed, cell identity,
 //! step, stage), never of the thread count, the slot order or what was drawn before.
 
+mod nematic;
 mod noise;
 mod polarity;
 mod populations;
@@ -33,6 +34,9 @@ use std::sync::Arc;
 
 use nalgebra::Vector2;
 
+pub use nematic::{
+    elastic_rate, nematic_alignment_rate, nematic_angle, nematic_tensor, CellNematic,
+};
 pub use noise::{normal_of_words, philox4x32_10, uniform_of_word, NoiseKey};
 pub use polarity::{alignment_rate, alignment_target, propulsion, Align, Polarity, Propulsion};
 pub use populations::{CellConstants, Population, Populations};
@@ -300,6 +304,23 @@ impl Terms {
             let any: &dyn std::any::Any = &*e.term;
             any.downcast_ref::<Polarity>().map(|p| (t, p))
         })
+    }
+
+    /// The built-in [`CellNematic`] with its state by identity (`θ_i`), if it is one of the
+    /// terms: what an evaluation reads for the nematic's stress and fields.
+    pub fn nematic(&self) -> Option<(&CellNematic, &[f64])> {
+        self.entries.iter().find_map(|e| {
+            let any: &dyn std::any::Any = &*e.term;
+            any.downcast_ref::<CellNematic>().map(|n| (n, &e.x[..]))
+        })
+    }
+
+    /// Whether a term's dynamics read the cells' deformation tensors (an alignment to the
+    /// shape), so that every evaluation of a step must compute them.
+    pub(crate) fn need_shapes(&self) -> bool {
+        self.polarity()
+            .is_some_and(|(_, p)| p.align == Align::Shape)
+            || self.nematic().is_some_and(|(n, _)| n.align == Align::Shape)
     }
 
     /// The term named `name`.

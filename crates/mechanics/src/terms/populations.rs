@@ -271,10 +271,11 @@ impl Populations {
     ) {
         out.clear();
         if self.kinds.is_empty() {
+            // Weighted (a cell's own active tensor beside `S_i`): every cell by the tissue's ζ.
             out.push(CellConstants {
                 coef: params.energy.coefficients(),
                 xi: params.xi,
-                zeta_weight: 1.0,
+                zeta_weight: if mixed { params.zeta } else { 1.0 },
             });
             return;
         }

@@ -798,3 +798,234 @@ fn a_force_that_fails_in_the_corrector_leaves_the_step_start() {
         );
     }
 }
+
+/// Five cells of R = 7 on 64², a centre cell (population 0) with four neighbours 13 away
+/// along ±x and ±y (population 1), relaxed at rest for 50 TU; every nematic along x.
+fn cross(zeta_q: f64) -> (Tissue, Workspace) {
+    let lattice = Lattice::new(64, 64);
+    let shape = PatchShape::new(lattice, 12).unwrap();
+    let c = 32.0;
+    let centres = [
+        [c, c],
+        [c + 13.0, c],
+        [c - 13.0, c],
+        [c, c + 13.0],
+        [c, c - 13.0],
+    ];
+    let cells = init::discs(lattice, shape, &centres, 7.0, 2.5);
+    let pops = Populations::from_assignment(
+        vec![Population::new(), Population::new()],
+        vec![0, 1, 1, 1, 1],
+    );
+    let nem = CellNematic::new(0.0)
+        .with_population(0, Some(zeta_q))
+        .with_initial_angle(0.0);
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0))
+        .with(pops)
+        .with(Terms::new(1).with(nem));
+    let mut ws = Workspace::new(t.cells());
+    t.set_active(false);
+    for _ in 0..100 {
+        t.step(&mut ws, &StepParams::default()).expect("stable");
+    }
+    t.set_active(true);
+    (t, ws)
+}
+
+/// T4.2 of the extensions, the sign: one cell whose nematic is fixed along x among passive
+/// cells. With ζ_Q > 0 (extensile) the force it adds pushes its neighbours along x outward and
+/// pulls those along y inward; with ζ_Q < 0 the reverse. The added force is the difference
+/// of the interface forces with and without ζ_Q in one evaluation of the same fields: linear
+/// in ζ_Q, so the two signs' are opposite to round-off (1e-12 of their size), and by the
+/// cross's symmetry the neighbours' are mirror images (1e-9) and the active cell's own zero.
+#[test]
+fn an_extensile_cell_nematic_pushes_along_its_axis() {
+    let added = |zeta_q: f64| {
+        let (t, mut ws) = cross(zeta_q);
+        t.refresh(&mut ws);
+        let with: Vec<Vector2<f64>> = ws.cell_states().iter().map(|s| s.force).collect();
+        // The same fields without the activity.
+        let mut t0 = t.clone();
+        t0.set_active(false);
+        t0.refresh(&mut ws);
+        let slots: Vec<usize> = (0..5)
+            .map(|id| t.cell_ids().iter().position(|&i| i == id).unwrap())
+            .collect();
+        slots
+            .iter()
+            .map(|&s| with[s] - ws.cell_states()[s].force)
+            .collect::<Vec<_>>()
+    };
+    let ext = added(0.01);
+    let con = added(-0.01);
+    eprintln!("added forces, extensile: {ext:?}");
+    let size = ext[1].norm();
+    assert!(size > 1e-6, "the nematic adds a force: {size:e}");
+    // Outward along x, inward along y.
+    assert!(ext[1].x > 0.0 && ext[2].x < 0.0, "{ext:?}");
+    assert!(ext[3].y < 0.0 && ext[4].y > 0.0, "{ext:?}");
+    for k in 0..5 {
+        assert!((ext[k] + con[k]).norm() < 1e-12 * size, "linear in ζ_Q");
+    }
+    assert!((ext[1].x + ext[2].x).abs() < 1e-9 * size);
+    assert!((ext[3].y + ext[4].y).abs() < 1e-9 * size);
+    assert!(
+        ext[0].norm() < 1e-9 * size,
+        "the active cell itself: {:?}",
+        ext[0]
+    );
+}
+
+/// θ relaxes to its target's axis at the set rate: an isolated cell pushed by a constant
+/// force `G x̂` moves at `v = G/ξ`, and its nematic aligned to the velocity at rate `J` turns
+/// as `dδ/dt = −J |v| δ`. From δ = 0.1 and from π − 0.1 (the same axis, the other end) the
+/// measured decay rate of ln δ down to δ = 0.02 is within 1 % of `J G/ξ` (the rate is exact
+/// in δ; what is left is Heun's error at `J|v| dt = 0.01`).
+#[test]
+fn the_cell_nematic_relaxes_to_its_target_at_the_set_rate() {
+    let (g, j, xi) = (0.02, 2.0, 2.0);
+    for (start, axis) in [
+        (0.1, 0.0),
+        (std::f64::consts::PI - 0.1, std::f64::consts::PI),
+    ] {
+        let nem = CellNematic::new(0.0)
+            .with_alignment(Align::Velocity, j)
+            .with_initial_angle(start);
+        let (mut t, mut ws) = relaxed_cell(Terms::new(1).with(nem).with(Tilt([g, 0.0])));
+        let delta = |t: &Tissue| (t.terms().state("nematic").unwrap()[0] - axis).abs();
+        let mut samples = Vec::new();
+        while delta(&t) > 0.02 {
+            t.step(&mut ws, &StepParams::default()).expect("stable");
+            samples.push((t.time(), delta(&t).ln()));
+        }
+        let n = samples.len() as f64;
+        let (mt, ml) = samples
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (t, l)| (a + t / n, b + l / n));
+        let (sxy, sxx) = samples.iter().fold((0.0, 0.0), |(a, b), (t, l)| {
+            (a + (t - mt) * (l - ml), b + (t - mt) * (t - mt))
+        });
+        let rate = -sxy / sxx;
+        let expected = j * g / xi;
+        eprintln!("nematic alignment from {start}: rate {rate} against {expected}");
+        assert!(
+            (rate / expected - 1.0).abs() < 0.01,
+            "{rate} against {expected}"
+        );
+    }
+}
+
+/// Sixteen cells on a square grid of spacing 12 on 48², relaxed at rest for 100 TU into a
+/// confluent tissue, with the nematic's fields measured (`K ≠ 0`).
+fn grid_tissue() -> (Tissue, Workspace) {
+    let lattice = Lattice::new(48, 48);
+    let shape = PatchShape::new(lattice, 12).unwrap();
+    let centres: Vec<[f64; 2]> = (0..16)
+        .map(|k| [6.0 + 12.0 * (k % 4) as f64, 6.0 + 12.0 * (k / 4) as f64])
+        .collect();
+    let cells = init::discs(lattice, shape, &centres, 6.8, 2.5);
+    let nem = CellNematic::new(0.0)
+        .with_elastic(1.0)
+        .with_initial_angle(0.0);
+    let mut t = Tissue::new(cells, ModelParams::paper(0.0)).with(Terms::new(1).with(nem));
+    let mut ws = Workspace::new(t.cells());
+    t.set_active(false);
+    for _ in 0..200 {
+        t.step(&mut ws, &StepParams::default()).expect("stable");
+    }
+    (t, ws)
+}
+
+/// The measured rotation rate of the flow is the closed form of rigid motions. For a
+/// tessellation of cells moving rigidly with `v_j = Ω ẑ × c_j`, the flow's curl lies on the
+/// interfaces, each weighted by `φ_i ≈ ½` there, and sums to `Ω d P_i / A_i` over a cell of
+/// perimeter `P_i` and area `A_i` whose neighbours are `d` away; for a square cell of side `d`
+/// that is `2Ω`, so `ω_i = Ω`. Measured on the four inner cells of a relaxed 4 × 4 grid
+/// (the outer ones meet the periodic wrap of `c_j`): 0.900 Ω, the same for the four to
+/// 1e-15. The 10 % are the grid's rounded corners, where the cells do not touch: the contact
+/// perimeter is shorter than a square's. Asserted: within 15 %. A uniform translation turns
+/// nothing: `|ω_i|` below 1e-3 of `V / d` (measured 1e-20 of V).
+#[test]
+fn the_vorticity_a_cell_feels_is_that_of_a_rigid_rotation() {
+    let (t, mut ws) = grid_tissue();
+    t.refresh(&mut ws);
+    let centre = [24.0, 24.0];
+    let omega = 1e-3;
+    let q = vec![[1.0, 0.0]; 16];
+    let slots: Vec<usize> = t.cell_ids().to_vec();
+    let at = |id: usize| [6.0 + 12.0 * (id % 4) as f64, 6.0 + 12.0 * (id / 4) as f64];
+    let states = &mut ws.cell_state;
+    for (slot, &id) in slots.iter().enumerate() {
+        let c = at(id);
+        states[slot].velocity =
+            Vector2::new(-omega * (c[1] - centre[1]), omega * (c[0] - centre[0]));
+    }
+    let mut fields = crate::scatter::LatticeSums::new(t.lattice());
+    crate::nematic_fields::measure(t.cells(), t.cells().phi(), &q, states, &mut fields);
+    for (slot, &id) in slots.iter().enumerate() {
+        let inner = [5, 6, 9, 10].contains(&id);
+        if inner {
+            let w = states[slot].vorticity;
+            eprintln!("cell {id}: ω = {w:e} against Ω = {omega:e}");
+            assert!((w / omega - 1.0).abs() < 0.15, "cell {id}: {w:e}");
+        }
+    }
+    let v = 1e-2;
+    for s in states.iter_mut() {
+        s.velocity = Vector2::new(v, 0.0);
+    }
+    crate::nematic_fields::measure(t.cells(), t.cells().phi(), &q, states, &mut fields);
+    let worst = states.iter().map(|s| s.vorticity.abs()).fold(0.0, f64::max);
+    eprintln!("translation: largest |ω| {worst:e}");
+    assert!(worst < 1e-3 * v / 12.0, "{worst:e}");
+    // Every cell's nematic along x: the mean field is along x too.
+    for s in states.iter() {
+        assert!(s.nematic_field[0] > 0.0 && s.nematic_field[1].abs() < 1e-12);
+    }
+}
+
+/// The nematic's stress adds to the shape activity's: without populations, the interface
+/// forces with ζ and ζ_Q both on are those with each alone, less those with neither, to 1e-12
+/// of their size (one evaluation of the same fields; the sum's weights differ in rounding
+/// only). A cell's own active tensor once made the step weight every `S_i` by 1 in place of
+/// ζ, which this catches.
+#[test]
+fn the_cell_nematic_stress_adds_to_the_shape_activity() {
+    // Four cells pressed into each other for 25 TU at rest, so that their shapes are not
+    // round (a disc's `S_i` is zero).
+    let mut pressed = four_cells();
+    let mut ws = Workspace::new(pressed.cells());
+    pressed.set_active(false);
+    for _ in 0..50 {
+        pressed.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    pressed.set_active(true);
+    let forces = |zeta: f64, zeta_q: f64| {
+        let mut t = pressed.clone();
+        t.params_mut().zeta = zeta;
+        let t = t.with(Terms::new(3).with(CellNematic::new(zeta_q)));
+        let mut ws = Workspace::new(t.cells());
+        t.refresh(&mut ws);
+        ws.cell_states().iter().map(|s| s.force).collect::<Vec<_>>()
+    };
+    let (both, shape, nematic, none) = (
+        forces(0.01, 0.004),
+        forces(0.01, 0.0),
+        forces(0.0, 0.004),
+        forces(0.0, 0.0),
+    );
+    let size = shape
+        .iter()
+        .chain(&nematic)
+        .map(|f| f.norm())
+        .fold(0.0, f64::max);
+    assert!(size > 1e-4, "{size:e}");
+    for i in 0..4 {
+        let sum = shape[i] + nematic[i] - none[i];
+        assert!(
+            (both[i] - sum).norm() < 1e-12 * size,
+            "cell {i}: {:?} against {sum:?}",
+            both[i]
+        );
+    }
+}

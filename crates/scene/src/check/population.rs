@@ -24,7 +24,7 @@ pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {
         }
         for (k, p) in file.population.iter().enumerate() {
             let which = format!("population {k} ({})", p.name(k));
-            let checks: [(&'static str, Option<f64>, bool, &str); 8] = [
+            let checks: [(&'static str, Option<f64>, bool, &str); 9] = [
                 (
                     "gamma",
                     p.gamma,
@@ -74,6 +74,12 @@ pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {
                     p.align_rate.is_none_or(|v| v.is_finite() && v >= 0.0),
                     "zero or positive",
                 ),
+                (
+                    "zeta_nematic",
+                    p.zeta_nematic,
+                    p.zeta_nematic.is_none_or(f64::is_finite),
+                    "a finite number, e.g. between -0.01 and 0.01",
+                ),
             ];
             for (key, value, ok, want) in checks {
                 if !ok {
@@ -101,6 +107,15 @@ pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {
                         "add a [polarity] table (alpha = 0 for cells that do not propel themselves), or remove the key",
                     ));
                 }
+            }
+            if let (None, Some(v)) = (&file.nematic, p.zeta_nematic) {
+                return Err(invalid(
+                    "population",
+                    "zeta_nematic",
+                    v,
+                    format!("{which} sets the activity of the cells' nematic, but the scene has no [nematic]"),
+                    "add a [nematic] table (zeta = 0 for the other populations), or remove the key",
+                ));
             }
         }
     }
