@@ -317,6 +317,9 @@ struct RenderCmd {
     /// Each cell's polarity as an arrow (scenes with [polarity]).
     #[arg(long)]
     polarity: bool,
+    /// Each cell's own nematic axis as a segment (scenes with [nematic]).
+    #[arg(long)]
+    nematic: bool,
     /// Each cell's track: its centre through every frame of the run up to the one drawn.
     #[arg(long)]
     tracks: bool,
@@ -446,6 +449,7 @@ fn render_command(cmd: RenderCmd) -> Result<ExitCode> {
         flow,
         axes,
         polarity,
+        nematic,
         tracks,
         events,
         size,
@@ -475,6 +479,7 @@ fn render_command(cmd: RenderCmd) -> Result<ExitCode> {
         flow,
         axes,
         polarity,
+        nematic,
         tracks,
         events,
         size,

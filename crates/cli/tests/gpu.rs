@@ -508,12 +508,22 @@ fn the_gpu_refuses_a_setting_it_has_not_implemented_by_name() {
             };
             let ext = scene.configured_extensions();
             let params = scene.model_params(scene.zeta());
-            assert_eq!(
-                gpu::unsupported(&ext, &params),
-                Vec::<String>::new(),
-                "{}",
-                path.display()
-            );
+            // The cell nematic (`nematic.toml`) is not on the GPU yet: refused by its keys,
+            // and by nothing else.
+            let refused: Vec<String> = gpu::unsupported(&ext, &params)
+                .into_iter()
+                .filter(|k| !k.starts_with("[nematic]"))
+                .collect();
+            assert_eq!(refused, Vec::<String>::new(), "{}", path.display());
+            if scene.file().nematic.is_some() {
+                assert!(
+                    gpu::unsupported(&ext, &params)
+                        .iter()
+                        .any(|k| k.starts_with("[nematic] zeta")),
+                    "{}",
+                    path.display()
+                );
+            }
             seen.extend(ext.settings(&params).into_iter().map(|s| s.key));
         }
     }

@@ -9,6 +9,7 @@ mod docs;
 mod from_state;
 mod gpu;
 mod hostile;
+mod nematic;
 mod resume_all;
 mod signals;
 mod terms;

@@ -968,3 +968,17 @@ fn pair_adhesion_is_refused_by_name() {
     let err = GpuBackend::check(&paired, &sp).unwrap_err().to_string();
     assert!(err.contains("[adhesion] pairs"), "{err}");
 }
+
+/// The cell nematic (`[nematic]`, issue 49) is not on the GPU yet: a tissue with it is refused
+/// before anything runs, naming the scene's keys.
+#[test]
+fn the_cell_nematic_is_refused_by_name() {
+    let sp = StepParams::paper();
+    let nem = mechanics::terms::CellNematic::new(0.005).with_elastic(0.01);
+    let t = paper_tissue(0.0).with(Terms::new(1).with(nem));
+    let err = GpuBackend::check(&t, &sp).unwrap_err().to_string();
+    assert!(
+        err.contains("[nematic] zeta") && err.contains("[nematic] elastic"),
+        "{err}"
+    );
+}

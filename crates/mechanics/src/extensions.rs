@@ -31,7 +31,8 @@ use crate::walls::Walls;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[non_exhaustive]
 pub enum Part {
-    /// Whole-cell physics terms with per-cell state (`[polarity]`, a user's `CellTerm`).
+    /// Whole-cell physics terms with per-cell state (`[polarity]`, `[nematic]`, a user's
+    /// `CellTerm`).
     Terms,
     /// Adhesion between cells (`[adhesion]`; a model parameter, no state).
     Adhesion,
@@ -57,7 +58,7 @@ impl Part {
     /// polarity's, and a registered term's own).
     pub fn scene_table(self) -> &'static str {
         match self {
-            Part::Terms => "[polarity] or [terms.NAME]",
+            Part::Terms => "[polarity], [nematic] or [terms.NAME]",
             Part::Adhesion => "[adhesion]",
             Part::Populations => "[[population]]",
             Part::Walls => "[walls]",

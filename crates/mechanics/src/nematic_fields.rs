@@ -1,4 +1,4 @@
-//! The lattice fields a cell nematic's dynamics read (docs/model.md §11.4), and what each cell
+//! The lattice fields a cell nematic's dynamics read (docs/model.md §11.6), and what each cell
 //! reads of them: the nematic field `M = Σ_j φ_j q_j`, the flow `u = Σ_j φ_j v_j /
 //! max(Σ_j φ_j, ½)`, and per cell their means `⟨M⟩_i` and `⟨½ ∇ × u⟩_i` over the cell
 //! (`⟨f⟩_i = Σ_x φ_i f / Σ_x φ_i`), into [`CellState::nematic_field`] and

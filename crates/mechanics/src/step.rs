@@ -571,7 +571,7 @@ impl<T: Real> Tissue<T> {
             kind_constants,
             nematic: nematic_scratch,
         } = scratch;
-        // The cell nematic (docs/model.md §11.4): each slot's tensor `q_i` from the terms'
+        // The cell nematic (docs/model.md §11.6): each slot's tensor `q_i` from the terms'
         // state of this stage (in a corrector, the predicted angles), and its active tensor
         // `ζ_Q q_i` while the activity is on.
         let nematic = self.ext.terms.nematic();

@@ -807,7 +807,7 @@ impl PySimulation {
 }
 
 /// Renders frames of the run directory `dir` (`steps`, or all) with `colour` and the boolean
-/// `options` of `monolayer render` (`director`, `defects`, `flow`, `axes`, `polarity`,
+/// `options` of `monolayer render` (`director`, `defects`, `flow`, `axes`, `polarity`, `nematic`,
 /// `tracks`, `events`) and `size`: `(step, PNG bytes)` for each.
 fn render_in(
     dir: &Path,
@@ -864,11 +864,12 @@ fn render_options(
                         "flow" => opts.flow = on,
                         "axes" => opts.axes = on,
                         "polarity" => opts.polarity = on,
+                        "nematic" => opts.nematic = on,
                         "tracks" => opts.tracks = on,
                         "events" => opts.events = on,
                         _ => {
                             return Err(PyValueError::new_err(format!(
-                            "render: no option {flag:?}; use size, range, director, defects, flow, axes, polarity, tracks or events"
+                            "render: no option {flag:?}; use size, range, director, defects, flow, axes, polarity, nematic, tracks or events"
                         )))
                         }
                     }

@@ -256,3 +256,26 @@ def test_adhesion_by_pair_of_populations_is_a_scene_key(root):
         scene.set("adhesion.pairs", [[0.006, 0.001], [0.0, 0.0]])
     with pytest.raises(ValueError, match="one row of 2 values"):
         scene.set("adhesion.pairs", [[0.006]])
+
+
+def test_the_cell_nematic_is_a_scene_key_with_columns(root):
+    """`[nematic]` (issue 49) from Python: its keys are set like any other, each cell's axis
+    and tensor are columns of `sim.cells`, and a bad key is refused by name."""
+    text = (root / "scenes" / "nematic.toml").read_text()
+    scene = (
+        ml.Scene.from_text(text)
+        .set("run.relax_time", 0.0)
+        .set("run.time", 2.0)
+        .set("nematic.zeta", -0.01)
+        .set("nematic.angle", 0.25)
+    )
+    sim = ml.Simulation(scene, threads=1)
+    cells = sim.cells
+    assert np.allclose(cells["nematic.theta"], 0.25)
+    # The tensor's components xx and xy.
+    assert np.allclose(cells["nematic.x"], np.cos(0.5))
+    assert np.allclose(cells["nematic.y"], np.sin(0.5))
+    sim.run(progress=False)
+    assert sim.cells["fx"].shape == (60,)
+    with pytest.raises(ValueError, match=r"\[nematic\].*elastic"):
+        scene.set("nematic.elastic", -1.0)

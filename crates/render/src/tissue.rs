@@ -153,6 +153,9 @@ pub struct TissuePicture {
     pub axes: Option<CellAxes>,
     /// Polarities, one arrow per cell.
     pub polarity: Option<CellArrows>,
+    /// The cells' own nematics `[q_xx, q_xy]` (docs/model.md §11.6), one headless segment per
+    /// cell along its axis, its length in proportion to `|q|`.
+    pub nematic: Option<CellAxes>,
     /// Each cell's track, its centres in time order (a jump of more than half the lattice is a
     /// crossing of the periodic boundary, not drawn).
     pub tracks: Option<Vec<Vec<[f64; 2]>>>,
@@ -179,6 +182,7 @@ pub const PLUS: [u8; 3] = [230, 85, 13];
 pub const MINUS: [u8; 3] = [0, 90, 200];
 const AXIS: [u8; 3] = [200, 20, 20];
 const POLARITY: [u8; 3] = [10, 110, 40];
+const NEMATIC: [u8; 3] = [110, 40, 170];
 const TRACK: [u8; 3] = [60, 60, 160];
 const WALL: [u8; 3] = [140, 140, 140];
 const DIVISION: [u8; 3] = [20, 150, 60];
@@ -202,6 +206,7 @@ impl TissuePicture {
             events: Vec::new(),
             axes: None,
             polarity: None,
+            nematic: None,
             tracks: None,
             mark: 8.0,
             title: String::new(),
@@ -288,7 +293,7 @@ impl TissuePicture {
                 }
             }
         }
-        if let Some(a) = &self.axes {
+        for a in [&self.axes, &self.nematic].into_iter().flatten() {
             if a.centres.len() != n || a.shapes.len() != n {
                 return Err(format!("{} axes for {n} cells", a.centres.len()));
             }
@@ -533,7 +538,10 @@ impl TissuePicture {
                 }
             }
         }
-        if let Some(CellAxes { centres, shapes }) = &self.axes {
+        for (axes, colour) in [(&self.axes, AXIS), (&self.nematic, NEMATIC)] {
+            let Some(CellAxes { centres, shapes }) = axes else {
+                continue;
+            };
             let smax = shapes
                 .iter()
                 .map(|s| s[0].hypot(s[1]))
@@ -549,8 +557,8 @@ impl TissuePicture {
                     let half = 0.9 * self.mark * m / smax;
                     let (ex, ey) = (th.cos() * half * s, -th.sin() * half * s);
                     self.periodic(c, ctr[0], ctr[1], half, |c, (px, py), _| {
-                        c.line((px - ex, py - ey), (px + ex, py + ey), 1.5 * line_w, AXIS);
-                        c.disc(px, py, 1.2 * line_w, AXIS);
+                        c.line((px - ex, py - ey), (px + ex, py + ey), 1.5 * line_w, colour);
+                        c.disc(px, py, 1.2 * line_w, colour);
                     });
                 }
             }

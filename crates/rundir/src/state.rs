@@ -207,7 +207,7 @@ fn check_populations(scene: &Scene, from: &Path) -> std::result::Result<(), Stat
 /// What a new user should be told about the saved state `scene` starts from
 /// (`init = "frame"`): its arrays that the scene has no part to carry ([`not_carried`]), and
 /// the scene's keys the state's arrays win over (`[polarity] angle` against the state's
-/// `polarity.theta`). The rules per key are in docs/scenes.md ("Starting from a saved
+/// `polarity.theta`, [`scene::SceneFile::initial_state_keys`]). The rules per key are in docs/scenes.md ("Starting from a saved
 /// state").
 ///
 /// # Errors
@@ -226,10 +226,10 @@ pub fn state_warnings(scene: &Scene) -> std::result::Result<Vec<String>, StateEr
             dropped.join(", ")
         ));
     }
-    if let Some(angle) = scene.file().polarity.as_ref().and_then(|p| p.angle) {
-        if names.iter().any(|n| n == "polarity.theta") {
+    for (array, key, value) in scene.file().initial_state_keys() {
+        if names.iter().any(|n| *n == array) {
             out.push(format!(
-                "[polarity] angle = {angle}: the cells start with the angles of the state's polarity.theta (from {from:?}), which win over the scene's; remove angle from the scene to say so, or start from a state without polarity.theta"
+                "{key} = {value}: the cells start with the values of the state's {array} (from {from:?}), which win over the scene's; remove the key from the scene to say so, or start from a state without {array}"
             ));
         }
     }

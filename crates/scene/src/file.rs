@@ -266,7 +266,7 @@ pub struct PolaritySpec {
 }
 
 /// `[nematic]`: a nematic inside each cell, with its own activity and dynamics
-/// (docs/model.md §11.4, `mechanics::terms::CellNematic`); absent: none.
+/// (docs/model.md §11.6, `mechanics::terms::CellNematic`); absent: none.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NematicSpec {
@@ -706,6 +706,21 @@ impl SceneFile {
             terms = terms.with(term);
         }
         terms
+    }
+
+    /// The keys that set a term's initial per-cell state, each as `(the state's array in a
+    /// frame, the scene key, its value)`: `("polarity.theta", "[polarity] angle", 0.3)`. A
+    /// run that starts from a saved state holding that array takes the array's values, which
+    /// win over the key (and the run says so).
+    pub fn initial_state_keys(&self) -> Vec<(String, String, f64)> {
+        let mut out = Vec::new();
+        if let Some(a) = self.polarity.as_ref().and_then(|p| p.angle) {
+            out.push(("polarity.theta".into(), "[polarity] angle".into(), a));
+        }
+        if let Some(a) = self.nematic.as_ref().and_then(|n| n.angle) {
+            out.push(("nematic.theta".into(), "[nematic] angle".into(), a));
+        }
+        out
     }
 
     /// The populations of `[[population]]` (empty without), cells dealt by `[run] seed`.

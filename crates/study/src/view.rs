@@ -149,6 +149,8 @@ pub struct RenderOptions {
     pub axes: bool,
     /// Each cell's polarity, an arrow (scenes with `[polarity]`).
     pub polarity: bool,
+    /// Each cell's own nematic axis, a segment (scenes with `[nematic]`).
+    pub nematic: bool,
     /// Each cell's track: its centre through every frame up to the one drawn.
     pub tracks: bool,
     /// The divisions, extrusions and deaths of `lineage.csv` since the frame before (runs
@@ -176,6 +178,7 @@ impl Default for RenderOptions {
             flow: false,
             axes: false,
             polarity: false,
+            nematic: false,
             tracks: false,
             events: false,
             size: None,
@@ -509,12 +512,30 @@ fn picture(
             })
             .collect();
     }
+    let arrays = if opts.polarity || opts.nematic {
+        frame.part_arrays()
+    } else {
+        Vec::new()
+    };
+    let vectors = |name: &str| {
+        arrays
+            .iter()
+            .find(|a| a.name == name && a.columns == 2)
+            .map(|v| v.values.chunks_exact(2).map(|d| [d[0], d[1]]).collect())
+    };
     if opts.polarity {
-        // The parts' first per-cell vector (a 2-column array of the frame: `polarity`).
-        if let Some(v) = frame.part_arrays().into_iter().find(|a| a.columns == 2) {
+        if let Some(directions) = vectors("polarity") {
             p.polarity = Some(CellArrows {
                 centres: frame.centres.clone(),
-                directions: v.values.chunks_exact(2).map(|d| [d[0], d[1]]).collect(),
+                directions,
+            });
+        }
+    }
+    if opts.nematic {
+        if let Some(shapes) = vectors("nematic") {
+            p.nematic = Some(CellAxes {
+                centres: frame.centres.clone(),
+                shapes,
             });
         }
     }
@@ -528,6 +549,11 @@ fn picture(
         each.join(", ")
     } else {
         frame.tissue.params().zeta.to_string()
+    };
+    // With the cells' own nematic, its activity too.
+    let zeta = match &run.scene.file().nematic {
+        Some(n) => format!("{zeta}   ζ_Q = {}", n.zeta),
+        None => zeta,
     };
     p.title = format!(
         "t = {}   ζ = {}   step {}",

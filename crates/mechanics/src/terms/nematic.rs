@@ -1,4 +1,4 @@
-//! A nematic inside each cell (docs/model.md §11.4): each cell carries an angle `θ_i`, its
+//! A nematic inside each cell (docs/model.md §11.6): each cell carries an angle `θ_i`, its
 //! nematic tensor `q_i = S (cos 2θ_i, sin 2θ_i)` (the `[xx, xy]` components of a traceless
 //! symmetric tensor), which adds the active stress `−ζ_Q Σ_j φ_j q_j` to the tissue's, beside
 //! the shape activity `−ζ Σ_j φ_j S_j`, so that the interface force gains
@@ -19,9 +19,12 @@
 //!   translation turns nothing); `W = 1` corotates the nematic with the flow;
 //! - `D_r` the rotational diffusion constant.
 //!
+//! While the activity is off (the relaxation of docs/model.md §6) the nematic neither acts nor
+//! turns: the angles a scene sets are those the activity starts from.
+//!
 //! ζ_Q > 0 is extensile (a cell whose `q` is along x pushes its neighbours along x outward),
 //! as ζ > 0 is for the shape activity. How each constant maps to the reference code's is in
-//! docs/model.md §11.4; it differs from it in three places (EXTENSIONS §0): the force is
+//! docs/model.md §11.6; it differs from it in three places (listed there): the force is
 //! recomputed at every evaluation, the vorticity term is a rate, and one sign convention holds
 //! throughout.
 
@@ -187,10 +190,13 @@ impl CellNematic {
 
     /// The deterministic rate of `θ` of a cell (the module's equation without the noise).
     pub fn rate_of(&self, cell: &CellContext<'_>, theta: f64) -> f64 {
+        if !cell.active {
+            return 0.0;
+        }
         let s = cell.state;
         let mut r = elastic_rate(self.elastic, self.order, theta, s.nematic_field)
             + self.vorticity * s.vorticity;
-        if cell.active && self.align != Align::None && self.align_rate != 0.0 {
+        if self.align != Align::None && self.align_rate != 0.0 {
             r += nematic_alignment_rate(self.align_rate, self.target(cell, theta), theta);
         }
         r
@@ -291,17 +297,24 @@ impl CellTerm for CellNematic {
     /// Near its fixed point `θ` relaxes at `2 K S |m| + J |t|` (the elastic torque is
     /// `K S |m| sin 2(ψ − θ)`).
     fn stiffness(&self, cell: &CellContext<'_>, x: &[f64]) -> f64 {
+        if !cell.active {
+            return 0.0;
+        }
         let m = cell.state.nematic_field;
         let mut k = 2.0 * (self.elastic * self.order).abs() * m[0].hypot(m[1]);
-        if cell.active && self.align != Align::None {
+        if self.align != Align::None {
             let [tx, ty] = self.target(cell, x[0]);
             k += self.align_rate.abs() * tx.hypot(ty);
         }
         k
     }
 
-    fn noise(&self, _cell: &CellContext<'_>, out: &mut [f64]) {
-        out[0] = (2.0 * self.rotational_diffusion).sqrt();
+    fn noise(&self, cell: &CellContext<'_>, out: &mut [f64]) {
+        out[0] = if cell.active {
+            (2.0 * self.rotational_diffusion).sqrt()
+        } else {
+            0.0
+        };
     }
 }
 

@@ -1,0 +1,159 @@
+//! `[nematic]` (issue 49): the cells' own nematic end to end. A run writes each cell's axis
+//! and tensor into its frames and the cells' nematic order into its analysis, resumes bit for
+//! bit on another thread count, hands its axes to a run that starts from its frame, and is
+//! refused by the GPU by name before anything is written; bad keys are refused by name.
+
+use crate::common::{bin, run_files, scene_path, stderr};
+
+fn run(out: &std::path::Path, time: &str, threads: &str, extra: &[&str]) -> std::process::Output {
+    let mut cmd = bin();
+    cmd.arg("run")
+        .arg(scene_path("nematic.toml"))
+        .arg("--out")
+        .arg(out)
+        .arg("--quiet")
+        .args([
+            "--set",
+            "run.relax_time=10",
+            "--set",
+            "run.output_every=10",
+            "--set",
+            "run.checkpoint_every=10",
+            "--set",
+            "run.series_every=5",
+            "--set",
+            "nematic.rotational_diffusion=0.01",
+        ])
+        .args(["--set", &format!("run.time={time}"), "--threads", threads]);
+    for e in extra {
+        cmd.args(["--set", e]);
+    }
+    cmd.output().unwrap()
+}
+
+/// The nematic scene for 60 TU on two threads equals, byte for byte, the run on one thread
+/// and a run of 20 TU extended to 60 with `--resume`: the angles are in the checkpoint, their
+/// noise is keyed by cell and step, and the lattice measurement of the elastic and vorticity
+/// torques is thread-count independent. Its frames hold `nematic.theta` and the tensor
+/// `nematic` (`S (cos 2θ, sin 2θ)`, to round-off), and `analyze` writes the cells' nematic
+/// order, below 1 once the noise has turned the axes.
+#[test]
+fn a_nematic_run_resumes_bit_for_bit_and_writes_its_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = dir.path().join("full");
+    let o = run(&full, "60", "2", &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let want = run_files(&full);
+    let last = rundir::last_frame(&full).unwrap();
+    let arrays = rundir::read_npz(
+        &full.join(format!("frames/frame_{last:08}.npz")),
+        &["nematic.theta", "nematic"],
+    )
+    .expect("a nematic frame has its axes and tensors");
+    let (theta, q) = (&arrays[0].data, &arrays[1].data);
+    assert_eq!(q.len(), 2 * theta.len());
+    for (t, q) in theta.iter().zip(q.chunks_exact(2)) {
+        assert!(((2.0 * t).cos() - q[0]).abs() < 1e-12 && ((2.0 * t).sin() - q[1]).abs() < 1e-12);
+    }
+    let one = dir.path().join("one");
+    assert!(run(&one, "60", "1", &[]).status.success());
+    assert!(run_files(&one) == want, "one thread differs from two");
+    let short = dir.path().join("short");
+    assert!(run(&short, "20", "1", &[]).status.success());
+    let o = bin()
+        .args(["run", "--resume"])
+        .arg(&short)
+        .args(["--quiet", "--set", "run.time=60"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(run_files(&short) == want, "the resumed run differs");
+    let o = bin()
+        .arg("analyze")
+        .arg(&full)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let obs = std::fs::read_to_string(full.join("analysis/observables.csv")).unwrap();
+    let header: Vec<&str> = obs.lines().next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "cell_nematic_order")
+        .unwrap();
+    let order: Vec<f64> = obs
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect();
+    assert!(
+        (order[0] - 1.0).abs() < 1e-12,
+        "every axis along x at the start: {order:?}"
+    );
+    assert!(
+        *order.last().unwrap() < 0.999,
+        "the noise turns them: {order:?}"
+    );
+}
+
+/// A run from a frame of a nematic run (`init = "frame"`) starts with the frame's axes, not
+/// the scene's `angle`, and says so.
+#[test]
+fn init_from_a_frame_carries_the_nematic_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = dir.path().join("first");
+    assert!(run(&first, "20", "1", &[]).status.success());
+    let step = rundir::last_frame(&first).unwrap();
+    let last = first.join(format!("frames/frame_{step:08}.npz"));
+    let saved = rundir::read_npz(&last, &["nematic.theta"]).unwrap();
+    let second = dir.path().join("second");
+    let from = format!("cells.from=\"{}\"", last.display());
+    let o = run(
+        &second,
+        "10",
+        "1",
+        &[
+            "cells.init=\"frame\"",
+            &from,
+            "run.relax_time=0",
+            "run.seed=99",
+        ],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("[nematic] angle") && stderr(&o).contains("nematic.theta"),
+        "{}",
+        stderr(&o)
+    );
+    let got = rundir::read_npz(
+        &second.join("frames/frame_00000000.npz"),
+        &["nematic.theta"],
+    )
+    .unwrap();
+    assert_eq!(got[0].data, saved[0].data);
+}
+
+/// The GPU does not run the cell nematic yet: refused naming `[nematic]`'s keys and the fix,
+/// with nothing written. Bad keys are refused by name.
+#[test]
+fn the_nematic_is_refused_where_it_cannot_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("gpu");
+    let o = run(&out, "10", "1", &["integrator.backend=\"gpu\""]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("[nematic] zeta"), "{e}");
+    assert!(!out.exists(), "nothing written");
+    for (set, key) in [
+        ("nematic.elastic=-1", "elastic"),
+        ("nematic.order=-0.5", "order"),
+        ("nematic.align_rate=0.5", "align_rate"),
+    ] {
+        let out = dir.path().join(key);
+        let o = run(&out, "10", "1", &[set]);
+        assert!(!o.status.success(), "{set}");
+        let e = stderr(&o);
+        assert!(e.contains("[nematic]") && e.contains(key), "{set}: {e}");
+        assert!(!out.exists(), "nothing written");
+    }
+}
