@@ -227,7 +227,7 @@ pub fn state_warnings(scene: &Scene) -> std::result::Result<Vec<String>, StateEr
         ));
     }
     for (array, key, value) in scene.file().initial_state_keys() {
-        if names.iter().any(|n| *n == array) {
+        if names.contains(&array) {
             out.push(format!(
                 "{key} = {value}: the cells start with the values of the state's {array} (from {from:?}), which win over the scene's; remove the key from the scene to say so, or start from a state without {array}"
             ));
