@@ -31,7 +31,9 @@
 use super::{CellContext, CellTerm, NoiseKey};
 use crate::terms::Align;
 
-/// A nematic in each cell, with its activity and its dynamics (docs/model.md §11.6): the stress `−ζ_Q Σ_j φ_j q_j` of `q_i = S (cos 2θ_i, sin 2θ_i)`, and `dθ_i = [K ⟨q_i × M⟩_i − J |t_i| δ(θ_i, ψ_i) + W ω_i] dt + √(2 D_r) dW_i`.
+/// A nematic in each cell, with its activity and its dynamics (docs/model.md §11.6): the
+/// stress `−ζ_Q Σ_j φ_j q_j` of `q_i = S (cos 2θ_i, sin 2θ_i)`, and
+/// `dθ_i = [K ⟨q_i × M⟩_i − J |t_i| δ(θ_i, ψ_i) + W ω_i] dt + √(2 D_r) dW_i`.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct CellNematic {
