@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod division;
 mod docs;
+mod forces;
 mod from_state;
 mod gpu;
 mod hostile;

@@ -130,6 +130,9 @@ pub(crate) struct EvalInput<'a, T: Real> {
     pub phi: &'a [T],
     /// Whether to compute the deformation tensors and `Q` (see [`evaluate`]).
     pub shapes: bool,
+    /// Whether the shape activity `ζ_i S_i` enters the stress (off only in the evaluations
+    /// that split the force by origin, `crate::origins`).
+    pub shape_activity: bool,
     pub cell_force: Option<&'a [[f64; 2]]>,
     /// Each slot's active tensor `T_i` beside `ζ_i S_i` (the cell nematic's `ζ_Q q_i`), which
     /// the stress takes as `−Σ_j φ_j T_j`; `None` without.
@@ -230,6 +233,7 @@ pub(crate) fn evaluate<T: Real>(
         cells,
         phi,
         shapes,
+        shape_activity,
         cell_force,
         cell_stress,
         populations: pops,
@@ -308,6 +312,7 @@ pub(crate) fn evaluate<T: Real>(
         &class,
         node_constants,
         cell_stress,
+        shape_activity,
     );
 
     // Each population's `s1_p`, for the node terms that read them; then the terms' lattice
@@ -491,6 +496,7 @@ fn lattice_sums<T: Real>(
     class: &(impl Fn(usize) -> usize + Sync),
     node_constants: &[[f64; 2]],
     cell_stress: Option<&[[f64; 2]]>,
+    shape_activity: bool,
 ) {
     let coef = *coef;
     // Whether a node term has a single-cell pressure `k_p φ ∇²φ` (adhesion's).
@@ -500,7 +506,11 @@ fn lattice_sums<T: Real>(
     // node terms' `k_p` of its class.
     let per_cell = |i: usize| {
         let k = constants(i);
-        let [sxx, sxy] = cs[i].shape.components();
+        let [sxx, sxy] = if shape_activity {
+            cs[i].shape.components()
+        } else {
+            [0.0; 2]
+        };
         let sh = match cell_stress {
             None => [k.zeta_weight * sxx, k.zeta_weight * sxy],
             Some(t) => [k.zeta_weight * sxx + t[i][0], k.zeta_weight * sxy + t[i][1]],

@@ -66,6 +66,7 @@ mod kernels;
 mod nematic_fields;
 mod node_terms;
 mod observables;
+mod origins;
 mod params;
 pub mod persist;
 mod scatter;
@@ -84,6 +85,7 @@ pub use fields::TissueFields;
 pub use geometry::TracelessTensor;
 pub use nalgebra::Vector2;
 pub use observables::{CellObservables, Observables};
+pub use origins::ForcesByOrigin;
 pub use params::{ModelParams, Precision, PressureKind, StepParams, ACTIVITY_DT};
 pub use scratch::thread_scratch_bytes;
 pub use simulation::{

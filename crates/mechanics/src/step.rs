@@ -15,6 +15,38 @@ use crate::tissue::Tissue;
 use crate::workspace::{TermScratch, Workspace};
 use crate::StepError;
 
+/// The parts of the model an evaluation includes: all of them in a step; one at a time in
+/// the evaluations that split the force by origin (`crate::origins`). The tissue pressure of
+/// the passive model (interfaces, area, repulsion) is always in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Included {
+    pub(crate) shape_activity: bool,
+    pub(crate) nematic: bool,
+    pub(crate) adhesion: bool,
+    pub(crate) walls: bool,
+    pub(crate) cell_forces: bool,
+}
+
+impl Included {
+    /// Every part.
+    pub(crate) const ALL: Included = Included {
+        shape_activity: true,
+        nematic: true,
+        adhesion: true,
+        walls: true,
+        cell_forces: true,
+    };
+
+    /// The passive model alone.
+    pub(crate) const NONE: Included = Included {
+        shape_activity: false,
+        nematic: false,
+        adhesion: false,
+        walls: false,
+        cell_forces: false,
+    };
+}
+
 /// How far outside `[0, 1]` a phase field may go before the step is declared unstable.
 ///
 /// Central-difference advection lets φ reach about −0.05 and 1.5 at ζ = 0.01 in stable runs
@@ -280,7 +312,7 @@ impl<T: Real> Tissue<T> {
     }
 
     /// What the terms see of every slot, with the per-cell quantities `cells`.
-    fn terms_view<'a>(&'a self, cells: &'a [CellState], stage: f64) -> CellsView<'a> {
+    pub(crate) fn terms_view<'a>(&'a self, cells: &'a [CellState], stage: f64) -> CellsView<'a> {
         CellsView {
             time: self.time + stage,
             stage,
@@ -562,6 +594,34 @@ impl<T: Real> Tissue<T> {
         stage: f64,
         com: Option<&ComTable>,
     ) -> Result<(), usize> {
+        self.evaluate_parts(
+            Included::ALL,
+            shapes,
+            out,
+            sums,
+            cell_state,
+            scratch,
+            post,
+            stage,
+            com,
+        )
+    }
+
+    /// [`Tissue::evaluate_fields`] with only the parts of the model `inc` (the evaluations
+    /// that split the force by origin, `crate::origins`).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn evaluate_parts(
+        &self,
+        inc: Included,
+        shapes: bool,
+        out: &mut [T],
+        sums: &mut LatticeSums<N_SUMS>,
+        cell_state: &mut [CellState],
+        scratch: &mut TermScratch,
+        post: Post<'_, T>,
+        stage: f64,
+        com: Option<&ComTable>,
+    ) -> Result<(), usize> {
         let TermScratch {
             cell_force,
             node_scratch,
@@ -574,7 +634,7 @@ impl<T: Real> Tissue<T> {
         // The cell nematic (docs/model.md §11.6): each slot's tensor `q_i` from the terms'
         // state of this stage (in a corrector, the predicted angles), and its active tensor
         // `ζ_Q q_i` while the activity is on.
-        let nematic = self.ext.terms.nematic();
+        let nematic = self.ext.terms.nematic().filter(|_| inc.nematic);
         let cell_stress = match nematic {
             Some((nem, theta)) => {
                 let n = self.cell_id.len();
@@ -598,17 +658,22 @@ impl<T: Real> Tissue<T> {
         // order their pressures and coefficients are added in).
         // Adhesion: one ω for every pair, or an ω for each pair of populations (the scene
         // gives one or the other).
-        let adhesion = (self.params.omega != 0.0).then(|| Adhesion {
+        let adhesion = (inc.adhesion && self.params.omega != 0.0).then(|| Adhesion {
             c: adhesion_coefficient(self.params.omega, self.params.energy.lambda),
         });
-        let pair_adhesion = self.ext.populations.adhesion().map(|m| {
-            PairAdhesion::new(
-                m,
-                self.ext.populations.kinds().len(),
-                self.params.energy.lambda,
-            )
-        });
-        let walls = self.wall_term();
+        let pair_adhesion = self
+            .ext
+            .populations
+            .adhesion()
+            .filter(|_| inc.adhesion)
+            .map(|m| {
+                PairAdhesion::new(
+                    m,
+                    self.ext.populations.kinds().len(),
+                    self.params.energy.lambda,
+                )
+            });
+        let walls = self.wall_term().filter(|_| inc.walls);
         let node_terms: [Option<&dyn NodeTerm>; 3] = [
             adhesion.as_ref().map(|t| t as &dyn NodeTerm),
             pair_adhesion.as_ref().map(|t| t as &dyn NodeTerm),
@@ -637,7 +702,7 @@ impl<T: Real> Tissue<T> {
         }
         // The terms' whole-cell forces of the current state, from the per-cell quantities the
         // last evaluation left (see `CellContext::state`).
-        let cell_force = if self.ext.terms.is_empty() {
+        let cell_force = if self.ext.terms.is_empty() || !inc.cell_forces {
             None
         } else {
             // In a corrector the fields are the predicted state: its centres of mass,
@@ -668,6 +733,7 @@ impl<T: Real> Tissue<T> {
             cells: &self.cells,
             phi: self.cells.phi(),
             shapes,
+            shape_activity: inc.shape_activity,
             cell_force,
             cell_stress,
             populations: &self.ext.populations,
@@ -693,7 +759,7 @@ impl<T: Real> Tissue<T> {
         evaluate(&input, out, scratch, post);
         // What the nematic's dynamics read of the fields just evaluated (the corrector wrote
         // the new state elsewhere: the fields are still those evaluated).
-        if nematic.is_some_and(|(n, _)| n.reads_fields()) {
+        if inc == Included::ALL && nematic.is_some_and(|(n, _)| n.reads_fields()) {
             let fields = nematic_scratch.fields.get_or_insert_with(|| {
                 LatticeSums::for_cells(self.lattice(), self.cells.n_cells(), self.cells.shape().nx)
             });

@@ -622,11 +622,25 @@ impl PySimulation {
         self.run_to(py, (Some(stop), Some(until.max(now) + 0.5 * dt)), progress)
     }
 
-    /// The cells' columns (a dict of 1-D NumPy arrays, copies).
+    /// The cells' columns (a dict of 1-D NumPy arrays, copies); with `[run] forces_by_origin`
+    /// also each cell's force by origin, `force.ORIGIN.x` and `.y`.
     fn cells<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let by_origin = self.scene.scene.file().run.forces_by_origin;
         with_sim!(&mut *self.inner()?, s => {
             let (t, ws, _) = s.observe();
-            cells_dict(py, t, ws)
+            let d = cells_dict(py, t, ws)?;
+            if by_origin {
+                let mut own = mechanics::Workspace::new(t.cells());
+                let parts = t.forces_by_origin(&mut own);
+                let slots = t.slots();
+                for (name, f) in parts.names.iter().zip(&parts.parts) {
+                    for (k, axis) in ["x", "y"].into_iter().enumerate() {
+                        let values: Vec<f64> = slots.iter().map(|&s| f[s][k]).collect();
+                        d.set_item(format!("force.{name}.{axis}"), crate::cells::column(py, values)?)?;
+                    }
+                }
+            }
+            Ok(d)
         })
     }
 

@@ -279,3 +279,27 @@ def test_the_cell_nematic_is_a_scene_key_with_columns(root):
     assert sim.cells["fx"].shape == (60,)
     with pytest.raises(ValueError, match=r"\[nematic\].*elastic"):
         scene.set("nematic.elastic", -1.0)
+
+
+def test_the_forces_by_origin_are_columns_of_the_cells(root):
+    """With `[run] forces_by_origin` (issue 49), `sim.cells` has each cell's force by origin,
+    and the parts add up to the interface force plus the terms' force (1e-12 of the largest)."""
+    text = (root / "scenes" / "nematic.toml").read_text()
+    scene = (
+        ml.Scene.from_text(text)
+        .set("run.relax_time", 0.0)
+        .set("run.time", 2.0)
+        .set("model.zeta", 0.005)
+        .set("run.forces_by_origin", True)
+    )
+    sim = ml.Simulation(scene, threads=1)
+    sim.run(progress=False)
+    cells = sim.cells
+    parts = ["pressure", "shape_activity", "nematic_activity"]
+    for axis in ["x", "y"]:
+        total = cells["f" + axis] + cells["cell_f" + axis]
+        summed = sum(cells[f"force.{p}.{axis}"] for p in parts)
+        size = max(np.abs(cells[f"force.{p}.{axis}"]).max() for p in parts)
+        assert np.abs(summed - total).max() < 1e-12 * size
+    plain = ml.Simulation(scene.set("run.forces_by_origin", False), threads=1)
+    assert not any(k.startswith("force.") for k in plain.cells)

@@ -62,6 +62,20 @@ pub fn npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
 /// Writes one frame (see the module docs); `ws` must hold the derived quantities of the
 /// current state (call [`Tissue::observe`] or [`Tissue::refresh`] first).
 pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -> Result<PathBuf> {
+    write_frame_with(dir, tissue, ws, None)
+}
+
+/// [`write_frame`], with each cell's force by origin (`parts`, by slot, from
+/// [`Tissue::forces_by_origin`] of the same state) as arrays `force.ORIGIN` `(N, 2)`.
+///
+/// # Errors
+/// As [`write_frame`].
+pub fn write_frame_with<T: Real>(
+    dir: &Path,
+    tissue: &Tissue<T>,
+    ws: &Workspace<T>,
+    parts: Option<&mechanics::ForcesByOrigin>,
+) -> Result<PathBuf> {
     let frames = dir.join("frames");
     std::fs::create_dir_all(&frames).map_err(|e| RunDirError::io("create", &frames, e))?;
     let path = frames.join(format!("frame_{:08}.npz", tissue.iteration()));
@@ -159,6 +173,14 @@ pub fn write_frame<T: Real>(dir: &Path, tissue: &Tissue<T>, ws: &Workspace<T>) -
             npy(&shape, rows.copied())
         };
         extra.push((array.name, a));
+    }
+    if let Some(p) = parts {
+        for (name, forces) in p.names.iter().zip(&p.parts) {
+            extra.push((
+                format!("force.{name}"),
+                npy(&[n64, 2], slots.iter().flat_map(|&s| forces[s])),
+            ));
+        }
     }
     for (name, a) in extra {
         let a = a.map_err(|e| RunDirError::io("encode", &path, e))?;

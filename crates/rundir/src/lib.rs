@@ -32,8 +32,8 @@ use std::path::{Path, PathBuf};
 
 pub use checkpoint::read_extensions;
 pub use frame::{
-    last_frame, npy, npz_names, read_npz, write_frame, write_npz, Array, FRAME_FORMAT,
-    FRAME_FORMATS_READ,
+    last_frame, npy, npz_names, read_npz, write_frame, write_frame_with, write_npz, Array,
+    FRAME_FORMAT, FRAME_FORMATS_READ,
 };
 pub use lineage::{read_lineage, write_lineage, LINEAGE_HEADER};
 pub use run::{lock_dir, DirLock, Interrupt, Outcome, RunDir, RunError, LOCK};

@@ -64,6 +64,16 @@ fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
             "(N, 2): the physics terms' whole-cell force on each cell (force units), beside the interface force 'force'".into(),
         );
     }
+    if scene.file().run.forces_by_origin {
+        let ext = scene.configured_extensions();
+        for name in ext.force_origins(&scene.model_params(scene.zeta()), true) {
+            let meaning = mechanics::ForcesByOrigin::meaning(&name);
+            m.insert(
+                format!("force.{name}"),
+                format!("(N, 2): {meaning}; the parts add up to force + cell_force"),
+            );
+        }
+    }
     for array in scene.configured_extensions().frame_arrays() {
         let shape = if array.columns == 1 {
             "(N,)".to_string()

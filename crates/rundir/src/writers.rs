@@ -11,7 +11,6 @@ use phasefield::Real;
 use scene::OutputSchedules;
 
 use crate::checkpoint::write_checkpoint;
-use crate::frame::write_frame;
 use crate::series::SeriesWriter;
 use crate::Result;
 
@@ -85,6 +84,7 @@ fn add_with<T: Real>(
         FinalToo::new(Frames {
             dir: dir.to_path_buf(),
             written: written.frames.clone(),
+            forces_by_origin: schedules.forces_by_origin,
         }),
     );
     sim.add_output_writer(
@@ -159,13 +159,21 @@ impl<T: Real> Callback<T> for SeriesRows {
 struct Frames {
     dir: PathBuf,
     written: Arc<AtomicUsize>,
+    /// Whether a frame carries each cell's force by origin (`[run] forces_by_origin`).
+    forces_by_origin: bool,
 }
 
 impl<T: Real> Callback<T> for Frames {
     fn call(&mut self, obs: &mut Observation<'_, T>) -> std::result::Result<(), CallbackError> {
         let tissue = obs.tissue();
+        // The split of the forces evaluates the state once per part, in a workspace of its
+        // own (the observation's is shared with the other writers).
+        let parts = self.forces_by_origin.then(|| {
+            let mut ws = mechanics::Workspace::new(tissue.cells());
+            tissue.forces_by_origin(&mut ws)
+        });
         let ws = obs.workspace();
-        write_frame(&self.dir, tissue, ws)?;
+        crate::frame::write_frame_with(&self.dir, tissue, ws, parts.as_ref())?;
         self.written.fetch_add(1, Ordering::Relaxed);
         Ok(())
     }

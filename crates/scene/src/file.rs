@@ -218,6 +218,10 @@ pub struct Run {
     /// written every 10 minutes of wall time and at the end).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub checkpoint_every: Option<f64>,
+    /// Whether each frame carries every cell's force split by its origin (`force.pressure`,
+    /// `force.shape_activity`, …; default false: one evaluation more per part at each frame).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub forces_by_origin: bool,
 }
 
 impl Default for Run {
@@ -229,6 +233,7 @@ impl Default for Run {
             output_every: 10.0,
             series_every: None,
             checkpoint_every: None,
+            forces_by_origin: false,
         }
     }
 }

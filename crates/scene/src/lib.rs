@@ -73,7 +73,8 @@ pub struct Scene {
     pub(crate) unbuilt: Vec<String>,
 }
 
-/// When the writers of a run directory fire ([`Scene::output_schedules`]).
+/// When the writers of a run directory fire, and what frames carry
+/// ([`Scene::output_schedules`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct OutputSchedules {
@@ -83,6 +84,8 @@ pub struct OutputSchedules {
     pub series: Schedule,
     /// Checkpoints (besides the wall-time ones and the one at the end).
     pub checkpoints: Schedule,
+    /// Whether frames carry each cell's force by origin (`[run] forces_by_origin`).
+    pub forces_by_origin: bool,
 }
 
 /// A scene's durations in steps (with the adaptive step, estimates from its first step).
@@ -241,6 +244,7 @@ impl Scene {
                 checkpoints: Schedule::TimeInterval(
                     r.checkpoint_every.unwrap_or((total / 20.0).max(1e-6)),
                 ),
+                forces_by_origin: r.forces_by_origin,
             }
         } else {
             let c = self.step_counts();
@@ -248,6 +252,7 @@ impl Scene {
                 frames: Schedule::IterationInterval(c.frame_every),
                 series: Schedule::IterationInterval(c.series_every),
                 checkpoints: Schedule::IterationInterval(c.checkpoint_every),
+                forces_by_origin: r.forces_by_origin,
             }
         }
     }

@@ -256,6 +256,9 @@ pub(crate) struct LoadedFrame {
     /// The identity of each row (the frame's `id`; `0..N` in frames before format 3). The
     /// tissue numbers its cells by row, `0..N`.
     pub ids: Vec<usize>,
+    /// Each cell's force by origin where the run recorded it (`[run] forces_by_origin`): the
+    /// frame's arrays `force.ORIGIN`, `(name, N × 2 values)`; empty otherwise.
+    pub force_parts: Vec<(String, Vec<f64>)>,
 }
 
 impl LoadedFrame {
@@ -326,6 +329,7 @@ impl LoadedFrame {
             velocities: pick(&|c| [c.velocity.x, c.velocity.y]),
             areas: slots.iter().map(|&s| cs[s].area).collect(),
             ids,
+            force_parts: Vec::new(),
         })
     }
 
@@ -622,6 +626,29 @@ pub(crate) fn load_frame(
             ));
         }
     }
+    // The forces by origin, as recorded.
+    let names = rundir::npz_names(path).map_err(|e| input(path, e.to_string()))?;
+    let recorded: Vec<&str> = names
+        .iter()
+        .map(String::as_str)
+        .filter(|n| n.starts_with("force."))
+        .collect();
+    let force_parts = if recorded.is_empty() {
+        Vec::new()
+    } else {
+        let arrays = read_npz(path, &recorded).map_err(|e| input(path, e.to_string()))?;
+        let mut out = Vec::new();
+        for (name, a) in recorded.iter().zip(arrays) {
+            if a.data.len() != 2 * n || a.data.iter().any(|v| !v.is_finite()) {
+                return Err(input(
+                    path,
+                    format!("array '{name}' holds {} values, not 2 finite values for each of the {n} cells", a.data.len()),
+                ));
+            }
+            out.push((name.to_string(), a.data));
+        }
+        out
+    };
     Ok(LoadedFrame {
         tissue,
         step,
@@ -632,6 +659,7 @@ pub(crate) fn load_frame(
         velocities: pairs(&velocity),
         areas: area.data,
         ids,
+        force_parts,
     })
 }
 

@@ -833,6 +833,14 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
         let components = if a.columns == 2 { 3 } else { a.columns };
         arrays.push(VtkArray::new(a.name, components, values));
     }
+    // The forces by origin the run recorded (`[run] forces_by_origin`), as vectors.
+    for (name, values) in &frame.force_parts {
+        let v = values
+            .chunks_exact(2)
+            .flat_map(|v| [v[0], v[1], 0.0])
+            .collect();
+        arrays.push(VtkArray::new(name.clone(), 3, VtkValues::F64(v)));
+    }
     (points, arrays)
 }
 
@@ -841,7 +849,7 @@ fn cell_arrays(frame: &LoadedFrame) -> (Vec<[f64; 3]>, Vec<VtkArray>) {
 /// | file | what |
 /// |---|---|
 /// | `fields_STEP.vti` | ImageData `lx × ly × 1`, spacing 1; point arrays (float32 unless said): `phi_sum` `Σ_i φ_i`; `cell_id` (int32) the cell with the largest `φ_i` at the node, −1 where none exceeds ½; `velocity` `(v_x, v_y, 0)`; `Q` `(Q_xx, Q_xy)`; `director` `|Q| (cos θ, sin θ, 0)`; `pressure`; `sigma_xx`, `sigma_yy`, `sigma_xy`; with `[walls]` `wall`, the wall field `w` in effect at the frame's time |
-/// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area`; and every per-cell array of the scene's parts, as the frame has it (a whole number as int32, a 2-column array as a vector `(x, y, 0)`): with `[polarity]` `polarity.theta` and `polarity` `(p_x, p_y, 0)`, with `[[population]]` `population` (int32) |
+/// | `cells_STEP.vtp` | PolyData, one vertex per cell at its centre; point arrays (float64): `cell_id` (int32), `velocity` `(v_x, v_y, 0)`, `deformation_axis` `|S| (cos θ_S, sin θ_S, 0)`, `shape_tensor` `(S_xx, S_xy)`, `area`; and every per-cell array of the scene's parts, as the frame has it (a whole number as int32, a 2-column array as a vector `(x, y, 0)`): with `[polarity]` `polarity.theta` and `polarity` `(p_x, p_y, 0)`, with `[[population]]` `population` (int32); with `[run] forces_by_origin`, each `force.ORIGIN` the frame holds, `(F_x, F_y, 0)` |
 /// | `fields.pvd`, `cells.pvd` | the time series (each file with its frame's time) |
 ///
 /// Every file also holds its time as the field `TimeValue`. `progress(done, total)` is called

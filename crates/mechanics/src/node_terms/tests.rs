@@ -59,6 +59,7 @@ fn evaluate_with(
         shapes: true,
         cell_force: None,
         cell_stress: None,
+        shape_activity: true,
         populations: pops,
         ids: &ids,
         active: true,

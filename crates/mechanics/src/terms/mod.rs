@@ -128,6 +128,13 @@ pub trait CellTerm: Send + Sync + fmt::Debug + std::any::Any {
         out.fill(0.0);
     }
 
+    /// Whether the term has a whole-cell force (true by default; a term with state only, such
+    /// as the cells' nematic, says false, and its force is then not listed among the forces by
+    /// origin).
+    fn has_force(&self) -> bool {
+        true
+    }
+
     /// The whole-cell force on the cell with state `x`, added to its interface force before
     /// the velocity `v_i = (F_i + Σ f_i)/ξ_i` is formed.
     fn force(&self, cell: &CellContext<'_>, x: &[f64]) -> [f64; 2] {
@@ -508,6 +515,26 @@ impl Terms {
                 *f = [f[0] + g[0], f[1] + g[1]];
             }
         }
+    }
+
+    /// Each term's whole-cell forces of the current state (by slot), as `(term's name,
+    /// forces)`, for the terms that have a force ([`CellTerm::has_force`]), in the terms'
+    /// order: the parts [`Terms::forces`] sums.
+    pub(crate) fn forces_of_each(&self, view: &CellsView<'_>) -> Vec<(String, Vec<[f64; 2]>)> {
+        let view = &CellsView {
+            by_id: Some(&self.last),
+            ..*view
+        };
+        let batch = CellBatch { view };
+        self.entries
+            .iter()
+            .filter(|e| e.term.has_force())
+            .map(|e| {
+                let mut out = vec![[0.0; 2]; view.cells.len()];
+                e.term.forces(&batch, &e.x, &mut out);
+                (e.term.name().to_string(), out)
+            })
+            .collect()
     }
 
     /// The stiffest cell of the stiffest term ([`CellTerm::stiffness`]) as `(term's name,

@@ -214,6 +214,11 @@ impl CellTerm for CellNematic {
         &["theta"]
     }
 
+    /// Its force is a stress, which the interface force carries: no whole-cell force.
+    fn has_force(&self) -> bool {
+        false
+    }
+
     fn describe_state(&self, _variable: &str) -> String {
         "each cell's nematic angle, radians counterclockwise from +x (an axis: θ and θ + π are the same)".into()
     }

@@ -1029,3 +1029,76 @@ fn the_cell_nematic_stress_adds_to_the_shape_activity() {
         );
     }
 }
+
+/// Forces by origin (issue 49): on the pressed four cells with every part on (ζ, the cells'
+/// nematic, adhesion, channel walls and a polarity), each part is listed and not zero, and the
+/// parts add up to the interface force plus the terms' whole-cell force to 1e-12 of the largest
+/// part; the pressure part is the interface force of the same fields without any extension
+/// (1e-12). A tissue without extensions has the pressure alone, equal to its force.
+#[test]
+fn the_forces_by_origin_add_up_to_the_force() {
+    use crate::walls::Walls;
+    use phasefield::{WallField, WallShape};
+    let mut t = four_cells();
+    let mut ws = Workspace::new(t.cells());
+    t.set_active(false);
+    for _ in 0..50 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    t.set_active(true);
+    let plain = t.clone();
+    t.params_mut().omega = 0.002;
+    let field = WallField::of_shape(t.lattice(), &WallShape::Channel { width: 40.0 }, 1.0, 0.0);
+    let terms = Terms::new(5)
+        .with(Polarity::new(0.01))
+        .with(CellNematic::new(0.004));
+    let t = t.with(Walls::new(field, 1.0, 0.0)).with(terms);
+    let parts = t.forces_by_origin(&mut ws);
+    assert_eq!(
+        parts.names,
+        [
+            "pressure",
+            "shape_activity",
+            "nematic_activity",
+            "adhesion",
+            "walls",
+            "polarity"
+        ]
+    );
+    let size = parts
+        .parts
+        .iter()
+        .flatten()
+        .map(|f| f[0].hypot(f[1]))
+        .fold(0.0, f64::max);
+    for (name, p) in parts.names.iter().zip(&parts.parts) {
+        let largest = p.iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+        assert!(largest > 1e-6 * size, "{name} is zero");
+    }
+    let states = ws.cell_states();
+    for slot in 0..4 {
+        let sum = parts
+            .parts
+            .iter()
+            .fold([0.0; 2], |a, p| [a[0] + p[slot][0], a[1] + p[slot][1]]);
+        let total = states[slot].force + states[slot].cell_force;
+        assert!(
+            (sum[0] - total.x).hypot(sum[1] - total.y) < 1e-12 * size,
+            "slot {slot}: {sum:?} against {total:?}"
+        );
+    }
+    let mut ws0 = Workspace::new(plain.cells());
+    let mut passive = plain.clone();
+    passive.params_mut().zeta = 0.0;
+    passive.refresh(&mut ws0);
+    for slot in 0..4 {
+        let (a, b) = (parts.parts[0][slot], ws0.cell_states()[slot].force);
+        assert!((a[0] - b.x).hypot(a[1] - b.y) < 1e-12 * size);
+    }
+    let alone = passive.forces_by_origin(&mut ws0);
+    assert_eq!(alone.names, ["pressure"]);
+    for slot in 0..4 {
+        let f = ws0.cell_states()[slot].force;
+        assert_eq!(alone.parts[0][slot], [f.x, f.y]);
+    }
+}

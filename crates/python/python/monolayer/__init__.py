@@ -163,7 +163,12 @@ class Simulation:
         ``id``, ``population``, ``x``, ``y`` (centre of mass), ``vx``, ``vy``, ``fx``, ``fy``
         (interface force), ``cell_fx``, ``cell_fy`` (the terms' whole-cell forces), ``area``,
         ``s_xx``, ``s_xy`` (deformation tensor), then what the scene's terms add (such as
-        ``polarity.theta``). Read-only copies: ``pandas.DataFrame(sim.cells)`` just works."""
+        ``polarity.theta``, or ``nematic.theta`` with ``nematic.x``, ``nematic.y`` the
+        components xx and xy of each cell's nematic tensor). With ``[run] forces_by_origin``
+        also each cell's force by origin, ``force.ORIGIN.x`` and ``.y`` (``pressure``,
+        ``shape_activity``, ``nematic_activity``, ``adhesion``, ``walls``, each term's), which
+        add up to ``fx + cell_fx``. Read-only copies: ``pandas.DataFrame(sim.cells)`` just
+        works."""
         return self._sim.cells()
 
     def phi(self) -> tuple:
