@@ -78,3 +78,46 @@ fn frames_carry_the_forces_by_origin() {
     let names = rundir::npz_names(&off.join(format!("frames/frame_{step:08}.npz"))).unwrap();
     assert!(!names.iter().any(|n| n.starts_with("force.")), "{names:?}");
 }
+
+/// Friction between cells (`[friction] cells`, issue 49) from the command line: a run with it
+/// records its part, `force.friction`, which sums to zero over the cells (1e-12 of its
+/// largest: friction is internal); a negative ξ_c is refused by name, with nothing written.
+#[test]
+fn friction_between_cells_is_a_force_of_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let run = |out: &std::path::Path, cells: &str| {
+        bin()
+            .arg("run")
+            .arg(scene_path("nematic.toml"))
+            .arg("--out")
+            .arg(out)
+            .arg("--quiet")
+            .args(["--set", "run.relax_time=10", "--set", "run.time=10"])
+            .args(["--set", "run.forces_by_origin=true"])
+            .args(["--set", &format!("friction.cells={cells}")])
+            .output()
+            .unwrap()
+    };
+    let o = run(&out, "0.2");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let step = rundir::last_frame(&out).unwrap();
+    let a = rundir::read_npz(
+        &out.join(format!("frames/frame_{step:08}.npz")),
+        &["force.friction"],
+    )
+    .unwrap();
+    let f = &a[0].data;
+    let largest = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(largest > 0.0);
+    for axis in 0..2 {
+        let sum: f64 = f.iter().skip(axis).step_by(2).sum();
+        assert!(sum.abs() < 1e-12 * largest, "{sum:e} of {largest:e}");
+    }
+    let bad = dir.path().join("bad");
+    let o = run(&bad, "-0.1");
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("[friction]") && e.contains("cells"), "{e}");
+    assert!(!bad.exists());
+}

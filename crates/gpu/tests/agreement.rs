@@ -982,3 +982,12 @@ fn the_cell_nematic_is_refused_by_name() {
         "{err}"
     );
 }
+
+/// Friction between cells (`[friction]`, issue 49) is not on the GPU yet: refused by name.
+#[test]
+fn friction_between_cells_is_refused_by_name() {
+    let sp = StepParams::paper();
+    let t = paper_tissue(0.0).with(mechanics::friction::CellFriction::new(0.1));
+    let err = GpuBackend::check(&t, &sp).unwrap_err().to_string();
+    assert!(err.contains("[friction]"), "{err}");
+}

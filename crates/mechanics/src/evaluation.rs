@@ -68,6 +68,9 @@ pub struct CellState {
     pub phi_min: f64,
     /// Largest `φ_i` on the patch.
     pub phi_max: f64,
+    /// The cell's own drag `ξ_i` (the substrate's, plus a wall's friction): its velocity is
+    /// `(F_i + Σ f_i)/ξ_i` without friction between cells (`crate::friction`).
+    pub drag: f64,
     /// With a cell nematic whose dynamics read it (`crate::terms::CellNematic`), the mean
     /// over the cell of the nematic field `M = Σ_j φ_j q_j`, `⟨M⟩_i = Σ_x φ_i M / Σ_x φ_i`
     /// (`[xx, xy]`); zero otherwise.

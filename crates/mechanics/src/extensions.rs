@@ -23,6 +23,7 @@
 //! wildcard) then fail to compile until its arrays, bytes and comparison are written.
 
 use crate::clock::Proliferation;
+use crate::friction::CellFriction;
 use crate::params::ModelParams;
 use crate::terms::{Populations, Terms};
 use crate::walls::Walls;
@@ -42,16 +43,19 @@ pub enum Part {
     Walls,
     /// Division, extrusion and death, with the lineage (`[division]`).
     Division,
+    /// Friction between overlapping cells (`[friction]`; a parameter, no state).
+    Friction,
 }
 
 impl Part {
     /// Every part, in a fixed order.
-    pub const ALL: [Part; 5] = [
+    pub const ALL: [Part; 6] = [
         Part::Terms,
         Part::Adhesion,
         Part::Populations,
         Part::Walls,
         Part::Division,
+        Part::Friction,
     ];
 
     /// The scene tables that configure it, such as `"[walls]"` (the terms: the built-in
@@ -63,6 +67,7 @@ impl Part {
             Part::Populations => "[[population]]",
             Part::Walls => "[walls]",
             Part::Division => "[division]",
+            Part::Friction => "[friction]",
         }
     }
 
@@ -74,6 +79,7 @@ impl Part {
             Part::Populations => "populations",
             Part::Walls => "walls",
             Part::Division => "division",
+            Part::Friction => "friction between cells",
         };
         format!("{name} ({})", self.scene_table())
     }
@@ -90,6 +96,8 @@ pub struct Extensions {
     pub(crate) walls: Option<Walls>,
     /// The cell-cycle clock and the lineage, if cells divide.
     pub(crate) proliferation: Option<Box<Proliferation>>,
+    /// Friction between overlapping cells, if any.
+    pub(crate) friction: Option<CellFriction>,
     /// Each identity's target area as a multiple of `πR²` (the growth before a division;
     /// empty: 1 for every cell), derived from the clock after each step.
     pub(crate) target_scale: Vec<f64>,
@@ -176,6 +184,13 @@ impl Extensions {
                         }
                     }
                 }
+                Part::Friction => {
+                    if let Some(f) = &self.friction {
+                        for (key, value) in f.settings() {
+                            add(part, key, value);
+                        }
+                    }
+                }
             }
         }
         out
@@ -214,6 +229,11 @@ impl Extensions {
         self.proliferation.as_deref()
     }
 
+    /// The friction between cells, if any.
+    pub fn friction(&self) -> Option<&CellFriction> {
+        self.friction.as_ref()
+    }
+
     /// The parts there are, in [`Part::ALL`]'s order (with the model's `params`: adhesion is
     /// one of them).
     pub fn parts(&self, params: &ModelParams) -> Vec<Part> {
@@ -232,6 +252,7 @@ impl Extensions {
             Part::Populations => !self.populations.is_empty(),
             Part::Walls => self.walls.is_some(),
             Part::Division => self.proliferation.is_some(),
+            Part::Friction => self.friction.is_some(),
         }
     }
 
@@ -248,6 +269,7 @@ impl Extensions {
                     self.proliferation.as_ref().map_or(0, |p| p.heap_bytes())
                         + self.target_scale.capacity() * std::mem::size_of::<f64>()
                 }
+                Part::Friction => 0,
             })
             .sum()
     }
@@ -294,6 +316,7 @@ impl Extensions {
                     }
                     _ => true,
                 },
+                Part::Friction => self.friction != other.friction,
             })
             .collect()
     }
@@ -335,6 +358,18 @@ impl ExtensionPart for Walls {
 impl ExtensionPart for Option<Proliferation> {
     fn place(self, ext: &mut Extensions) {
         ext.proliferation = self.map(Box::new);
+    }
+}
+
+impl ExtensionPart for Option<CellFriction> {
+    fn place(self, ext: &mut Extensions) {
+        ext.friction = self;
+    }
+}
+
+impl ExtensionPart for CellFriction {
+    fn place(self, ext: &mut Extensions) {
+        Some(self).place(ext);
     }
 }
 

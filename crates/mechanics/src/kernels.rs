@@ -737,6 +737,7 @@ fn force_and_rhs<T: Real>(
         let half_v = v.map(|c| 0.5 * c);
         st.force = Vector2::from(force);
         st.velocity = Vector2::from(v);
+        st.drag = xi;
         let area_factor = coef.area_factor(st.area);
         match node_terms {
             None => run.write_to(

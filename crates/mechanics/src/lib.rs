@@ -61,6 +61,7 @@ pub mod equations;
 mod evaluation;
 pub mod extensions;
 mod fields;
+pub mod friction;
 mod geometry;
 mod kernels;
 mod nematic_fields;

@@ -6,7 +6,8 @@
 //! and `ζ_Q q_i`). So each part's force is the interface force of an evaluation of the same
 //! fields with that part alone, less that of the passive model (the pressure of the interfaces,
 //! the area and the repulsion), which is a part itself; they add up to the interface force to
-//! round-off. Computed only when asked (a frame of a scene with `[run] forces_by_origin`,
+//! round-off; with friction between cells, its part completes the sum to `ξ_i v_i` (to the
+//! solver's tolerance). Computed only when asked (a frame of a scene with `[run] forces_by_origin`,
 //! Python's `sim.cells` then): one evaluation per part, against a hundred per frame interval.
 
 use phasefield::Real;
@@ -39,6 +40,9 @@ impl ForcesByOrigin {
             }
             "adhesion" => "adhesion's force, through the pressure".into(),
             "walls" => "the walls' force, through the pressure".into(),
+            "friction" => {
+                "the friction of the overlapping cells, -xi_c sum_j o_ij (v_i - v_j)".into()
+            }
             term => format!("the whole-cell force of the term {term}"),
         }
     }
@@ -57,6 +61,7 @@ impl Extensions {
                     .filter(|t| t.has_force())
                     .map(|t| t.name().to_string()),
             )
+            .chain(self.friction.is_some().then(|| "friction".to_string()))
             .collect()
     }
 
@@ -158,6 +163,15 @@ impl<T: Real> Tissue<T> {
                 names.push(name);
                 parts.push(f);
             }
+        }
+        // Friction between cells, `−ξ_c Σ_j o_ij (v_i − v_j)` from the solved velocities.
+        if let Some(f) = &self.ext.friction {
+            names.push("friction".into());
+            parts.push(crate::friction::forces(
+                &ws.term_scratch.friction.pairs,
+                f.xi_c,
+                ws.cell_states(),
+            ));
         }
         ForcesByOrigin { names, parts }
     }

@@ -179,7 +179,7 @@ impl Extensions {
                         });
                     }
                 }
-                Part::Adhesion | Part::Walls => {}
+                Part::Adhesion | Part::Walls | Part::Friction => {}
                 Part::Populations => {
                     if !self.populations.is_empty() {
                         out.push(StateArray {
@@ -325,7 +325,7 @@ impl Extensions {
                             .map_err(|r| bad(&array.name, r))?;
                     }
                 }
-                Part::Adhesion | Part::Walls => {}
+                Part::Adhesion | Part::Walls | Part::Friction => {}
             }
         }
         let assigned = self.populations.of_cell().len();

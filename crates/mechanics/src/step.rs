@@ -25,6 +25,7 @@ pub(crate) struct Included {
     pub(crate) adhesion: bool,
     pub(crate) walls: bool,
     pub(crate) cell_forces: bool,
+    pub(crate) friction: bool,
 }
 
 impl Included {
@@ -35,6 +36,7 @@ impl Included {
         adhesion: true,
         walls: true,
         cell_forces: true,
+        friction: true,
     };
 
     /// The passive model alone.
@@ -44,6 +46,7 @@ impl Included {
         adhesion: false,
         walls: false,
         cell_forces: false,
+        friction: false,
     };
 }
 
@@ -213,8 +216,11 @@ impl<T: Real> Tissue<T> {
         // before it replaces the old one, so that a step that blows up (the last of a run
         // included) leaves the last good state and says so.
         let bound = check.phi_bound();
+        // With friction between cells every corrector is the separate sweep (the evaluation
+        // must finish its velocities before the update).
+        let fused = self.ext.friction.is_none();
         for pass in 0..step_params.npc {
-            if pass + 1 < step_params.npc {
+            if pass + 1 < step_params.npc || !fused {
                 if let Err(slot) = self.correct::<false>(ws, dt) {
                     return Err(self.abandon_step(ws, slot));
                 }
@@ -222,13 +228,13 @@ impl<T: Real> Tissue<T> {
                 self.correct_last(ws, dt, bound)?;
             }
         }
-        if step_params.npc == 0 {
+        if step_params.npc == 0 || !fused {
             if let Some(b) = bound {
                 self.check_new_state(ws, dt, b)?;
             }
         }
         self.advance_clock(dt);
-        if step_params.npc > 0 {
+        if step_params.npc > 0 && fused {
             // The last corrector pass measured the new centres (`Post::Correct`).
             self.move_patches_to(&ws.next_centre);
         } else {
@@ -262,9 +268,12 @@ impl<T: Real> Tissue<T> {
             term_scratch,
             ..
         } = ws;
+        // With friction between cells the predictor is a sweep of its own, after the
+        // velocities are solved (below).
+        let fused = self.ext.friction.is_none();
         let post = match predict {
-            Some(h) => Post::Predict { h, out: phi_old },
-            None => Post::Nothing,
+            Some(h) if fused => Post::Predict { h, out: phi_old },
+            _ => Post::Nothing,
         };
         let shapes = self.step_needs_shapes();
         // (Stage 0 never refuses: the check below reports a force that is not finite.)
@@ -298,6 +307,9 @@ impl<T: Real> Tissue<T> {
         }
         if let Some(h) = predict {
             self.ext.terms.predict(h);
+            if !fused {
+                self.predict_fields(ws, h);
+            }
         }
         Ok(())
     }
@@ -512,6 +524,11 @@ impl<T: Real> Tissue<T> {
     /// left in `ws`.
     pub(crate) fn predict(&mut self, ws: &Workspace<T>, h: f64) {
         self.ext.terms.predict(h);
+        self.predict_fields(ws, h);
+    }
+
+    /// The fields' part of [`Tissue::predict`].
+    fn predict_fields(&mut self, ws: &Workspace<T>, h: f64) {
         let phi = self.cells.phi_mut();
         phi.par_iter_mut()
             .zip(ws.phi_old.par_iter().zip(ws.k1.par_iter()))
@@ -630,7 +647,15 @@ impl<T: Real> Tissue<T> {
             population_sums,
             kind_constants,
             nematic: nematic_scratch,
+            friction: friction_scratch,
         } = scratch;
+        // Friction between cells couples the velocities, so the right-hand side is corrected
+        // after the evaluation: never in an evaluation fused with an update (`Post`).
+        let friction = self.ext.friction.as_ref().filter(|_| inc.friction);
+        debug_assert!(
+            friction.is_none() || matches!(post, Post::Nothing),
+            "friction between cells in a fused evaluation"
+        );
         // The cell nematic (docs/model.md §11.6): each slot's tensor `q_i` from the terms'
         // state of this stage (in a corrector, the predicted angles), and its active tensor
         // `ζ_Q q_i` while the activity is on.
@@ -757,6 +782,18 @@ impl<T: Real> Tissue<T> {
             kind_constants,
         };
         evaluate(&input, out, scratch, post);
+        if let Some(f) = friction {
+            let crate::workspace::FrictionScratch {
+                pairs,
+                before,
+                solve,
+            } = friction_scratch;
+            crate::friction::pair_overlaps(&self.cells, pairs);
+            before.clear();
+            before.extend(cell_state.iter().map(|s| [s.velocity.x, s.velocity.y]));
+            *solve = crate::friction::solve(cell_state, pairs, f);
+            crate::friction::correct_rhs(&self.cells, out, before, cell_state);
+        }
         // What the nematic's dynamics read of the fields just evaluated (the corrector wrote
         // the new state elsewhere: the fields are still those evaluated).
         if inc == Included::ALL && nematic.is_some_and(|(n, _)| n.reads_fields()) {

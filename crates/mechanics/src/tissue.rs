@@ -148,6 +148,7 @@ impl<T: Real> Tissue<T> {
             populations,
             walls,
             proliferation,
+            friction,
             target_scale: _,
         } = ext;
         assert!(
@@ -169,6 +170,7 @@ impl<T: Real> Tissue<T> {
             populations,
             walls,
             proliferation,
+            friction,
             target_scale: Vec::new(),
         };
         self.refresh_target_scale();

@@ -52,6 +52,17 @@ pub(crate) struct TermScratch {
     /// With a cell nematic, each slot's nematic tensor `q_i`, its active tensor `ζ_Q q_i`,
     /// and the lattice fields its dynamics read (`crate::nematic_fields`), made on first use.
     pub(crate) nematic: NematicScratch,
+    /// With friction between cells: the overlaps of the pairs, the velocities before the
+    /// solve, and what the last solve did (`crate::friction`).
+    pub(crate) friction: FrictionScratch,
+}
+
+/// Friction's buffers ([`TermScratch::friction`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct FrictionScratch {
+    pub(crate) pairs: Vec<(u32, u32, f64)>,
+    pub(crate) before: Vec<[f64; 2]>,
+    pub(crate) solve: crate::friction::FrictionSolve,
 }
 
 /// The cell nematic's buffers ([`TermScratch::nematic`]).
@@ -79,6 +90,8 @@ impl TermScratch {
             + self.population_sums.heap_bytes()
             + self.kind_constants.capacity() * std::mem::size_of::<crate::terms::CellConstants>()
             + self.nematic.heap_bytes()
+            + self.friction.pairs.capacity() * std::mem::size_of::<(u32, u32, f64)>()
+            + self.friction.before.capacity() * std::mem::size_of::<[f64; 2]>()
     }
 }
 
@@ -125,6 +138,7 @@ impl<T: Real> Workspace<T> {
                 population_sums: Default::default(),
                 kind_constants: Vec::with_capacity(4),
                 nematic: NematicScratch::default(),
+                friction: FrictionScratch::default(),
             },
         }
     }

@@ -327,6 +327,30 @@ impl NematicSpec {
     }
 }
 
+/// `[friction]`: friction between overlapping cells (docs/model.md §11.8,
+/// `mechanics::friction`); absent: none.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionSpec {
+    /// ξ_c, the friction per unit of overlap `o_ij = Σ_x φ_i φ_j`:
+    /// `ξ_i v_i = F_i − ξ_c Σ_j o_ij (v_i − v_j)`.
+    pub cells: f64,
+    /// The solver's relative residual (default 1e-10).
+    #[serde(default = "friction_tolerance")]
+    pub tolerance: f64,
+}
+
+fn friction_tolerance() -> f64 {
+    1e-10
+}
+
+impl FrictionSpec {
+    /// The part these keys describe.
+    pub fn friction(&self) -> mechanics::friction::CellFriction {
+        mechanics::friction::CellFriction::new(self.cells).with_tolerance(self.tolerance)
+    }
+}
+
 /// `[adhesion]`: cell–cell adhesion (docs/model.md §11.2); absent: none.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -598,6 +622,9 @@ pub struct SceneFile {
     /// `[polarity]`, when the cells are self-propelled.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polarity: Option<PolaritySpec>,
+    /// `[friction]`, when overlapping cells drag each other.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionSpec>,
     /// `[nematic]`, when the cells carry a nematic of their own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nematic: Option<NematicSpec>,

@@ -45,8 +45,8 @@ mod walls;
 pub use error::{SceneError, MAX_SIDE, MAX_STEPS};
 pub use file::{
     AdhesionSpec, AlignKind, CellsSpec, ComputeBackend, DivisionAxis, DivisionSpec, Domain,
-    InitKind, Integrator, Model, NematicSpec, PolaritySpec, PopulationSpec, PropulsionKind, Run,
-    SceneFile, WallKind, WallsSpec,
+    FrictionSpec, InitKind, Integrator, Model, NematicSpec, PolaritySpec, PopulationSpec,
+    PropulsionKind, Run, SceneFile, WallKind, WallsSpec,
 };
 pub use paths::absolute_paths;
 pub use registry::{register_term, registered_terms, TermBuilder, TermError};
@@ -346,6 +346,7 @@ impl Scene {
             .with(self.terms())
             .with(self.file.populations())
             .with(self.walls())
+            .with(self.file.friction.as_ref().map(|f| f.friction()))
             .with(self.file.division.as_ref().map(|spec| {
                 let (t0, rate) = spec.cycle();
                 let clock =

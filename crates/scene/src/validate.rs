@@ -39,6 +39,7 @@ impl SceneFile {
         crate::check::adhesion(&self)?;
         crate::check::polarity(&self)?;
         crate::check::nematic(&self)?;
+        crate::check::friction(&self)?;
         crate::check::integrator(&self)?;
         crate::check::run(&self)?;
         if let Some(spec) = &self.division {

@@ -18,7 +18,7 @@ pub(crate) use cells::cells;
 pub(crate) use domain::domain;
 pub(crate) use integrator::integrator;
 pub(crate) use model::model;
-pub(crate) use nematic::nematic;
+pub(crate) use nematic::{friction, nematic};
 pub(crate) use polarity::polarity;
 pub(crate) use population::population;
 pub(crate) use run::run;
