@@ -524,7 +524,13 @@ fn picture(
             .map(|v| v.values.chunks_exact(2).map(|d| [d[0], d[1]]).collect())
     };
     if opts.polarity {
-        if let Some(directions) = vectors("polarity") {
+        // The parts' first per-cell vector (a 2-column array of the frame: `polarity`, a
+        // user's term's), not the cells' nematic, which is a tensor (drawn as axes below).
+        let first = arrays
+            .iter()
+            .find(|a| a.columns == 2 && a.name != "nematic")
+            .map(|a| a.name.clone());
+        if let Some(directions) = first.and_then(|name| vectors(&name)) {
             p.polarity = Some(CellArrows {
                 centres: frame.centres.clone(),
                 directions,
