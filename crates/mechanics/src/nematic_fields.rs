@@ -70,12 +70,15 @@ pub(crate) fn measure<T: Real>(
             for (a, &x) in map.cell_x(shape, i).iter().enumerate() {
                 let x = x as usize;
                 let [s1, mxx, mxy, ux, _] = fields.columns(x);
-                let [s1_right, _, _, _, uy_right] = fields.columns((x + 1) % lx);
-                let [s1_left, _, _, _, uy_left] = fields.columns((x + lx - 1) % lx);
+                let [s1_right, _, _, _, uy_right] =
+                    fields.columns(if x + 1 == lx { 0 } else { x + 1 });
+                let [s1_left, _, _, _, uy_left] =
+                    fields.columns(if x == 0 { lx - 1 } else { x - 1 });
                 let column = &cell[a * shape.ny..(a + 1) * shape.ny];
                 for (&y, p) in ys.iter().zip(column) {
                     let (y, p) = (y as usize, p.to_f64());
-                    let (up, down) = ((y + 1) % ly, (y + ly - 1) % ly);
+                    let up = if y + 1 == ly { 0 } else { y + 1 };
+                    let down = if y == 0 { ly - 1 } else { y - 1 };
                     let dx_uy =
                         0.5 * (flow(uy_right[y], s1_right[y]) - flow(uy_left[y], s1_left[y]));
                     let dy_ux = 0.5 * (flow(ux[up], s1[up]) - flow(ux[down], s1[down]));
