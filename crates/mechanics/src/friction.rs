@@ -80,22 +80,29 @@ pub fn pair_overlaps<T: Real>(cells: &Cells<T>, out: &mut Vec<(u32, u32, f64)>) 
     let map = cells.map();
     let phi = cells.phi();
     let plen = shape.len();
-    // The storage indices (s_i, s_j) of the patches' shared columns (or rows), when j's patch
-    // starts `d` nodes after i's on a periodic axis of length `l`, with `w` nodes per patch
-    // stored from the offsets `f_i`, `f_j` (logical `u` is stored at `(u + f) mod w`); into
-    // `out`, so that the inner loop reads two tables and no division.
-    let shared =
-        |d: usize, w: usize, l: usize, fi: usize, fj: usize, out: &mut Vec<(usize, usize)>| {
-            out.clear();
-            for u in 0..w {
-                let v = if u >= d { u - d } else { u + l - d };
-                if v < w {
-                    let si = if u + fi >= w { u + fi - w } else { u + fi };
-                    let sj = if v + fj >= w { v + fj - w } else { v + fj };
-                    out.push((si, sj));
+    // The patches' shared columns (or rows) as runs contiguous in both storages, `(s_i, s_j,
+    // len)`, when j's patch starts `d` nodes after i's on a periodic axis of length `l`, with
+    // `w` nodes per patch stored from the offsets `f_i`, `f_j` (logical `u` is stored at
+    // `(u + f) mod w`): so that the inner loop is a dot product of two slices.
+    let shared = |d: usize,
+                  w: usize,
+                  l: usize,
+                  fi: usize,
+                  fj: usize,
+                  out: &mut Vec<(usize, usize, usize)>| {
+        out.clear();
+        for u in 0..w {
+            let v = if u >= d { u - d } else { u + l - d };
+            if v < w {
+                let si = if u + fi >= w { u + fi - w } else { u + fi };
+                let sj = if v + fj >= w { v + fj - w } else { v + fj };
+                match out.last_mut() {
+                    Some((a, b, len)) if *a + *len == si && *b + *len == sj => *len += 1,
+                    _ => out.push((si, sj, 1)),
                 }
             }
-        };
+        }
+    };
     let per_cell: Vec<Vec<(u32, u32, f64)>> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -106,8 +113,17 @@ pub fn pair_overlaps<T: Real>(cells: &Cells<T>, out: &mut Vec<(u32, u32, f64)>) 
             let (mut cols, mut rows) = (Vec::with_capacity(nx), Vec::with_capacity(ny));
             for j in i + 1..n {
                 let [oxj, oyj] = map.origin[j];
-                let dx = (oxj + lx - oxi) % lx;
-                let dy = (oyj + ly - oyi) % ly;
+                // (Without divisions: this test runs for every pair of cells.)
+                let dx = if oxj >= oxi {
+                    oxj - oxi
+                } else {
+                    oxj + lx - oxi
+                };
+                let dy = if oyj >= oyi {
+                    oyj - oyi
+                } else {
+                    oyj + ly - oyi
+                };
                 let near = |d: usize, w: usize, l: usize| d < w || d + w > l;
                 if !(near(dx, nx, lx) && near(dy, ny, ly)) {
                     continue;
@@ -117,10 +133,18 @@ pub fn pair_overlaps<T: Real>(cells: &Cells<T>, out: &mut Vec<(u32, u32, f64)>) 
                 shared(dx, nx, lx, fxi, fxj, &mut cols);
                 shared(dy, ny, ly, fyi, fyj, &mut rows);
                 let mut o = 0.0;
-                for &(ai, aj) in &cols {
-                    let (coli, colj) = (&ci[ai * ny..(ai + 1) * ny], &cj[aj * ny..(aj + 1) * ny]);
-                    for &(bi, bj) in &rows {
-                        o += coli[bi].to_f64() * colj[bj].to_f64();
+                for &(ai, aj, ncols) in &cols {
+                    for c in 0..ncols {
+                        let coli = &ci[(ai + c) * ny..(ai + c + 1) * ny];
+                        let colj = &cj[(aj + c) * ny..(aj + c + 1) * ny];
+                        for &(bi, bj, len) in &rows {
+                            let (x, y) = (&coli[bi..bi + len], &colj[bj..bj + len]);
+                            o += x
+                                .iter()
+                                .zip(y)
+                                .map(|(a, b)| a.to_f64() * b.to_f64())
+                                .sum::<f64>();
+                        }
                     }
                 }
                 if o > 0.0 {
