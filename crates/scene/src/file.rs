@@ -526,10 +526,29 @@ pub struct PopulationSpec {
     pub align_rate: Option<f64>,
     /// The activity ζ_Q of the cells' nematics (default `[nematic] zeta`; needs `[nematic]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub zeta_nematic: Option<f64>,
+    pub nematic_zeta: Option<f64>,
+    /// The nematic's alignment rate J (default `[nematic] align_rate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nematic_align_rate: Option<f64>,
+    /// The nematic's elastic constant K (default `[nematic] elastic`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nematic_elastic: Option<f64>,
+    /// The nematic's rotational diffusion D_r (default `[nematic] rotational_diffusion`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nematic_rotational_diffusion: Option<f64>,
 }
 
 impl PopulationSpec {
+    /// Its own `[ζ_Q, J, K, D_r]` of the cells' nematic, where given.
+    pub fn nematic_values(&self) -> [Option<f64>; 4] {
+        [
+            self.nematic_zeta,
+            self.nematic_align_rate,
+            self.nematic_elastic,
+            self.nematic_rotational_diffusion,
+        ]
+    }
+
     /// The population's name: its own, or a letter by its position `k`.
     pub fn name(&self, k: usize) -> String {
         self.name.clone().unwrap_or_else(|| {
@@ -731,8 +750,9 @@ impl SceneFile {
         if let Some(n) = &self.nematic {
             let mut term = n.term();
             for (k, pop) in self.population.iter().enumerate() {
-                if pop.zeta_nematic.is_some() {
-                    term = term.with_population(k, pop.zeta_nematic);
+                let own = pop.nematic_values();
+                if own.iter().any(Option::is_some) {
+                    term = term.with_population(k, own);
                 }
             }
             terms = terms.with(term);

@@ -53,8 +53,8 @@ pub struct CellNematic {
     pub rotational_diffusion: f64,
     /// Every cell's initial angle; `None`: uniform in `(−π/2, π/2]`, drawn from the seed.
     pub initial_angle: Option<f64>,
-    /// Per population (`crate::terms::Populations`), its own `ζ_Q` where given.
-    pub by_population: Vec<Option<f64>>,
+    /// Per population (`crate::terms::Populations`), its own `[ζ_Q, J, K, D_r]` where given.
+    pub by_population: Vec<[Option<f64>; 4]>,
 }
 
 impl CellNematic {
@@ -110,33 +110,50 @@ impl CellNematic {
         self
     }
 
-    /// With population `k`'s own `ζ_Q`.
-    pub fn with_population(mut self, k: usize, zeta: Option<f64>) -> Self {
+    /// With population `k`'s own `[ζ_Q, J, K, D_r]`, where given.
+    pub fn with_population(mut self, k: usize, values: [Option<f64>; 4]) -> Self {
         if self.by_population.len() <= k {
-            self.by_population.resize(k + 1, None);
+            self.by_population.resize(k + 1, [None; 4]);
         }
-        self.by_population[k] = zeta;
+        self.by_population[k] = values;
         self
+    }
+
+    /// `[ζ_Q, J, K, D_r]` of a cell of population `k`.
+    pub fn values(&self, k: usize) -> [f64; 4] {
+        let own = self.by_population.get(k).copied().unwrap_or([None; 4]);
+        let base = [
+            self.zeta,
+            self.align_rate,
+            self.elastic,
+            self.rotational_diffusion,
+        ];
+        std::array::from_fn(|i| own[i].unwrap_or(base[i]))
     }
 
     /// The `ζ_Q` of a cell of population `k`.
     pub fn zeta_of(&self, k: usize) -> f64 {
-        self.by_population
-            .get(k)
-            .copied()
-            .flatten()
-            .unwrap_or(self.zeta)
+        self.values(k)[0]
     }
 
     /// Whether any cell's nematic is active (a `ζ_Q` not zero).
     pub fn is_active(&self) -> bool {
-        self.zeta != 0.0 || self.by_population.iter().flatten().any(|&z| z != 0.0)
+        self.zeta != 0.0
+            || self
+                .by_population
+                .iter()
+                .any(|v| v[0].is_some_and(|z| z != 0.0))
     }
 
     /// Whether the dynamics read the lattice's nematic and flow fields (`K` or `W` not zero):
     /// only then does an evaluation measure them (`crate::nematic_fields`).
     pub fn reads_fields(&self) -> bool {
-        self.elastic != 0.0 || self.vorticity != 0.0
+        self.elastic != 0.0
+            || self.vorticity != 0.0
+            || self
+                .by_population
+                .iter()
+                .any(|v| v[2].is_some_and(|k| k != 0.0))
     }
 
     /// The nematic tensor `q = S (cos 2θ, sin 2θ)` of angle `theta`.
@@ -196,10 +213,11 @@ impl CellNematic {
             return 0.0;
         }
         let s = cell.state;
-        let mut r = elastic_rate(self.elastic, self.order, theta, s.nematic_field)
-            + self.vorticity * s.vorticity;
-        if self.align != Align::None && self.align_rate != 0.0 {
-            r += nematic_alignment_rate(self.align_rate, self.target(cell, theta), theta);
+        let [_, j, k, _] = self.values(cell.population);
+        let mut r =
+            elastic_rate(k, self.order, theta, s.nematic_field) + self.vorticity * s.vorticity;
+        if self.align != Align::None && j != 0.0 {
+            r += nematic_alignment_rate(j, self.target(cell, theta), theta);
         }
         r
     }
@@ -269,12 +287,20 @@ impl CellTerm for CellNematic {
         if let Some(theta) = initial_angle {
             out.push(("[nematic] angle".into(), theta.to_string()));
         }
-        for (k, z) in by_population.iter().enumerate() {
-            if let Some(z) = z {
-                out.push((
-                    "[[population]] zeta_nematic".into(),
-                    format!("{z} (population {k})"),
-                ));
+        for (k, values) in by_population.iter().enumerate() {
+            let keys = [
+                "nematic_zeta",
+                "nematic_align_rate",
+                "nematic_elastic",
+                "nematic_rotational_diffusion",
+            ];
+            for (key, v) in keys.iter().zip(values) {
+                if let Some(v) = v {
+                    out.push((
+                        format!("[[population]] {key}"),
+                        format!("{v} (population {k})"),
+                    ));
+                }
             }
         }
         out
@@ -308,17 +334,18 @@ impl CellTerm for CellNematic {
             return 0.0;
         }
         let m = cell.state.nematic_field;
-        let mut k = 2.0 * (self.elastic * self.order).abs() * m[0].hypot(m[1]);
+        let [_, j, elastic, _] = self.values(cell.population);
+        let mut k = 2.0 * (elastic * self.order).abs() * m[0].hypot(m[1]);
         if self.align != Align::None {
             let [tx, ty] = self.target(cell, x[0]);
-            k += self.align_rate.abs() * tx.hypot(ty);
+            k += j.abs() * tx.hypot(ty);
         }
         k
     }
 
     fn noise(&self, cell: &CellContext<'_>, out: &mut [f64]) {
         out[0] = if cell.active {
-            (2.0 * self.rotational_diffusion).sqrt()
+            (2.0 * self.values(cell.population)[3]).sqrt()
         } else {
             0.0
         };

@@ -24,7 +24,7 @@ pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {
         }
         for (k, p) in file.population.iter().enumerate() {
             let which = format!("population {k} ({})", p.name(k));
-            let checks: [(&'static str, Option<f64>, bool, &str); 9] = [
+            let checks: [(&'static str, Option<f64>, bool, &str); 12] = [
                 (
                     "gamma",
                     p.gamma,
@@ -75,10 +75,30 @@ pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {
                     "zero or positive",
                 ),
                 (
-                    "zeta_nematic",
-                    p.zeta_nematic,
-                    p.zeta_nematic.is_none_or(f64::is_finite),
+                    "nematic_zeta",
+                    p.nematic_zeta,
+                    p.nematic_zeta.is_none_or(f64::is_finite),
                     "a finite number, e.g. between -0.01 and 0.01",
+                ),
+                (
+                    "nematic_align_rate",
+                    p.nematic_align_rate,
+                    p.nematic_align_rate
+                        .is_none_or(|v| v.is_finite() && v >= 0.0),
+                    "zero or positive",
+                ),
+                (
+                    "nematic_elastic",
+                    p.nematic_elastic,
+                    p.nematic_elastic.is_none_or(|v| v.is_finite() && v >= 0.0),
+                    "zero or positive",
+                ),
+                (
+                    "nematic_rotational_diffusion",
+                    p.nematic_rotational_diffusion,
+                    p.nematic_rotational_diffusion
+                        .is_none_or(|v| v.is_finite() && v >= 0.0),
+                    "zero or positive",
                 ),
             ];
             for (key, value, ok, want) in checks {
@@ -108,12 +128,22 @@ pub(crate) fn population(file: &SceneFile) -> Result<(), SceneError> {
                     ));
                 }
             }
-            if let (None, Some(v)) = (&file.nematic, p.zeta_nematic) {
+            let keys = [
+                "nematic_zeta",
+                "nematic_align_rate",
+                "nematic_elastic",
+                "nematic_rotational_diffusion",
+            ];
+            let own = keys
+                .iter()
+                .zip(p.nematic_values())
+                .find_map(|(k, v)| v.map(|v| (*k, v)));
+            if let (None, Some((key, v))) = (&file.nematic, own) {
                 return Err(invalid(
                     "population",
-                    "zeta_nematic",
+                    key,
                     v,
-                    format!("{which} sets the activity of the cells' nematic, but the scene has no [nematic]"),
+                    format!("{which} sets a parameter of the cells' nematic, but the scene has no [nematic]"),
                     "add a [nematic] table (zeta = 0 for the other populations), or remove the key",
                 ));
             }
