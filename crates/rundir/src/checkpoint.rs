@@ -355,7 +355,7 @@ mod tests {
     use mechanics::Part;
 
     /// A scene with every part of [`Part::ALL`]: polar cells of two populations that adhere,
-    /// inside a disc wall, dividing on a short cycle. `without` leaves one table out.
+    /// inside a disc wall, dividing on a short cycle, with friction between them. `without` leaves one table out.
     fn scene(without: Option<Part>) -> scene::Scene {
         let table = |part: Part, text: &str| -> String {
             if without == Some(part) {
@@ -383,6 +383,7 @@ mod tests {
                 Part::Division,
                 "[division]\ncycle_time = 4.0\ncycle_spread = 2.0\nmax_cells = 12\n",
             ),
+            &table(Part::Friction, "[friction]\ncells = 0.1\n"),
             "[integrator]\ndt = 0.5\nmargin = 12\n[run]\nrelax_time = 2.0\ntime = 10.0\nseed = 3\n",
         ]
         .concat();
