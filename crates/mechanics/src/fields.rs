@@ -25,7 +25,8 @@ pub struct TissueFields {
     pub qxy: Vec<f64>,
     /// The pressure `P` of the run's [`crate::PressureKind`].
     pub pressure: Vec<f64>,
-    /// `σ_xx = −P − ζ Q_xx`.
+    /// `σ_xx = −P − ζ Q_xx` (with populations of their own ζ or the cells' nematic, the
+    /// active part is `−Σ_j φ_j (ζ_j S_j + ζ_Q,j q_j)`, docs/model.md §11.6).
     pub sigma_xx: Vec<f64>,
     /// `σ_yy = −P + ζ Q_xx`.
     pub sigma_yy: Vec<f64>,
@@ -72,9 +73,15 @@ impl<T: Real> Tissue<T> {
     pub fn fields(&self, ws: &mut Workspace<T>) -> TissueFields {
         self.refresh(ws);
         self.scatter_velocity(ws);
-        // With populations of their own ζ the sums hold `Σ ζ_j φ_j S_j`, the active stress's
-        // tensor, and `Q` is scattered again unweighted.
-        let mixed = self.ext.populations.mixed_zeta(&self.params, self.active);
+        // With populations of their own ζ, or the cells' nematic stress, the sums hold the
+        // active stress's tensor `Σ φ_j (ζ_j S_j + ζ_Q,j q_j)` (as the evaluation weighted
+        // them, `kernels::evaluate`), and `Q` is scattered again unweighted.
+        let mixed = self.ext.populations.mixed_zeta(&self.params, self.active)
+            || self
+                .ext
+                .terms
+                .nematic()
+                .is_some_and(|(n, _)| n.is_active() && self.active);
         let zeta = if mixed { 1.0 } else { self.params.zeta };
         let [vx, vy] = ws.velocity_field();
         let mut f = TissueFields {

@@ -1136,3 +1136,38 @@ fn a_population_turns_its_nematic_at_its_own_rate() {
         );
     }
 }
+
+/// The analysis's fields of a tissue with the cells' nematic: `Q` is still `Σ φ_j S_j` (to
+/// 1e-12 of the same fields without the nematic), and the stress carries the nematic's part,
+/// `σ_xx = −P − ζ Q_xx − ζ_Q S s1` and `σ_xy = −ζ Q_xy` for every axis along x (1e-12). The
+/// fields once read the evaluation's weighted sums as `Q` and multiplied them by ζ again.
+#[test]
+fn the_fields_of_a_nematic_tissue_keep_q_and_carry_its_stress() {
+    let mut t = four_cells();
+    let mut ws = Workspace::new(t.cells());
+    t.set_active(false);
+    for _ in 0..50 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    t.set_active(true);
+    let zq = 0.004;
+    let plain = t.fields(&mut ws);
+    let nem = t
+        .clone()
+        .with(Terms::new(2).with(CellNematic::new(zq).with_initial_angle(0.0)));
+    let f = nem.fields(&mut ws);
+    let s1 = ws.sum_field(crate::SumField::S1);
+    let scale = plain
+        .qxx
+        .iter()
+        .chain(&plain.pressure)
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let zeta = t.params().zeta;
+    for k in 0..s1.len() {
+        assert!((f.qxx[k] - plain.qxx[k]).abs() < 1e-12 * scale);
+        assert!((f.qxy[k] - plain.qxy[k]).abs() < 1e-12 * scale);
+        let sxx = -f.pressure[k] - zeta * f.qxx[k] - zq * s1[k];
+        assert!((f.sigma_xx[k] - sxx).abs() < 1e-12 * scale, "node {k}");
+        assert!((f.sigma_xy[k] + zeta * f.qxy[k]).abs() < 1e-12 * scale);
+    }
+}
