@@ -277,7 +277,6 @@ pub(crate) fn correct_rhs<T: Real>(
     cell_state: &[CellState],
 ) {
     let shape = cells.shape();
-    let (nx, ny) = (shape.nx, shape.ny);
     let plen = shape.len();
     rhs.par_chunks_mut(plen)
         .zip(cells.phi().par_chunks(plen))
@@ -290,21 +289,10 @@ pub(crate) fn correct_rhs<T: Real>(
             if dv == [0.0, 0.0] {
                 return;
             }
-            // The patch is periodic in its storage indices, as the force pass's stencil is
-            // (`phasefield::kernel::PaddedPatch::fill`).
-            let next = |a: usize, n: usize| if a + 1 == n { 0 } else { a + 1 };
-            let prev = |a: usize, n: usize| if a == 0 { n - 1 } else { a - 1 };
-            for a in 0..nx {
-                let right = &phi[next(a, nx) * ny..][..ny];
-                let left = &phi[prev(a, nx) * ny..][..ny];
-                let col = &phi[a * ny..(a + 1) * ny];
-                let out = &mut out[a * ny..(a + 1) * ny];
-                for b in 0..ny {
-                    let gx = 0.5 * (right[b].to_f64() - left[b].to_f64());
-                    let gy = 0.5 * (col[next(b, ny)].to_f64() - col[prev(b, ny)].to_f64());
-                    out[b] = T::from_f64(out[b].to_f64() - (dv[0] * gx + dv[1] * gy));
-                }
-            }
+            // The patch is periodic in its storage indices, as the force pass's stencil is.
+            phasefield::for_each_stencil(phi, shape, |k, s| {
+                out[k] = T::from_f64(out[k].to_f64() - (dv[0] * s.dx() + dv[1] * s.dy()));
+            });
         });
 }
 
