@@ -77,11 +77,7 @@ impl<T: Real> Tissue<T> {
         // active stress's tensor `Σ φ_j (ζ_j S_j + ζ_Q,j q_j)` (as the evaluation weighted
         // them, `kernels::evaluate`), and `Q` is scattered again unweighted.
         let mixed = self.ext.populations.mixed_zeta(&self.params, self.active)
-            || self
-                .ext
-                .terms
-                .nematic()
-                .is_some_and(|(n, _)| n.is_active() && self.active);
+            || self.ext.terms.nematic_stress(self.active);
         let zeta = if mixed { 1.0 } else { self.params.zeta };
         let [vx, vy] = ws.velocity_field();
         let mut f = TissueFields {

@@ -69,10 +69,7 @@ impl Extensions {
     /// pressure's, the passive model, first).
     fn force_parts(&self, params: &ModelParams, active: bool) -> Vec<(&'static str, Included)> {
         let activity = self.populations.any_activity(params, active);
-        let nematic = self
-            .terms
-            .nematic()
-            .is_some_and(|(n, _)| n.is_active() && active);
+        let nematic = self.terms.nematic_stress(active);
         let has = |p: Part| self.has(p, params);
         [
             ("pressure", true, Included::NONE),

@@ -666,7 +666,7 @@ impl<T: Real> Tissue<T> {
                 let crate::workspace::NematicScratch { q, stress, .. } = nematic_scratch;
                 q.clear();
                 q.extend(self.cell_id.iter().map(|&id| nem.tensor(theta[id])));
-                if nem.is_active() && self.active {
+                if self.ext.terms.nematic_stress(self.active) {
                     stress.clear();
                     stress.extend((0..n).map(|slot| {
                         let z = nem.zeta_of(self.ext.populations.population(self.cell_id[slot]));

@@ -322,6 +322,14 @@ impl Terms {
         })
     }
 
+    /// Whether the cells' nematic adds to the stress with the activity `active` (a `ζ_Q` that
+    /// is not zero, and the activity on): the one rule by which an evaluation weights its
+    /// active tensors (`kernels::evaluate`), the analysis's fields undo that weighting and
+    /// the forces by origin list the nematic's part.
+    pub(crate) fn nematic_stress(&self, active: bool) -> bool {
+        active && self.nematic().is_some_and(|(n, _)| n.is_active())
+    }
+
     /// Whether a term's dynamics read the cells' deformation tensors (an alignment to the
     /// shape), so that every evaluation of a step must compute them.
     pub(crate) fn need_shapes(&self) -> bool {
