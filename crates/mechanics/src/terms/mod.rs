@@ -128,6 +128,14 @@ pub trait CellTerm: Send + Sync + fmt::Debug + std::any::Any {
         out.fill(0.0);
     }
 
+    /// Whether the term's dynamics read the cells' deformation tensors (`CellContext::state`'s
+    /// `shape`): every evaluation of a step then computes them, which it otherwise does only
+    /// with an active stress. False by default; the built-in terms say true when they align
+    /// to the shape.
+    fn needs_shapes(&self) -> bool {
+        false
+    }
+
     /// Whether the term has a whole-cell force (true by default; a term with state only, such
     /// as the cells' nematic, says false, and its force is then not listed among the forces by
     /// origin).
@@ -333,9 +341,7 @@ impl Terms {
     /// Whether a term's dynamics read the cells' deformation tensors (an alignment to the
     /// shape), so that every evaluation of a step must compute them.
     pub(crate) fn need_shapes(&self) -> bool {
-        self.polarity()
-            .is_some_and(|(_, p)| p.align == Align::Shape)
-            || self.nematic().is_some_and(|(n, _)| n.align == Align::Shape)
+        self.iter().any(|t| t.needs_shapes())
     }
 
     /// The term named `name`.

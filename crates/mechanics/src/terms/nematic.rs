@@ -197,14 +197,7 @@ impl CellNematic {
     /// The alignment target of a cell ([`crate::terms::alignment_target`]: its sign does not
     /// matter to an axis).
     fn target(&self, cell: &CellContext<'_>, theta: f64) -> [f64; 2] {
-        let s = cell.state;
-        super::alignment_target(
-            self.align,
-            [s.velocity.x, s.velocity.y],
-            [s.force.x, s.force.y],
-            s.shape.components(),
-            theta,
-        )
+        self.align.target_of(cell, theta)
     }
 
     /// The deterministic rate of `θ` of a cell (the module's equation without the noise).
@@ -237,6 +230,10 @@ impl CellTerm for CellNematic {
         false
     }
 
+    fn needs_shapes(&self) -> bool {
+        self.align == Align::Shape
+    }
+
     fn describe_state(&self, _variable: &str) -> String {
         "each cell's nematic angle, radians counterclockwise from +x (an axis: θ and θ + π are the same)".into()
     }
@@ -266,16 +263,7 @@ impl CellTerm for CellNematic {
         let mut out = vec![
             ("[nematic] zeta".to_string(), zeta.to_string()),
             ("[nematic] order".into(), order.to_string()),
-            (
-                "[nematic] align".into(),
-                match align {
-                    Align::None => "none",
-                    Align::Velocity => "velocity",
-                    Align::Force => "force",
-                    Align::Shape => "shape",
-                }
-                .into(),
-            ),
+            ("[nematic] align".into(), align.key().into()),
             ("[nematic] align_rate".into(), align_rate.to_string()),
             ("[nematic] elastic".into(), elastic.to_string()),
             ("[nematic] vorticity".into(), vorticity.to_string()),

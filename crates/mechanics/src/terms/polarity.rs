@@ -33,6 +33,31 @@ pub enum Align {
     Shape,
 }
 
+impl Align {
+    /// Its value in a scene (`"velocity"`), as the terms' settings list it.
+    pub fn key(self) -> &'static str {
+        match self {
+            Align::None => "none",
+            Align::Velocity => "velocity",
+            Align::Force => "force",
+            Align::Shape => "shape",
+        }
+    }
+
+    /// The target it names for `cell` ([`alignment_target`] of what the cell's evaluation
+    /// left), with the polarity or nematic angle `theta`.
+    pub(crate) fn target_of(self, cell: &CellContext<'_>, theta: f64) -> [f64; 2] {
+        let s = cell.state;
+        alignment_target(
+            self,
+            [s.velocity.x, s.velocity.y],
+            [s.force.x, s.force.y],
+            s.shape.components(),
+            theta,
+        )
+    }
+}
+
 /// How the propulsion is spread over the cell.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
@@ -144,14 +169,7 @@ impl Polarity {
 
     /// The alignment target of a cell whose polarity is `p`.
     fn target(&self, cell: &CellContext<'_>, theta: f64) -> [f64; 2] {
-        let s = cell.state;
-        alignment_target(
-            self.align,
-            [s.velocity.x, s.velocity.y],
-            [s.force.x, s.force.y],
-            s.shape.components(),
-            theta,
-        )
+        self.align.target_of(cell, theta)
     }
 }
 
@@ -230,6 +248,10 @@ impl CellTerm for Polarity {
         &["theta"]
     }
 
+    fn needs_shapes(&self) -> bool {
+        self.align == Align::Shape
+    }
+
     fn describe_state(&self, _variable: &str) -> String {
         "each cell's polarity angle, radians counterclockwise from +x".into()
     }
@@ -270,16 +292,7 @@ impl CellTerm for Polarity {
                 "[polarity] rotational_diffusion".into(),
                 rotational_diffusion.to_string(),
             ),
-            (
-                "[polarity] align".into(),
-                match align {
-                    Align::None => "none",
-                    Align::Velocity => "velocity",
-                    Align::Force => "force",
-                    Align::Shape => "shape",
-                }
-                .into(),
-            ),
+            ("[polarity] align".into(), align.key().into()),
             ("[polarity] align_rate".into(), align_rate.to_string()),
         ];
         if let Some(theta) = initial_angle {

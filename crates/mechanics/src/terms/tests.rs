@@ -1171,3 +1171,26 @@ fn the_fields_of_a_nematic_tissue_keep_q_and_carry_its_stress() {
         assert!((f.sigma_xy[k] + zeta * f.qxy[k]).abs() < 1e-12 * scale);
     }
 }
+
+/// A term that aligns to the shape gets the shapes even without an active stress
+/// (`CellTerm::needs_shapes`): at ζ = 0 the pressed four cells' polarities, aligned to their
+/// long axes, turn in a step. (The step once skipped the shapes at ζ = 0, and the polarity
+/// aligned to zero.)
+#[test]
+fn a_shape_alignment_sees_the_shapes_at_zero_activity() {
+    let mut t = four_cells();
+    t.params_mut().zeta = 0.0;
+    let mut ws = Workspace::new(t.cells());
+    for _ in 0..50 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    let pol = Polarity::new(0.0)
+        .with_alignment(Align::Shape, 1.0)
+        .with_initial_angle(0.3);
+    let mut t = t.with(Terms::new(1).with(pol));
+    for _ in 0..2 {
+        t.step(&mut ws, &StepParams::default()).unwrap();
+    }
+    let theta = t.terms().state("polarity").unwrap();
+    assert!(theta.iter().all(|&a| (a - 0.3).abs() > 1e-9), "{theta:?}");
+}
