@@ -4,6 +4,21 @@
 
 use crate::common::{bin, scene_path, stderr};
 
+/// The nematic scene, 10 TU of relaxation then 10 TU, into `out`, with the overrides `set`.
+fn run(out: &std::path::Path, set: &[String]) -> std::process::Output {
+    let mut cmd = bin();
+    cmd.arg("run")
+        .arg(scene_path("nematic.toml"))
+        .arg("--out")
+        .arg(out)
+        .arg("--quiet")
+        .args(["--set", "run.relax_time=10", "--set", "run.time=10"]);
+    for s in set {
+        cmd.args(["--set", s]);
+    }
+    cmd.output().unwrap()
+}
+
 /// The nematic scene with shape activity too (ζ = 0.005), its forces by origin on: the last
 /// frame holds `force.pressure`, `force.shape_activity` and `force.nematic_activity`, whose
 /// sum is the frame's `force` to 1e-12 of the largest part (the nematic has no whole-cell
@@ -12,17 +27,13 @@ use crate::common::{bin, scene_path, stderr};
 fn frames_carry_the_forces_by_origin() {
     let dir = tempfile::tempdir().unwrap();
     let run = |out: &std::path::Path, on: bool| {
-        bin()
-            .arg("run")
-            .arg(scene_path("nematic.toml"))
-            .arg("--out")
-            .arg(out)
-            .arg("--quiet")
-            .args(["--set", "run.relax_time=10", "--set", "run.time=10"])
-            .args(["--set", "model.zeta=0.005"])
-            .args(["--set", &format!("run.forces_by_origin={on}")])
-            .output()
-            .unwrap()
+        run(
+            out,
+            &[
+                "model.zeta=0.005".into(),
+                format!("run.forces_by_origin={on}"),
+            ],
+        )
     };
     let out = dir.path().join("on");
     let o = run(&out, true);
@@ -87,17 +98,13 @@ fn friction_between_cells_is_a_force_of_its_own() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let run = |out: &std::path::Path, cells: &str| {
-        bin()
-            .arg("run")
-            .arg(scene_path("nematic.toml"))
-            .arg("--out")
-            .arg(out)
-            .arg("--quiet")
-            .args(["--set", "run.relax_time=10", "--set", "run.time=10"])
-            .args(["--set", "run.forces_by_origin=true"])
-            .args(["--set", &format!("friction.cells={cells}")])
-            .output()
-            .unwrap()
+        run(
+            out,
+            &[
+                "run.forces_by_origin=true".into(),
+                format!("friction.cells={cells}"),
+            ],
+        )
     };
     let o = run(&out, "0.2");
     assert!(o.status.success(), "{}", stderr(&o));
