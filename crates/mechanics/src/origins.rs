@@ -120,7 +120,6 @@ impl<T: Real> Tissue<T> {
     /// terms' whole-cell force of that evaluation, to round-off.
     pub fn forces_by_origin(&self, ws: &mut Workspace<T>) -> ForcesByOrigin {
         let parts_of = self.ext.force_parts(&self.params, self.active);
-        let mut names: Vec<String> = parts_of.iter().map(|(n, _)| n.to_string()).collect();
         let forces_of = |inc: Included, ws: &mut Workspace<T>| -> Vec<[f64; 2]> {
             let Workspace {
                 k2,
@@ -156,20 +155,19 @@ impl<T: Real> Tissue<T> {
         self.refresh(ws);
         if !self.ext.terms.is_empty() {
             let view = self.terms_view(ws.cell_states(), 0.0);
-            for (name, f) in self.ext.terms.forces_of_each(&view) {
-                names.push(name);
-                parts.push(f);
-            }
+            parts.extend(self.ext.terms.forces_of_each(&view));
         }
         // Friction between cells, `−ξ_c Σ_j o_ij (v_i − v_j)` from the solved velocities.
         if let Some(f) = &self.ext.friction {
-            names.push("friction".into());
             parts.push(crate::friction::forces(
                 &ws.term_scratch.friction.pairs,
                 f.xi_c,
                 ws.cell_states(),
             ));
         }
+        // The names in the same order, from the one list of them.
+        let names = self.ext.force_origins(&self.params, self.active);
+        debug_assert_eq!(names.len(), parts.len());
         ForcesByOrigin { names, parts }
     }
 }

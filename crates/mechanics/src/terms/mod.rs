@@ -531,10 +531,10 @@ impl Terms {
         }
     }
 
-    /// Each term's whole-cell forces of the current state (by slot), as `(term's name,
-    /// forces)`, for the terms that have a force ([`CellTerm::has_force`]), in the terms'
-    /// order: the parts [`Terms::forces`] sums.
-    pub(crate) fn forces_of_each(&self, view: &CellsView<'_>) -> Vec<(String, Vec<[f64; 2]>)> {
+    /// Each term's whole-cell forces of the current state (by slot), for the terms that have
+    /// a force ([`CellTerm::has_force`]), in the terms' order: the parts [`Terms::forces`]
+    /// sums.
+    pub(crate) fn forces_of_each(&self, view: &CellsView<'_>) -> Vec<Vec<[f64; 2]>> {
         let view = &CellsView {
             by_id: Some(&self.last),
             ..*view
@@ -546,7 +546,7 @@ impl Terms {
             .map(|e| {
                 let mut out = vec![[0.0; 2]; view.cells.len()];
                 e.term.forces(&batch, &e.x, &mut out);
-                (e.term.name().to_string(), out)
+                out
             })
             .collect()
     }
