@@ -25,3 +25,38 @@ pub(crate) use polarity::polarity;
 pub(crate) use population::population;
 pub(crate) use run::run;
 pub(crate) use walls::walls;
+
+use crate::error::{invalid, SceneError};
+use crate::file::AlignKind;
+
+/// A term's alignment in `section` (`[polarity]`, `[nematic]`): a rate needs a target.
+pub(crate) fn alignment(
+    section: &'static str,
+    align: AlignKind,
+    rate: f64,
+) -> Result<(), SceneError> {
+    if rate > 0.0 && align == AlignKind::None {
+        return Err(invalid(
+            section,
+            "align_rate",
+            rate,
+            "an alignment rate with align = \"none\" aligns to nothing",
+            "set align = \"velocity\", \"force\" or \"shape\", or remove align_rate",
+        ));
+    }
+    Ok(())
+}
+
+/// A term's initial angle in `section`, if given: a finite number.
+pub(crate) fn initial_angle(section: &'static str, angle: Option<f64>) -> Result<(), SceneError> {
+    if let Some(a) = angle.filter(|a| !a.is_finite()) {
+        return Err(invalid(
+            section,
+            "angle",
+            a,
+            "the initial angle must be a finite number",
+            "give it in radians (0 is along +x), or remove it for random angles",
+        ));
+    }
+    Ok(())
+}

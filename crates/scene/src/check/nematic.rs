@@ -1,7 +1,7 @@
 //! The check of `[nematic]`.
 
 use crate::error::{invalid, SceneError};
-use crate::file::{AlignKind, SceneFile};
+use crate::file::SceneFile;
 
 /// `[nematic]`: each key in range, and an alignment rate only with a target.
 pub(crate) fn nematic(file: &SceneFile) -> Result<(), SceneError> {
@@ -52,23 +52,6 @@ pub(crate) fn nematic(file: &SceneFile) -> Result<(), SceneError> {
             return Err(invalid("nematic", key, value, problem, fix));
         }
     }
-    if n.align_rate > 0.0 && n.align == AlignKind::None {
-        return Err(invalid(
-            "nematic",
-            "align_rate",
-            n.align_rate,
-            "an alignment rate with align = \"none\" aligns to nothing",
-            "set align = \"velocity\", \"force\" or \"shape\", or remove align_rate",
-        ));
-    }
-    if let Some(a) = n.angle.filter(|a| !a.is_finite()) {
-        return Err(invalid(
-            "nematic",
-            "angle",
-            a,
-            "the initial angle must be a finite number",
-            "give it in radians (0 is along +x), or remove it for random angles",
-        ));
-    }
-    Ok(())
+    super::alignment("nematic", n.align, n.align_rate)?;
+    super::initial_angle("nematic", n.angle)
 }

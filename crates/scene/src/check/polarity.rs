@@ -1,7 +1,7 @@
 //! The check of `[polarity]`.
 
 use crate::error::{invalid, SceneError};
-use crate::file::{AlignKind, SceneFile};
+use crate::file::SceneFile;
 
 /// `[polarity]`: each key in range.
 pub(crate) fn polarity(file: &SceneFile) -> Result<(), SceneError> {
@@ -33,15 +33,7 @@ pub(crate) fn polarity(file: &SceneFile) -> Result<(), SceneError> {
                 "use a rate of order 0.1 (the reference code's J-pol), or 0 for none",
             ));
         }
-        if p.align_rate > 0.0 && p.align == AlignKind::None {
-            return Err(invalid(
-                "polarity",
-                "align_rate",
-                p.align_rate,
-                "an alignment rate with align = \"none\" aligns to nothing",
-                "set align = \"velocity\", \"force\" or \"shape\", or remove align_rate",
-            ));
-        }
+        super::alignment("polarity", p.align, p.align_rate)?;
         if !(p.contact_inhibition.is_finite() && p.contact_inhibition >= 0.0) {
             return Err(invalid(
                 "polarity",
@@ -51,15 +43,7 @@ pub(crate) fn polarity(file: &SceneFile) -> Result<(), SceneError> {
                 "use a value of order 1 (3 stalls a cell pressed with its own force to 5 %), or 0 for none",
             ));
         }
-        if let Some(a) = p.angle.filter(|a| !a.is_finite()) {
-            return Err(invalid(
-                "polarity",
-                "angle",
-                a,
-                "the initial angle must be a finite number",
-                "give it in radians (0 is along +x), or remove it for random angles",
-            ));
-        }
+        super::initial_angle("polarity", p.angle)?;
     }
     Ok(())
 }
