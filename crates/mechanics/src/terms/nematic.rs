@@ -297,11 +297,11 @@ impl CellTerm for CellNematic {
     /// `cell_nematic_order`: `|⟨(cos 2θ_i, sin 2θ_i)⟩|`, 1 when every cell's axis is the same,
     /// about `1/√N` for random axes (NaN for no cell).
     fn observables(&self, x: &[f64], ids: &[usize]) -> Vec<(&'static str, f64)> {
-        let (c, s) = ids.iter().fold((0.0, 0.0), |(c, s), &id| {
-            (c + (2.0 * x[id]).cos(), s + (2.0 * x[id]).sin())
-        });
-        let n = ids.len() as f64;
-        vec![("cell_nematic_order", (c / n).hypot(s / n))]
+        let doubled = ids.iter().map(|&id| 2.0 * x[id]);
+        vec![(
+            "cell_nematic_order",
+            super::polarity::mean_direction_length(doubled),
+        )]
     }
 
     fn initial_state(&self, _id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {

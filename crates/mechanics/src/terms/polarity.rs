@@ -233,6 +233,14 @@ pub fn alignment_rate(rate: f64, t: [f64; 2], theta: f64) -> f64 {
     }
 }
 
+/// `|⟨(cos a, sin a)⟩|` over the angles `angles` (NaN for none): the polar order of
+/// polarity angles, and the nematic order of doubled axis angles.
+pub(crate) fn mean_direction_length(angles: impl ExactSizeIterator<Item = f64>) -> f64 {
+    let n = angles.len() as f64;
+    let (c, s) = angles.fold((0.0, 0.0), |(c, s), a| (c + a.cos(), s + a.sin()));
+    (c / n).hypot(s / n)
+}
+
 /// The polarity `(cos θ, sin θ)`.
 pub(crate) fn direction(theta: f64) -> Vector2<f64> {
     let (s, c) = theta.sin_cos();
@@ -320,11 +328,10 @@ impl CellTerm for Polarity {
     /// `polar_order`: `|⟨p_i⟩|`, the length of the mean unit polarity (1 when all point the
     /// same way, about `1/√N` for random angles; NaN for no cell).
     fn observables(&self, x: &[f64], ids: &[usize]) -> Vec<(&'static str, f64)> {
-        let (c, s) = ids
-            .iter()
-            .fold((0.0, 0.0), |(c, s), &id| (c + x[id].cos(), s + x[id].sin()));
-        let n = ids.len() as f64;
-        vec![("polar_order", (c / n).hypot(s / n))]
+        vec![(
+            "polar_order",
+            mean_direction_length(ids.iter().map(|&id| x[id])),
+        )]
     }
 
     fn initial_state(&self, _id: usize, keys: &dyn Fn(u64) -> NoiseKey, out: &mut [f64]) {
