@@ -70,7 +70,7 @@ fn frame_arrays(scene: &scene::Scene) -> BTreeMap<String, String> {
             let meaning = mechanics::ForcesByOrigin::meaning(&name);
             m.insert(
                 format!("force.{name}"),
-                format!("(N, 2): {meaning}; the parts add up to force + cell_force"),
+                format!("(N, 2): {meaning}; the parts add up to force + cell_force, and with [friction] (its part included) to the drag times the velocity"),
             );
         }
     }
