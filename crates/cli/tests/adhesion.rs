@@ -1,4 +1,5 @@
-//! `[adhesion] pairs` (issue 49): adhesion by pair of populations, checked by pair.
+//! `[adhesion] pairs` and `[repulsion] pairs` (issue 49): adhesion and repulsion by pair of
+//! populations, checked by pair.
 
 use scene::Scene;
 
@@ -43,4 +44,32 @@ fn pairs_are_checked_by_pair() {
     let s = parse("[adhesion]\nomega = 0.002\n").unwrap();
     assert_eq!(s.populations().adhesion(), None);
     assert_eq!(s.model_params(0.0).omega, 0.002);
+}
+
+/// `[repulsion] pairs` (issue 49): a symmetric matrix reaches the populations, and each cell
+/// has its population's own κ_pp; the errors name the key and the pair; the time step's
+/// stability estimate takes the largest entry, so a κ_ab far above the tissue's refuses the
+/// scene's dt, naming it.
+#[test]
+fn repulsion_pairs_are_checked_by_pair() {
+    let s = parse("[repulsion]\npairs = [[0.1, 0.3], [0.3, 0.05]]\n").unwrap();
+    let pops = s.populations();
+    assert_eq!(pops.repulsion(), Some(&[0.1, 0.3, 0.3, 0.05][..]));
+    let base = s.model_params(0.0);
+    assert_eq!(pops.params(1, &base).energy.kappa, 0.05);
+    assert_eq!(pops.largest_repulsion(1, &base), 0.3);
+    let err = parse("[repulsion]\npairs = [[0.1, 0.3], [0.2, 0.05]]\n").unwrap_err();
+    assert!(
+        err.contains("[repulsion]") && err.contains("a–b") && err.contains("symmetric"),
+        "{err}"
+    );
+    let err = parse("[repulsion]\npairs = [[0.1, -0.3], [-0.3, 0.05]]\n").unwrap_err();
+    assert!(err.contains("a–b") && err.contains("positive"), "{err}");
+    let err = parse("[repulsion]\npairs = [[0.1]]\n").unwrap_err();
+    assert!(err.contains("one row of 2"), "{err}");
+    let err = parse("[repulsion]\nkappa = 0.1\n").unwrap_err();
+    assert!(err.contains("kappa"), "{err}");
+    // 4κ/λ at κ = 30 and λ = 3 is 40 of stiffness: dt = 0.2 is far past 2/40.
+    let err = parse("[repulsion]\npairs = [[0.1, 30.0], [30.0, 0.1]]\n").unwrap_err();
+    assert!(err.contains("dt"), "{err}");
 }

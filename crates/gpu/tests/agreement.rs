@@ -951,9 +951,10 @@ fn wall_friction_is_refused_by_name() {
     assert!(err.contains("[walls] friction = 0.5"), "{err}");
 }
 
-/// Adhesion by pair of populations (issue 49) is not on the GPU yet: refused by its key.
+/// Adhesion and repulsion by pair of populations (issue 49) are not on the GPU yet: refused by
+/// their keys.
 #[test]
-fn pair_adhesion_is_refused_by_name() {
+fn pair_adhesion_and_repulsion_are_refused_by_name() {
     let sp = StepParams::paper();
     let pops = |m: Option<Vec<f64>>| {
         let p = Populations::new(vec![Population::new(); 2], &[30, 30], 3);
@@ -967,6 +968,9 @@ fn pair_adhesion_is_refused_by_name() {
     let paired = paper_tissue(0.0).with(pops(Some(vec![0.004, 0.0, 0.0, 0.004])));
     let err = GpuBackend::check(&paired, &sp).unwrap_err().to_string();
     assert!(err.contains("[adhesion] pairs"), "{err}");
+    let repelled = paper_tissue(0.0).with(pops(None).with_repulsion(vec![0.1, 0.3, 0.3, 0.1]));
+    let err = GpuBackend::check(&repelled, &sp).unwrap_err().to_string();
+    assert!(err.contains("[repulsion] pairs"), "{err}");
 }
 
 /// The cell nematic (`[nematic]`, issue 49) is not on the GPU yet: a tissue with it is refused

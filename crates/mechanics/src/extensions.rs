@@ -37,7 +37,8 @@ pub enum Part {
     Terms,
     /// Adhesion between cells (`[adhesion]`; a model parameter, no state).
     Adhesion,
-    /// Populations of cells with parameters of their own (`[[population]]`).
+    /// Populations of cells with parameters of their own (`[[population]]`), and the
+    /// repulsion of each pair of them (`[repulsion] pairs`).
     Populations,
     /// Walls and masks (`[walls]`; a static lattice field).
     Walls,
@@ -64,7 +65,7 @@ impl Part {
         match self {
             Part::Terms => "[polarity], [nematic] or [terms.NAME]",
             Part::Adhesion => "[adhesion]",
-            Part::Populations => "[[population]]",
+            Part::Populations => "[[population]] and [repulsion]",
             Part::Walls => "[walls]",
             Part::Division => "[division]",
             Part::Friction => "[friction]",
@@ -168,6 +169,9 @@ impl Extensions {
                                 );
                             }
                         }
+                    }
+                    if let Some(m) = self.populations.repulsion() {
+                        add(part, "[repulsion] pairs".into(), format!("{m:?}"));
                     }
                 }
                 Part::Walls => {
@@ -298,6 +302,7 @@ impl Extensions {
                 Part::Adhesion => self.populations.adhesion() != other.populations.adhesion(),
                 Part::Populations => {
                     self.populations.of_cell() != other.populations.of_cell()
+                        || self.populations.repulsion() != other.populations.repulsion()
                         || format!("{:?}", self.populations.kinds())
                             != format!("{:?}", other.populations.kinds())
                 }

@@ -598,9 +598,15 @@ fn node_term_pass<'a, T: Real>(
         constants: node_constants,
         population_sums,
     } = buffers;
-    if terms.iter().flatten().any(|t| t.needs_population_sums()) {
+    let moments = terms
+        .iter()
+        .flatten()
+        .map(|t| t.population_moments())
+        .max()
+        .unwrap_or(0);
+    if moments > 0 {
         let n = pops.kinds().len().max(1);
-        population_sums.fill(cells, phi, n, |i| pops.population(ids[i]));
+        population_sums.fill(cells, phi, n, moments, |i| pops.population(ids[i]));
     }
     let nodes = cells.lattice().len();
     {

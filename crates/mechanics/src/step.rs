@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use crate::equations::{adhesion_coefficient, heun_corrector, heun_predictor, wall_coefficients};
 use crate::evaluation::{CellState, N_SUMS};
 use crate::kernels::{evaluate, EvalInput, EvalScratch, Post};
-use crate::node_terms::{Adhesion, NodeTerm, PairAdhesion, WallTerm};
+use crate::node_terms::{Adhesion, NodeTerm, PairAdhesion, PairRepulsion, WallTerm};
 use crate::params::StepParams;
 use crate::scatter::LatticeSums;
 use crate::terms::CellsView;
@@ -679,8 +679,8 @@ impl<T: Real> Tissue<T> {
             }
             None => None,
         };
-        // The node terms of this evaluation, in a fixed order (adhesion, then walls: the
-        // order their pressures and coefficients are added in).
+        // The node terms of this evaluation, in a fixed order (adhesion, pair repulsion, then
+        // walls: the order their pressures and coefficients are added in).
         // Adhesion: one ω for every pair, or an ω for each pair of populations (the scene
         // gives one or the other).
         let adhesion = (inc.adhesion && self.params.omega != 0.0).then(|| Adhesion {
@@ -698,10 +698,21 @@ impl<T: Real> Tissue<T> {
                     self.params.energy.lambda,
                 )
             });
+        // Repulsion by pair of populations: part of the passive model, always in.
+        let pair_repulsion = self.ext.populations.repulsion().map(|m| {
+            PairRepulsion::new(
+                m,
+                self.ext.populations.kinds().len(),
+                self.params.energy.lambda,
+                self.params.energy.kappa,
+                self.params.pressure,
+            )
+        });
         let walls = self.wall_term().filter(|_| inc.walls);
-        let node_terms: [Option<&dyn NodeTerm>; 3] = [
+        let node_terms: [Option<&dyn NodeTerm>; 4] = [
             adhesion.as_ref().map(|t| t as &dyn NodeTerm),
             pair_adhesion.as_ref().map(|t| t as &dyn NodeTerm),
+            pair_repulsion.as_ref().map(|t| t as &dyn NodeTerm),
             walls.as_ref().map(|t| t as &dyn NodeTerm),
         ];
         // Their lattice scratch, made on its first use (the one allocation of a run with

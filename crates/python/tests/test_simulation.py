@@ -258,6 +258,22 @@ def test_adhesion_by_pair_of_populations_is_a_scene_key(root):
         scene.set("adhesion.pairs", [[0.006]])
 
 
+def test_repulsion_by_pair_of_populations_is_a_scene_key(root):
+    """`[repulsion] pairs` (issue 49) from Python: set as a nested list, run, and refused with
+    the pair named when it is not symmetric."""
+    text = (root / "scenes" / "sorting.toml").read_text()
+    scene = (
+        ml.Scene.from_text(text)
+        .set("run.relax_time", 0.0)
+        .set("run.time", 2.0)
+        .set("repulsion.pairs", [[0.1, 0.3], [0.3, 0.1]])
+    )
+    assert "[repulsion]" in scene.to_toml()
+    ml.Simulation(scene, threads=1).run(progress=False)
+    with pytest.raises(ValueError, match="repulsion.*symmetric"):
+        scene.set("repulsion.pairs", [[0.1, 0.3], [0.2, 0.1]])
+
+
 def test_the_cell_nematic_is_a_scene_key_with_columns(root):
     """`[nematic]` (issue 49) from Python: its keys are set like any other, each cell's axis
     and tensor are columns of `sim.cells`, and a bad key is refused by name."""

@@ -366,6 +366,17 @@ pub struct AdhesionSpec {
     pub pairs: Option<Vec<Vec<f64>>>,
 }
 
+/// `[repulsion]`: the repulsion of each pair of populations (docs/model.md §11.2); absent:
+/// `[model] kappa` for every pair.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RepulsionSpec {
+    /// κ_pq, one row per `[[population]]` in order (symmetric): the energy
+    /// `(1/λ) Σ_{i<j} κ_{p_i p_j} ∫φ_i²φ_j²` in place of one κ for every pair (`[model] kappa`
+    /// then no longer acts).
+    pub pairs: Vec<Vec<f64>>,
+}
+
 /// `[walls] kind`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -647,6 +658,9 @@ pub struct SceneFile {
     /// `[nematic]`, when the cells carry a nematic of their own.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub nematic: Option<NematicSpec>,
+    /// `[repulsion]`, when the repulsion depends on the pair of populations.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repulsion: Option<RepulsionSpec>,
     /// `[adhesion]`, when the cells adhere.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub adhesion: Option<AdhesionSpec>,
@@ -782,8 +796,12 @@ impl SceneFile {
         }
         let counts: Vec<usize> = self.population.iter().map(|p| p.count).collect();
         let pops = Populations::new(self.population_kinds(), &counts, self.run.seed);
-        match self.adhesion.as_ref().and_then(|a| a.pairs.as_ref()) {
+        let pops = match self.adhesion.as_ref().and_then(|a| a.pairs.as_ref()) {
             Some(rows) => pops.with_adhesion(rows.iter().flatten().copied().collect()),
+            None => pops,
+        };
+        match &self.repulsion {
+            Some(r) => pops.with_repulsion(r.pairs.iter().flatten().copied().collect()),
             None => pops,
         }
     }

@@ -37,6 +37,7 @@ impl SceneFile {
         crate::check::model(&self)?;
         crate::check::population(&self)?;
         crate::check::adhesion(&self)?;
+        crate::check::repulsion(&self)?;
         crate::check::polarity(&self)?;
         crate::check::nematic(&self)?;
         crate::check::friction(&self)?;
@@ -160,9 +161,15 @@ impl SceneFile {
             .as_ref()
             .filter(|w| w.kappa > 0.0)
             .map_or(f64::INFINITY, |w| base.energy.lambda / w.kappa);
-        self.population_kinds()
-            .iter()
-            .map(|p| p.params(&base).max_stable_dt())
+        // Each population with its own constants and the largest repulsion it feels from any
+        // neighbour (`[repulsion] pairs`).
+        let pops = self.populations();
+        (0..pops.kinds().len())
+            .map(|k| {
+                let mut own = pops.params(k, &base);
+                own.energy.kappa = pops.largest_repulsion(k, &base);
+                own.max_stable_dt()
+            })
             .fold(base.max_stable_dt().min(walls), f64::min)
     }
 }

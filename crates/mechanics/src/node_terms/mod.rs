@@ -1,5 +1,5 @@
 //! Node terms: free-energy terms that act at the lattice nodes, inside the step's node loops,
-//! one file each ([`adhesion`], [`pair_adhesion`], [`walls`]). What a new one writes is the
+//! one file each ([`adhesion`], [`pair_adhesion`], [`pair_repulsion`], [`walls`]). What a new one writes is the
 //! [`NodeTerm`] trait; `kernels::evaluate` takes the terms of an evaluation as a list and never
 //! names one.
 //!
@@ -17,9 +17,9 @@
 //! interaction term: a single-cell part `k_p φ_i ∇²φ_i` that the scatter adds to `U`
 //! (`equations::adhesion_pressure_cell_part` with `k_p`), and a lattice part it adds to `P`
 //! itself. Besides the step's sums (`s1, s2, U, Q`, `P`) a term may read each population's
-//! `s1_p = Σ_{i ∈ p} φ_i` ([`PopulationSums`], scattered only when a term asks for them) and
-//! keep lattice fields of its own between its pressure and its coefficients
-//! ([`NodeTerm::scratch_fields`]).
+//! `s1_p = Σ_{i ∈ p} φ_i` and `s2_p = Σ_{i ∈ p} φ_i²` ([`PopulationSums`], scattered only
+//! when a term asks for them) and keep lattice fields of its own between its pressure and its
+//! coefficients ([`NodeTerm::scratch_fields`]).
 //!
 //! So the terms are dispatched once per evaluation, outside the loops: the loops see only the
 //! summed coefficients of the cell's population (`a_p`, `b_p` gathered beside each patch,
@@ -33,10 +33,12 @@
 
 pub(crate) mod adhesion;
 pub(crate) mod pair_adhesion;
+pub(crate) mod pair_repulsion;
 pub(crate) mod walls;
 
 pub(crate) use adhesion::Adhesion;
 pub(crate) use pair_adhesion::PairAdhesion;
+pub(crate) use pair_repulsion::PairRepulsion;
 pub(crate) use walls::WallTerm;
 
 use phasefield::{Cells, Lattice, Real};
@@ -53,9 +55,10 @@ pub(crate) trait NodeTerm: Sync {
         false
     }
 
-    /// Whether it reads each population's `s1_p` ([`PopulationSums`]).
-    fn needs_population_sums(&self) -> bool {
-        false
+    /// Which of each population's sums it reads ([`PopulationSums`]): 0 none, 1 `s1_p`, 2
+    /// `s1_p` and `s2_p`.
+    fn population_moments(&self) -> usize {
+        0
     }
 
     /// `k_p` of its single-cell pressure part `k_p φ_i ∇²φ_i` for a cell of `population`,
@@ -110,17 +113,20 @@ pub(crate) fn classes(terms: &[Option<&dyn NodeTerm>], populations: &Populations
     }
 }
 
-/// Populations per scatter of [`PopulationSums`]: one pass over the cells fills the sums of
-/// this many populations.
-const POPULATIONS_PER_PASS: usize = 4;
+/// Lattice fields per scatter of [`PopulationSums`]: one pass over the cells fills this many
+/// (the sums of 4 populations, or of 2 with their squares).
+const FIELDS_PER_PASS: usize = 4;
 
-/// Each population's `s1_p = Σ_{i ∈ p} φ_i` on the lattice, for the node terms that read it
-/// ([`NodeTerm::needs_population_sums`]): scattered after the step's sums, in cell order like
-/// them (so independent of the thread count), [`POPULATIONS_PER_PASS`] populations a pass.
+/// Each population's `s1_p = Σ_{i ∈ p} φ_i`, and where a term asks for it `s2_p = Σ_{i ∈ p}
+/// φ_i²`, on the lattice, for the node terms that read them ([`NodeTerm::population_moments`]):
+/// scattered after the step's sums, in cell order like them (so independent of the thread
+/// count), [`FIELDS_PER_PASS`] fields a pass.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PopulationSums {
-    passes: Vec<LatticeSums<POPULATIONS_PER_PASS>>,
+    passes: Vec<LatticeSums<FIELDS_PER_PASS>>,
     populations: usize,
+    /// Fields per population: 1 (`s1_p`) or 2 (`s1_p`, `s2_p`).
+    moments: usize,
 }
 
 impl PopulationSums {
@@ -129,10 +135,22 @@ impl PopulationSums {
         self.populations
     }
 
+    /// Lattice column `x` of field `m` of population `p`.
+    fn field(&self, p: usize, m: usize, x: usize) -> &[f64] {
+        assert!(p < self.populations, "population {p} is not summed");
+        assert!(m < self.moments, "moment {m} is not summed");
+        let f = p * self.moments + m;
+        self.passes[f / FIELDS_PER_PASS].column(f % FIELDS_PER_PASS, x)
+    }
+
     /// Lattice column `x` of `s1_p`.
     pub(crate) fn column(&self, p: usize, x: usize) -> &[f64] {
-        assert!(p < self.populations, "population {p} is not summed");
-        self.passes[p / POPULATIONS_PER_PASS].column(p % POPULATIONS_PER_PASS, x)
+        self.field(p, 0, x)
+    }
+
+    /// Lattice column `x` of `s2_p` (summed when a term asked for two moments).
+    pub(crate) fn squares(&self, p: usize, x: usize) -> &[f64] {
+        self.field(p, 1, x)
     }
 
     /// Bytes of heap memory held.
@@ -140,17 +158,23 @@ impl PopulationSums {
         self.passes.iter().map(LatticeSums::heap_bytes).sum()
     }
 
-    /// Sums `populations` populations of the cells (`population_of(slot)`) on `lattice`,
-    /// allocating the passes on the first call that needs them.
+    /// Sums `populations` populations of the cells (`population_of(slot)`) on `lattice`, with
+    /// `moments` fields each (1: `s1_p`; 2: `s1_p` and `s2_p`), allocating the passes on the
+    /// first call that needs them.
     pub(crate) fn fill<T: Real>(
         &mut self,
         cells: &Cells<T>,
         phi: &[T],
         populations: usize,
+        moments: usize,
         population_of: impl Fn(usize) -> usize + Sync,
     ) {
+        assert!(
+            moments == 1 || moments == 2,
+            "one or two moments per population"
+        );
         let lattice: Lattice = cells.lattice();
-        let passes = populations.div_ceil(POPULATIONS_PER_PASS);
+        let passes = (populations * moments).div_ceil(FIELDS_PER_PASS);
         if self.passes.len() != passes
             || self.passes.first().is_some_and(|s| s.lattice() != lattice)
         {
@@ -159,22 +183,30 @@ impl PopulationSums {
                 .collect();
         }
         self.populations = populations;
+        self.moments = moments;
         for (pass, sums) in self.passes.iter_mut().enumerate() {
-            let first = pass * POPULATIONS_PER_PASS;
-            scatter::<POPULATIONS_PER_PASS, T, _, _, _>(
+            let first = pass * FIELDS_PER_PASS;
+            scatter::<FIELDS_PER_PASS, T, _, _, _>(
                 cells,
                 phi,
                 sums,
                 |i| {
-                    // The cell's field in this pass, if its population is one of the pass's.
-                    let field = population_of(i)
+                    // The cell's first field in this pass, if its population is one of the
+                    // pass's (a population's moments share a pass: 4 is a multiple of both).
+                    let field = (population_of(i) * moments)
                         .checked_sub(first)
-                        .filter(|&f| f < POPULATIONS_PER_PASS);
+                        .filter(|&f| f < FIELDS_PER_PASS);
                     move |run: &phasefield::kernel::StencilRun<'_, T>,
-                          dst: [&mut [f64]; POPULATIONS_PER_PASS]| {
+                          dst: [&mut [f64]; FIELDS_PER_PASS]| {
                         if let Some(f) = field {
-                            let out = dst.into_iter().nth(f).expect("a field of the pass");
-                            run.add_to([], |s, []| [s.c], [out]);
+                            let mut dst = dst.into_iter().skip(f);
+                            let s1 = dst.next().expect("a field of the pass");
+                            if moments == 1 {
+                                run.add_to([], |s, []| [s.c], [s1]);
+                            } else {
+                                let s2 = dst.next().expect("a field of the pass");
+                                run.add_to([], |s, []| [s.c, s.c * s.c], [s1, s2]);
+                            }
                         }
                     }
                 },

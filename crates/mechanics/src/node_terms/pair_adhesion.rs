@@ -52,8 +52,8 @@ impl NodeTerm for PairAdhesion {
         true
     }
 
-    fn needs_population_sums(&self) -> bool {
-        true
+    fn population_moments(&self) -> usize {
+        1
     }
 
     fn cell_pressure_coefficient(&self, p: usize) -> f64 {

@@ -90,6 +90,9 @@ pub struct Populations {
     /// The adhesion ω_pq of each pair of populations, `n × n` row by row (symmetric), when it
     /// depends on the pair (`[adhesion] pairs`, docs/model.md §11.2).
     adhesion: Option<Vec<f64>>,
+    /// The repulsion κ_pq of each pair of populations, `n × n` row by row (symmetric), when it
+    /// depends on the pair (`[repulsion] pairs`, docs/model.md §11.2).
+    repulsion: Option<Vec<f64>>,
 }
 
 /// A cell's constants in one evaluation (one set per population), as the step uses them and
@@ -137,6 +140,7 @@ impl Populations {
             kinds,
             of_cell,
             adhesion: None,
+            repulsion: None,
         }
     }
 
@@ -149,22 +153,56 @@ impl Populations {
     /// Unless `omega` is `n × n` and symmetric, every entry finite: a scene checks its matrix
     /// before this (naming the pair).
     pub fn with_adhesion(mut self, omega: Vec<f64>) -> Self {
-        let n = self.kinds.len();
-        assert_eq!(omega.len(), n * n, "ω_pq is n × n for n populations");
-        for p in 0..n {
-            for q in 0..n {
-                assert!(omega[p * n + q].is_finite(), "ω_pq is finite");
-                assert_eq!(omega[p * n + q], omega[q * n + p], "ω_pq is symmetric");
-            }
-        }
+        self.assert_pair_matrix(&omega, "ω_pq");
         self.adhesion = Some(omega);
         self
+    }
+
+    /// These populations with the repulsion `kappa` of each pair (`n × n` row by row): the
+    /// energy `(1/λ) Σ_{i≠j} κ_{p_i p_j} ∫φ_i²φ_j²` in place of one κ for every pair. A cell
+    /// of population `p` has `κ_pp` among its own constants ([`Populations::params`]), and
+    /// the node term `PairRepulsion` adds what the unlike pairs differ by.
+    ///
+    /// # Panics
+    /// Unless `kappa` is `n × n` and symmetric, every entry finite: a scene checks its matrix
+    /// before this (naming the pair).
+    pub fn with_repulsion(mut self, kappa: Vec<f64>) -> Self {
+        self.assert_pair_matrix(&kappa, "κ_pq");
+        self.repulsion = Some(kappa);
+        self
+    }
+
+    fn assert_pair_matrix(&self, m: &[f64], what: &str) {
+        let n = self.kinds.len();
+        assert_eq!(m.len(), n * n, "{what} is n × n for n populations");
+        for p in 0..n {
+            for q in 0..n {
+                assert!(m[p * n + q].is_finite(), "{what} is finite");
+                assert_eq!(m[p * n + q], m[q * n + p], "{what} is symmetric");
+            }
+        }
     }
 
     /// The adhesion of each pair of populations (`n × n` row by row), when it depends on the
     /// pair.
     pub fn adhesion(&self) -> Option<&[f64]> {
         self.adhesion.as_deref()
+    }
+
+    /// The repulsion of each pair of populations (`n × n` row by row), when it depends on the
+    /// pair.
+    pub fn repulsion(&self) -> Option<&[f64]> {
+        self.repulsion.as_deref()
+    }
+
+    /// The largest repulsion a cell of population `k` feels from any neighbour (the tissue's
+    /// κ without a matrix): what the stability estimate takes.
+    pub fn largest_repulsion(&self, k: usize, base: &ModelParams) -> f64 {
+        let n = self.kinds.len();
+        match &self.repulsion {
+            Some(m) if k < n => m[k * n..(k + 1) * n].iter().copied().fold(0.0, f64::max),
+            _ => base.energy.kappa,
+        }
     }
 
     /// Populations with the given population of every cell, by identity.
@@ -177,6 +215,7 @@ impl Populations {
             kinds,
             of_cell,
             adhesion: None,
+            repulsion: None,
         }
     }
 
@@ -200,6 +239,7 @@ impl Populations {
         }
         Ok(Self {
             adhesion: self.adhesion.clone(),
+            repulsion: self.repulsion.clone(),
             ..Self::from_assignment(
                 self.kinds.clone(),
                 of_cell.iter().map(|&v| v as u16).collect(),
@@ -244,10 +284,18 @@ impl Populations {
         (0..self.kinds.len()).any(|k| self.zeta(k, params, active) != params.zeta)
     }
 
-    /// The model parameters of population `k` ([`Population::params`]; the tissue's `base`
-    /// for a population that is not there).
+    /// The model parameters of population `k` ([`Population::params`], with its own repulsion
+    /// `κ_kk` when the repulsion depends on the pair; the tissue's `base` for a population
+    /// that is not there).
     pub fn params(&self, k: usize, base: &ModelParams) -> ModelParams {
-        self.kinds.get(k).map_or(*base, |p| p.params(base))
+        let n = self.kinds.len();
+        self.kinds.get(k).map_or(*base, |p| {
+            let mut own = p.params(base);
+            if let Some(m) = &self.repulsion {
+                own.energy.kappa = m[k * n + k];
+            }
+            own
+        })
     }
 
     /// The ζ of population `k`, with the activity on or off.

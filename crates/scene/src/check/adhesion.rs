@@ -39,31 +39,82 @@ pub(crate) fn adhesion(file: &SceneFile) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// `[adhesion] pairs`: one row per `[[population]]`, square, symmetric, finite and not
-/// negative, each ω_pq below min(γ_p, γ_q) (the single ω's limit for the two cells of the
-/// pair); not with `omega`.
+/// `[adhesion] pairs`: a pair matrix ([`pair_matrix`]) with each ω_pq below min(γ_p, γ_q)
+/// (the single ω's limit for the two cells of the pair); not with `omega`.
 fn pairs(file: &SceneFile, omega: f64, rows: &[Vec<f64>]) -> Result<(), SceneError> {
-    let n = file.population.len();
-    let shown = format!("{rows:?}");
     if omega != 0.0 {
         return Err(invalid(
             "adhesion",
             "pairs",
-            shown,
+            format!("{rows:?}"),
             "`pairs` gives the adhesion of every pair of populations, and `omega` one for every pair: only one can hold",
             "remove `omega` (or set it to 0), or remove `pairs`",
         ));
     }
+    let gamma = |p: usize| file.population[p].gamma.unwrap_or(file.model.gamma);
+    pair_matrix(
+        file,
+        "adhesion",
+        "ω",
+        rows,
+        "use values of order 0.01 or 0",
+        |p, q, w| {
+            let limit = gamma(p).min(gamma(q));
+            (w >= limit).then(|| {
+            (
+                format!("at or above the interface stiffness of its cells (gamma = {limit}): their shared interface would cost nothing, and contacts break into stripes at the lattice scale"),
+                format!("use a value below {limit}, e.g. {}", limit * 0.75),
+            )
+        })
+        },
+    )
+}
+
+/// `[repulsion]`: `pairs`, a pair matrix ([`pair_matrix`]) of κ_pq; the time step's stability
+/// takes the largest entry (`validate::stability_estimate`).
+pub(crate) fn repulsion(file: &SceneFile) -> Result<(), SceneError> {
+    let Some(r) = &file.repulsion else {
+        return Ok(());
+    };
+    pair_matrix(
+        file,
+        "repulsion",
+        "κ",
+        &r.pairs,
+        "use values of order 0.1 (the paper's κ) or 0",
+        |_, _, _| None,
+    )
+}
+
+/// A matrix over the populations in `[section] pairs` (symbol `what`): one row per
+/// `[[population]]` (in their order), square, symmetric, finite and not negative, and each
+/// entry past no limit of its pair (`limit(p, q, value)`: the problem and the fix, if it is
+/// past). Errors name the pair (by population names, or A, B, … without) and its row and
+/// column.
+pub(crate) fn pair_matrix(
+    file: &SceneFile,
+    section: &'static str,
+    what: &str,
+    rows: &[Vec<f64>],
+    typical: &str,
+    limit: impl Fn(usize, usize, f64) -> Option<(String, String)>,
+) -> Result<(), SceneError> {
+    let n = file.population.len();
+    let shown = format!("{rows:?}");
     if n == 0 || rows.len() != n || rows.iter().any(|r| r.len() != n) {
         return Err(invalid(
-            "adhesion",
+            section,
             "pairs",
             shown,
             format!("`pairs` needs one row of {n} values for each of the scene's {n} [[population]] tables (in their order)"),
             if n == 0 {
-                "add [[population]] tables, or use `omega` for one adhesion between every pair".to_string()
+                if section == "adhesion" {
+                    "add [[population]] tables, or use `omega` for one adhesion between every pair".to_string()
+                } else {
+                    "add [[population]] tables, or use [model] kappa for one repulsion between every pair".to_string()
+                }
             } else {
-                format!("give a {n} × {n} matrix, such as [[0.004, 0.0], [0.0, 0.004]] for two populations")
+                format!("give a {n} × {n} matrix, such as [[a, b], [b, c]] for two populations")
             },
         ));
     }
@@ -73,37 +124,35 @@ fn pairs(file: &SceneFile, omega: f64, rows: &[Vec<f64>]) -> Result<(), SceneErr
             .clone()
             .unwrap_or_else(|| ((b'A' + (p % 26) as u8) as char).to_string())
     };
-    let gamma = |p: usize| file.population[p].gamma.unwrap_or(file.model.gamma);
     for p in 0..n {
         for q in 0..n {
             let w = rows[p][q];
             let pair = format!("{}–{}", name(p), name(q));
             if !(w.is_finite() && w >= 0.0) {
                 return Err(invalid(
-                    "adhesion",
+                    section,
                     "pairs",
                     shown,
-                    format!("ω of the pair {pair} (row {}, column {}) is {w}: adhesion must be zero or positive", p + 1, q + 1),
-                    "use values of order 0.01 or 0",
+                    format!("{what} of the pair {pair} (row {}, column {}) is {w}: it must be zero or positive", p + 1, q + 1),
+                    typical,
                 ));
             }
             if rows[q][p] != w {
                 return Err(invalid(
-                    "adhesion",
+                    section,
                     "pairs",
                     shown,
-                    format!("ω of the pair {pair} is {w} in row {}, column {} but {} in row {}, column {}: the matrix must be symmetric", p + 1, q + 1, rows[q][p], q + 1, p + 1),
+                    format!("{what} of the pair {pair} is {w} in row {}, column {} but {} in row {}, column {}: the matrix must be symmetric", p + 1, q + 1, rows[q][p], q + 1, p + 1),
                     "give the same value on both sides of the diagonal",
                 ));
             }
-            let limit = gamma(p).min(gamma(q));
-            if w >= limit {
+            if let Some((problem, fix)) = limit(p, q, w) {
                 return Err(invalid(
-                    "adhesion",
+                    section,
                     "pairs",
                     shown,
-                    format!("ω of the pair {pair} is {w}, at or above the interface stiffness of its cells (gamma = {limit}): their shared interface would cost nothing, and contacts break into stripes at the lattice scale"),
-                    format!("use a value below {limit}, e.g. {}", limit * 0.75),
+                    format!("{what} of the pair {pair} is {w}, {problem}"),
+                    fix,
                 ));
             }
         }

@@ -14,7 +14,7 @@ mod population;
 mod run;
 mod walls;
 
-pub(crate) use adhesion::adhesion;
+pub(crate) use adhesion::{adhesion, repulsion};
 pub(crate) use cells::cells;
 pub(crate) use domain::domain;
 pub(crate) use friction::friction;
