@@ -9,7 +9,7 @@
 #
 # Environment:
 #   SCENES  shipped scenes (default: paper.toml; every scene the GPU runs:
-#           "paper.toml polar.toml disc.toml wound.toml sorting.toml mixture.toml
+#           "paper.toml polar.toml disc.toml wound.toml extensile_contractile.toml mixture.toml
 #            channel.toml doublet.toml walker.toml single.toml")
 #   SEEDS   seeds per backend (5)
 #   TIME    active time in TU (500), SKIP the transient left out (100), RELAX the relaxation

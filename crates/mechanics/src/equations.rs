@@ -180,40 +180,6 @@ pub fn adhesion_pressure(c: f64, s1: f64, lap_s1: f64) -> f64 {
     -c * s1 * lap_s1
 }
 
-/// The unlike part of pair repulsion's derivative for a cell of population `p`,
-/// `(2/λ) Σ_q (κ_pq − κ_pp) s2_q` (`d[q]` = `2(κ_pq − κ_pp)/λ`, `s2[q]` = `s2_q`): with the
-/// cell's own `(2κ_pp/λ) φ_i (s2 − φ_i²)` ([`EnergyCoefficients::rep`] of its constants) the
-/// derivative of `(1/λ) Σ_{i≠j} κ_{p_i p_j} ∫φ_i²φ_j²` is this times `φ_i` plus that, which is
-/// `(2/λ) φ_i (Σ_q κ_pq s2_q − κ_pp φ_i²)` (docs/model.md §11.2).
-#[inline(always)]
-pub fn pair_repulsion_coefficient(d: &[f64], s2: impl Iterator<Item = f64>) -> f64 {
-    d.iter().zip(s2).map(|(d, s)| d * s).sum()
-}
-
-/// Pair repulsion's lattice part of the pressure, added to [`pressure`]'s with the tissue's
-/// κ: `Σ_pq (2κ_pq/λ) X_p s2_q − (2κ/λ) X s2`, with `X_p = s1_p` (paper form) or `s2_p`
-/// (interaction form), `X = Σ_p X_p` and `s2 = Σ_q s2_q` (`c[p * n + q]` = `2κ_pq/λ`,
-/// `c_tissue` = `2κ/λ`). With the cells' own `−(2κ_pp/λ) φ_i³` (or `φ_i⁴`) in `U`, the pressure
-/// is the pair energy's `Σ_i δF/δφ_i` (or `Σ_i φ_i δF/δφ_i`), as with one κ.
-#[inline(always)]
-pub fn pair_repulsion_pressure(
-    c: &[f64],
-    c_tissue: f64,
-    x_p: &[f64],
-    s2_q: &[f64],
-    x: f64,
-    s2: f64,
-) -> f64 {
-    let n = x_p.len();
-    let mut sum = 0.0;
-    for (p, &xp) in x_p.iter().enumerate() {
-        for (q, &sq) in s2_q.iter().enumerate() {
-            sum += c[p * n + q] * xp * sq;
-        }
-    }
-    sum - c_tissue * x * s2
-}
-
 /// The wall coefficients `[2κ_w/λ, 2ω_wλ]` of the wall energy
 /// `F_wall = Σ_i Σ_x [(κ_w/λ) φ_i² w² + 2ω_wλ ∇φ_i·∇w]` (docs/model.md §11.4), with `w` the
 /// static wall field (`phasefield::WallField`).

@@ -252,7 +252,7 @@ def test_adhesion_by_pair_of_populations_is_a_scene_key(root):
     assert "pairs" in scene.to_toml()
     sim = ml.Simulation(scene, threads=1)
     sim.run(progress=False)
-    with pytest.raises(ValueError, match="extensile–contractile.*symmetric"):
+    with pytest.raises(ValueError, match="a–b.*symmetric"):
         scene.set("adhesion.pairs", [[0.006, 0.001], [0.0, 0.0]])
     with pytest.raises(ValueError, match="one row of 2 values"):
         scene.set("adhesion.pairs", [[0.006]])

@@ -15,7 +15,7 @@ pub const SERIES_HEADER: &str =
 
 /// The header of `analysis/observables.csv`, one row per analysed frame (written by
 /// `monolayer analyze`; its columns are described in docs/outputs.md).
-pub const OBSERVABLES_HEADER: &str = "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap,rotation,shape_index,v_mean_x,v_mean_y,v_shear_x";
+pub const OBSERVABLES_HEADER: &str = "frame,time,v_rms,s_rms,s_rms_rel,n_plus,n_minus,n_other,net_charge,defect_density,creations,annihilations,unpaired,creation_rate,v_rms_smooth,demixing,polar_order,gap,rotation,shape_index,v_mean_x,v_mean_y,v_shear_x,radial_excess";
 
 /// The header of `analysis/msd.csv`: the mean squared displacement of the cells at each lag
 /// between analysed frames, with the tissue's mean displacement removed (`msd`) and kept

@@ -338,7 +338,7 @@ impl Accumulator {
         } = self;
         let (lattice, box_side, radius, area, lineage) =
             (*lattice, *box_side, *radius, *area, *lineage);
-        let (demix, polar, term_obs) = mixing_and_order(&frame, shape);
+        let (demix, boundary, polar, term_obs) = mixing_and_order(&frame, shape);
         let columns = term_columns.get_or_insert_with(|| term_obs.iter().map(|o| o.0).collect());
         // Each cell's shape index P/√A, averaged; and the centres for the MSD.
         let cells_n = frame.centres.len();
@@ -434,7 +434,7 @@ impl Accumulator {
             _ => f64::NAN,
         };
         let mut line = format!(
-            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+            "{step},{time:.6},{:e},{:e},{:e},{n_plus},{n_minus},{},{},{:e},{creations},{annihilations},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
             rms(&[&f.vx, &f.vy]),
             s,
             s_rms_baseline.map_or(f64::NAN, |b| s / b),
@@ -453,7 +453,8 @@ impl Accumulator {
             f.vy.iter().sum::<f64>() / area,
             analysis::confinement::shear_across(&analysis::confinement::mean_over_x(
                 &f.vx, lattice.lx, lattice.ly
-            ))
+            )),
+            boundary
         );
         for name in columns.iter() {
             let v = term_obs
@@ -716,24 +717,41 @@ fn write_cell_events(
 }
 
 /// The demixing parameter of the frame's populations over the cells that touch
-/// (`analysis::mixing`; NaN without populations), the polar order `|⟨p_i⟩|` of the cells'
+/// (`analysis::mixing`; NaN without populations), the first population's radial order in a
+/// free cluster (`analysis::mixing::radial_excess`, when the tissue has a free boundary: an
+/// outside region of at least a cell's area `πR²`; NaN without populations or a free
+/// boundary), the polar order `|⟨p_i⟩|` of the cells'
 /// polarities (NaN without `[polarity]`), and every other observable the terms define, by
 /// name (columns of their own at the end of `observables.csv`).
 fn mixing_and_order(
     frame: &LoadedFrame,
     shape: &PatchShape,
-) -> (f64, f64, Vec<(&'static str, f64)>) {
+) -> (f64, f64, f64, Vec<(&'static str, f64)>) {
     let tissue = &frame.tissue;
     let pops = tissue.populations();
-    let demix = if pops.is_empty() {
-        f64::NAN
+    let (demix, boundary) = if pops.is_empty() {
+        (f64::NAN, f64::NAN)
     } else {
         let (_, owner) = frame.phi_sum_and_owner(shape.nx, shape.ny);
         let pairs = analysis::mixing::contacts(tissue.lattice(), &owner);
         let label: Vec<usize> = (0..tissue.n_cells())
             .map(|id| pops.population(id))
             .collect();
-        analysis::mixing::demixing(&pairs, &label)
+        let cell_area = tissue.params().energy.target_area().ceil() as usize;
+        let lattice = tissue.lattice();
+        let on = analysis::mixing::free_boundary(lattice, &owner, label.len(), cell_area);
+        let radial = if on.contains(&true) {
+            analysis::mixing::radial_excess(
+                &frame.centres,
+                &label,
+                0,
+                lattice.lx as f64,
+                lattice.ly as f64,
+            )
+        } else {
+            f64::NAN
+        };
+        (analysis::mixing::demixing(&pairs, &label), radial)
     };
     // The terms' own observables (`CellTerm::observables`) over the frame's cells.
     let ids: Vec<usize> = (0..tissue.n_cells()).collect();
@@ -742,7 +760,12 @@ fn mixing_and_order(
         .observables(&ids)
         .into_iter()
         .partition(|(name, _)| *name == "polar_order");
-    (demix, polar.first().map_or(f64::NAN, |o| o.1), others)
+    (
+        demix,
+        boundary,
+        polar.first().map_or(f64::NAN, |o| o.1),
+        others,
+    )
 }
 
 fn write_averages(path: &Path, avg: &DefectAverage) -> Result<()> {

@@ -7,8 +7,10 @@
 //! ```
 //!
 //! with `s1_q` the sum of the fields of population `q` ([`PopulationSums`]): `b_p = −Σ_q c_pq
-//! ∇²s1_q` and the Laplacian coefficient `c_pp`. Its pressure, the φ-weighted sum of the
+//! ∇²s1_q = −∇²t_p` with `t_p = Σ_q c_pq s1_q` (one Laplacian per population), and the
+//! Laplacian coefficient `c_pp`. Its pressure, the φ-weighted sum of the
 //! derivative, is `c_pp φ_i ∇²φ_i` per cell in the scatter and `Σ_p s1_p b_p` on the lattice.
+//! Its lattice loops run column by column over contiguous slices.
 //! With every `ω_pq = ω` it is [`super::Adhesion`] of `c = 2ωλ`, to round-off (the sums are
 //! grouped by population). The scene key `[adhesion] pairs` builds it
 //! (`Populations::with_adhesion`); `[adhesion] omega` is the uniform term.
@@ -64,48 +66,68 @@ impl NodeTerm for PairAdhesion {
         self.c[p * self.n + p]
     }
 
-    /// `∇²s1_q` for every population `q`.
+    /// `t_p = Σ_q c_pq s1_q` and its Laplacian for every population `p`: by linearity
+    /// `Σ_q c_pq ∇²s1_q = ∇²t_p`, one Laplacian per population.
     fn scratch_fields(&self) -> usize {
-        self.n
+        2 * self.n
     }
 
     fn add_pressure(
         &self,
         sums: &mut LatticeSums<N_SUMS>,
         populations: &PopulationSums,
-        lap: &mut [f64],
+        scratch: &mut [f64],
     ) {
+        use rayon::prelude::*;
         const I_P: usize = SumField::P.index();
         let n = self.n;
         assert_eq!(populations.populations(), n, "one sum per population");
         let lattice = sums.lattice();
         let (lx, ly) = (lattice.lx, lattice.ly);
         let nodes = lx * ly;
-        for (q, out) in lap.chunks_exact_mut(nodes).enumerate() {
-            laplacian_into(lattice, |x| populations.column(q, x), out);
+        let (t, lap) = scratch.split_at_mut(n * nodes);
+        // t_p, column by column (each column a sum over q of contiguous slices).
+        t.par_chunks_mut(ly).enumerate().for_each(|(k, out)| {
+            let (p, x) = (k / lx, k % lx);
+            out.fill(0.0);
+            for q in 0..n {
+                let c = self.c[p * n + q];
+                for (o, &s) in out.iter_mut().zip(populations.column(q, x)) {
+                    *o += c * s;
+                }
+            }
+        });
+        for (p, out) in lap.chunks_exact_mut(nodes).enumerate() {
+            let t_p = &t[p * nodes..(p + 1) * nodes];
+            laplacian_into(lattice, |x| &t_p[x * ly..(x + 1) * ly], out);
         }
+        // The lattice part of the pressure, `−Σ_pq c_pq s1_p ∇²s1_q = −Σ_p s1_p ∇²t_p`
+        // ([`adhesion_pressure`] with c = 1).
         for x in 0..lx {
             let p_col = sums.columns_read_write::<0>([], I_P, x).1;
-            for (y, p_node) in p_col.iter_mut().enumerate() {
-                let k = x * ly + y;
-                let mut add = 0.0;
-                for p in 0..n {
-                    let s1 = populations.column(p, x)[y];
-                    for q in 0..n {
-                        add += adhesion_pressure(self.c[p * n + q], s1, lap[q * nodes + k]);
-                    }
+            for p in 0..n {
+                let s1 = populations.column(p, x);
+                let lap_t = &lap[p * nodes + x * ly..p * nodes + (x + 1) * ly];
+                for ((out, &s), &l) in p_col.iter_mut().zip(s1).zip(lap_t) {
+                    *out += adhesion_pressure(1.0, s, l);
                 }
-                *p_node += add;
             }
         }
     }
 
-    fn add_coefficients(&self, p: usize, lap: &[f64], k0: usize, _a: &mut [f64], b: &mut [f64]) {
-        let (n, nodes) = (self.n, lap.len() / self.n);
-        for (k, b) in b.iter_mut().enumerate() {
-            for q in 0..n {
-                *b += adhesion_derivative(self.c[p * n + q], lap[q * nodes + k0 + k], 0.0);
-            }
+    /// `b_p = −∇²t_p` ([`adhesion_derivative`] with c = 1).
+    fn add_coefficients(
+        &self,
+        p: usize,
+        scratch: &[f64],
+        k0: usize,
+        _a: &mut [f64],
+        b: &mut [f64],
+    ) {
+        let nodes = scratch.len() / (2 * self.n);
+        let lap_t = &scratch[(self.n + p) * nodes + k0..];
+        for (b, &l) in b.iter_mut().zip(lap_t) {
+            *b += adhesion_derivative(1.0, l, 0.0);
         }
     }
 }

@@ -11,13 +11,18 @@
 //! with `s2_q` the sum of the squares of the fields of population `q` ([`PopulationSums`]).
 //! The first part is the paper's repulsion with the cell's own `κ_pp`, which the cell's
 //! constants carry (`Populations::params`); this term is the second, `a_p = (2/λ) Σ_q
-//! (κ_pq − κ_pp) s2_q` ([`pair_repulsion_coefficient`]). Its pressure: the cells' `U` has
-//! their own `κ_pp`, the lattice formula [`crate::equations::pressure`] the tissue's κ, and
-//! the term adds the difference ([`pair_repulsion_pressure`]). With every `κ_pq = κ` it adds
-//! zero. The scene key `[repulsion] pairs` builds it (`Populations::with_repulsion`).
+//! (κ_pq − κ_pp) s2_q`. Its pressure: the cells' `U` has their own `κ_pp`, the lattice formula
+//! [`crate::equations::pressure`] the tissue's κ, and the term adds the difference
+//!
+//! ```text
+//! Σ_pq (2κ_pq/λ) X_p s2_q − (2κ/λ) X s2,     X_p = s1_p (paper form) or s2_p (interaction),
+//! ```
+//!
+//! so that the pressure is the pair energy's `Σ_i δF/δφ_i` (or `Σ_i φ_i δF/δφ_i`), as with
+//! one κ. With every `κ_pq = κ` it adds zero. Its lattice loops run column by column over
+//! contiguous slices. The scene key `[repulsion] pairs` builds it (`Populations::with_repulsion`).
 
 use super::{NodeTerm, PopulationSums};
-use crate::equations::{pair_repulsion_coefficient, pair_repulsion_pressure};
 use crate::evaluation::{SumField, N_SUMS};
 use crate::params::PressureKind;
 use crate::scatter::LatticeSums;
@@ -93,29 +98,42 @@ impl NodeTerm for PairRepulsion {
         let lattice = sums.lattice();
         let (lx, ly) = (lattice.lx, lattice.ly);
         let nodes = lx * ly;
-        let (mut x_p, mut s2_q) = (vec![0.0; n], vec![0.0; n]);
+        // Per column: `u_p = Σ_q (2κ_pq/λ) s2_q` and `a_p = Σ_q d_pq s2_q` over contiguous
+        // slices, then `P += Σ_p X_p u_p − (2κ/λ) X s2`.
+        let mut u = vec![0.0; n * ly];
         for x in 0..lx {
-            let ([s1, s2], p_col) = sums.columns_read_write([I_S1, I_S2], I_P, x);
-            for (y, p_node) in p_col.iter_mut().enumerate() {
+            u.fill(0.0);
+            for p in 0..n {
+                let a_p = &mut a[p * nodes + x * ly..p * nodes + (x + 1) * ly];
+                a_p.fill(0.0);
+                let u_p = &mut u[p * ly..(p + 1) * ly];
                 for q in 0..n {
-                    s2_q[q] = populations.squares(q, x)[y];
-                    x_p[q] = match self.kind {
-                        PressureKind::Paper => populations.column(q, x)[y],
-                        PressureKind::Interaction => s2_q[q],
-                    };
+                    let (c, d) = (self.c[p * n + q], self.d[p * n + q]);
+                    for ((u, a), &s) in u_p
+                        .iter_mut()
+                        .zip(a_p.iter_mut())
+                        .zip(populations.squares(q, x))
+                    {
+                        *u += c * s;
+                        *a += d * s;
+                    }
                 }
-                let total = match self.kind {
-                    PressureKind::Paper => s1[y],
-                    PressureKind::Interaction => s2[y],
+            }
+            let ([s1, s2], p_col) = sums.columns_read_write([I_S1, I_S2], I_P, x);
+            let total = match self.kind {
+                PressureKind::Paper => s1,
+                PressureKind::Interaction => s2,
+            };
+            for (y, p_node) in p_col.iter_mut().enumerate() {
+                *p_node -= self.c_tissue * total[y] * s2[y];
+            }
+            for p in 0..n {
+                let x_p = match self.kind {
+                    PressureKind::Paper => populations.column(p, x),
+                    PressureKind::Interaction => populations.squares(p, x),
                 };
-                *p_node +=
-                    pair_repulsion_pressure(&self.c, self.c_tissue, &x_p, &s2_q, total, s2[y]);
-                let k = x * ly + y;
-                for p in 0..n {
-                    a[p * nodes + k] = pair_repulsion_coefficient(
-                        &self.d[p * n..(p + 1) * n],
-                        s2_q.iter().copied(),
-                    );
+                for ((p_node, &xp), &u) in p_col.iter_mut().zip(x_p).zip(&u[p * ly..(p + 1) * ly]) {
+                    *p_node += xp * u;
                 }
             }
         }
