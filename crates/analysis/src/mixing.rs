@@ -37,6 +37,18 @@ pub fn contacts(lattice: Lattice, owner: &[i32]) -> Vec<[usize; 2]> {
     pairs
 }
 
+/// How many cells each of `n` cells touches, from the touching pairs `pairs` ([`contacts`]):
+/// its coordination in the tessellation of the owned regions, the dual of the triangulation
+/// of the centres, whose 5- and 7-fold cells are the tissue's disclinations.
+pub fn neighbour_counts(pairs: &[[usize; 2]], n: usize) -> Vec<usize> {
+    let mut counts = vec![0; n];
+    for &[i, j] in pairs {
+        counts[i] += 1;
+        counts[j] += 1;
+    }
+    counts
+}
+
 /// The demixing parameter of the labels `label` (by cell) over the touching pairs `pairs`
 /// (see the module docs); NaN without pairs or with fewer than two cells.
 pub fn demixing(pairs: &[[usize; 2]], label: &[usize]) -> f64 {
@@ -305,6 +317,13 @@ mod tests {
             .collect();
         let pairs = contacts(lattice, &owner);
         assert_eq!(pairs.len(), 128);
+        // Square cells on a torus are 4-fold; cell 9 merged into its neighbour 10 leaves 10
+        // with 6 (its own 3 others and 9's 3), 9 with none, and the others with 4 (no cell
+        // touched both).
+        assert!(neighbour_counts(&pairs, 64).iter().all(|&c| c == 4));
+        let merged: Vec<i32> = owner.iter().map(|&o| if o == 9 { 10 } else { o }).collect();
+        let counts = neighbour_counts(&contacts(lattice, &merged), 64);
+        assert_eq!((counts[9], counts[10], counts[1], counts[8]), (0, 6, 4, 4));
         let expected = 2.0 * (32.0 * 31.0) / (64.0 * 63.0);
         let checker: Vec<usize> = (0..64).map(|c| (c / 8 + c % 8) % 2).collect();
         assert!((demixing(&pairs, &checker) + expected).abs() < 1e-12);

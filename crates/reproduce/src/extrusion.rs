@@ -8,9 +8,12 @@
 //! stress at the cell, rises above a threshold) and the area rule (`[division] extrusion`: a
 //! cell squeezed below a fraction of its target area). `monolayer analyze` gives each
 //! extrusion's distance to the nearest +½ and −½ defect of the frame nearest in time, and the
-//! mean distance of a random point of that frame's tissue (`analysis/cell_events.csv`). The
-//! statistic of a run is the mean over its extrusions of `d₊ − d₊,random` (and of
-//! `d₋ − d₋,random`); of a rule, the mean and standard error over seeds.
+//! share of that frame's tissue within one cell radius of a defect (`analysis/cell_events.csv`).
+//! The statistic of a run is the enrichment of its extrusions within one radius of a +½ defect
+//! (and of a −½ defect, and of a 5-fold cell: Loewe et al., PRL 2020) against random points
+//! of the tissue (`analysis::proximity::enrichment`); of a rule, the mean and standard error
+//! over seeds. Issue 49 made it an effect size: before, the rule accepted any resolved
+//! attraction, and the area rule "held" on 3.5 % of R.
 
 #[cfg(test)]
 use std::path::Path;
@@ -50,9 +53,13 @@ output_every = 10.0
 series_every = 10.0
 ";
 
-/// The distance (nodes) closer to a defect than random points by which an attraction is
-/// material: a quarter of a cell radius.
-pub(crate) const MATERIAL: f64 = 2.0;
+/// The enrichment that counts: extrusions within one cell radius of the points half again as
+/// often as random points of the tissue are (issue 49's example).
+pub(crate) const MATERIAL: f64 = 1.5;
+
+/// The cell radius of [`EXTRUSION_SCENE`], the distance within which an extrusion is at a
+/// defect.
+const RADIUS: f64 = 8.0;
 
 /// The two rules: name, their key, its value.
 const RULES: [(&str, &str); 2] = [
@@ -64,42 +71,47 @@ fn seeds(scale: Scale) -> study::Seeds {
     scale.seeds_up_to(8, 20)
 }
 
-/// The verdict on "extrusions concentrate at the defects" from the per-seed means of
-/// `d − d_random`, by the rule of an effect ([`super::rule::Rule::effect`]): the effect is how
-/// much closer to the defects than random points of the tissue the extrusions are, `−(d −
-/// d_random)`, over seeds, and the smallest that counts is [`MATERIAL`] (a quarter radius).
-/// Holds when it is resolved by two standard errors and at least that; does not hold when it
-/// is below that by two standard errors; inconclusive otherwise (and with fewer than two
-/// seeds). (The rule before issue 54 read "holds" and "does not hold" at once on
-/// −0.28 ± 0.14 nodes; now that reads "does not hold".)
+/// The verdict on "extrusions concentrate at the points" from the per-seed enrichments `E`
+/// (extrusions within one radius of a point, over the number random points of the tissue
+/// would give), by the rule of an effect ([`super::rule::Rule::effect`]) on `E − 1` with
+/// smallest effect `MATERIAL − 1`: holds when `E − 2 s.e. > 1` and `E ≥ 1.5`; does not hold
+/// when `E + 2 s.e. < 1.5`; inconclusive otherwise (and with fewer than two seeds).
 pub(crate) fn verdict(per_seed: &[f64]) -> (Verdict, String) {
     let (m, se) = mean_se(per_seed);
     let n = per_seed.iter().filter(|v| v.is_finite()).count();
     let rule = super::rule::Rule::effect(
-        format!("d_random − d, how much closer to the defects than random points, over {n} seeds (nodes)"),
-        MATERIAL,
+        format!("E − 1, the enrichment of extrusions within R of the points beyond random points of the tissue, over {n} seeds"),
+        MATERIAL - 1.0,
     );
-    let o = rule.decide(-m, se);
+    let o = rule.decide(m - 1.0, se);
     (o.verdict, o.why)
 }
 
-/// The statistic of a rule: `d − d_random`, mean ± s.e. over the seeds.
+/// The statistic of a rule: the enrichment, mean ± s.e. over the seeds.
 fn stat(per_seed: &[f64]) -> String {
     let (m, se) = mean_se(per_seed);
     format!(
-        "d − d_random = {} ± {} nodes over {} seeds",
+        "enrichment within R = {} ± {} over {} seeds",
         g(m),
         g(se),
         per_seed.iter().filter(|v| v.is_finite()).count()
     )
 }
 
-/// The claim on the extrusions of rule `rule` at the +½ (`plus`) or −½ defects.
-fn claim(rule: &str, plus: bool) -> String {
-    if plus {
-        format!("extrusion (issue 41), {rule} rule: extruded cells are found at +½ defects (Saw et al. 2017)")
-    } else {
-        format!("extrusion, {rule} rule: extruded cells are found at −½ defects")
+/// The points the claims are about: the column of `extrusion.csv`, the column of the
+/// distance and of the random share in `cell_events.csv`, and the claim.
+const POINTS: [(&str, &str, &str); 3] = [
+    ("e_plus", "d_plus", "near_plus_random"),
+    ("e_minus", "d_minus", "near_minus_random"),
+    ("e_fivefold", "d_fivefold", "near_fivefold_random"),
+];
+
+/// The claim on the extrusions of rule `rule` at the points of [`POINTS`]`[k]`.
+fn claim(rule: &str, k: usize) -> String {
+    match k {
+        0 => format!("extrusion (issue 41), {rule} rule: extruded cells are found at +½ defects, 1.5 times as often as random points of the tissue or more (Saw et al. 2017)"),
+        1 => format!("extrusion, {rule} rule: extruded cells are found at −½ defects, 1.5 times as often as random points or more"),
+        _ => format!("extrusion (issue 49), {rule} rule: extrusion starts near 5-fold disclinations of the cells' triangulation, 1.5 times as often as random points or more (Loewe et al. 2020)"),
     }
 }
 
@@ -118,26 +130,20 @@ fn control(rule: &str) -> String {
 #[cfg(test)]
 pub(crate) fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>, SweepError> {
     let t = super::Table::read(&dir.join("extrusion.csv"))?;
-    let (rules, plus, minus) = (
-        t.strs("rule")?,
-        t.f64s("d_plus_excess")?,
-        t.f64s("d_minus_excess")?,
-    );
-    // The control's column (issue 54) is absent from tables made before it.
-    let decoy = t.f64s("d_plus_decoy_excess").ok();
+    let rules = t.strs("rule")?;
     let mut out = Vec::new();
     for (rule, _) in RULES {
-        let of = |v: &[f64]| -> Vec<f64> {
-            (0..rules.len())
+        let of = |column: &str| -> Result<Vec<f64>, SweepError> {
+            let v = t.f64s(column)?;
+            Ok((0..rules.len())
                 .filter(|&k| rules[k] == rule)
                 .map(|k| v[k])
-                .collect()
+                .collect())
         };
-        out.push((claim(rule, true), verdict(&of(&plus)).0));
-        out.push((claim(rule, false), verdict(&of(&minus)).0));
-        if let Some(d) = &decoy {
-            out.push((control(rule), verdict(&of(d)).0));
+        for (k, (column, _, _)) in POINTS.iter().enumerate() {
+            out.push((claim(rule, k), verdict(&of(column)?).0));
         }
+        out.push((control(rule), verdict(&of("e_decoy")?).0));
     }
     Ok(out)
 }
@@ -156,6 +162,10 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         "d_plus_excess",
         "d_minus_excess",
         "d_plus_decoy_excess",
+        "e_plus",
+        "e_minus",
+        "e_fivefold",
+        "e_decoy",
         "cells_end",
     ]);
     for (rule, key) in RULES {
@@ -172,8 +182,9 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 seeds: Some(seeds(p.scale)),
             },
         )?;
-        let (mut plus, mut minus, mut counts) = (Vec::new(), Vec::new(), Vec::new());
-        let mut decoy = Vec::new();
+        let mut counts = Vec::new();
+        // Each run's enrichment at the points of `POINTS`, then at the decoys.
+        let mut enriched: [Vec<f64>; 4] = Default::default();
         for r in res.records(None)? {
             let ev = super::Table::read(&r.run.join("analysis/cell_events.csv"))?;
             let kind = ev.strs("kind")?;
@@ -203,6 +214,20 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
             } else {
                 (excess(0, 1), excess(2, 3), excess(4, 5))
             };
+            let ext: Vec<usize> = (0..kind.len())
+                .filter(|&k| kind[k] == "extrusion")
+                .collect();
+            let enrichment = |distance: &str, share: &str| -> Result<f64, SweepError> {
+                let (d, s) = (ev.f64s(distance)?, ev.f64s(share)?);
+                let near: Vec<bool> = ext.iter().map(|&k| d[k] <= RADIUS).collect();
+                let share: Vec<f64> = ext.iter().map(|&k| s[k]).collect();
+                Ok(analysis::proximity::enrichment(&near, &share))
+            };
+            let mut e = [f64::NAN; 4];
+            for (k, (_, distance, share)) in POINTS.iter().enumerate() {
+                e[k] = enrichment(distance, share)?;
+            }
+            e[3] = enrichment("d_plus_decoy", "near_plus_decoy_random")?;
             let series = super::Table::read(&r.run.join("series.csv"))?;
             let cells_end = series.f64s("cells")?.last().copied().unwrap_or(f64::NAN);
             csv.row([
@@ -213,46 +238,42 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
                 sci(dp),
                 sci(dm),
                 sci(dd),
+                sci(e[0]),
+                sci(e[1]),
+                sci(e[2]),
+                sci(e[3]),
                 cell(cells_end),
             ]);
-            decoy.push(dd);
-            plus.push(dp);
-            minus.push(dm);
+            for (all, e) in enriched.iter_mut().zip(e) {
+                all.push(e);
+            }
             counts.push(n_ext as f64);
         }
-        let (vp, wp) = verdict(&plus);
-        let (vm, wm) = verdict(&minus);
         let n = mean_se(&counts);
-        claims.push(Claim::new(
-            claim(rule, true),
-            format!(
-                "{} extrusions per run (mean over seeds); {}",
-                g(n.0),
-                stat(&plus)
-            ),
-            vp,
-            wp,
-        ));
-        claims.push(Claim::new(
-            claim(rule, false),
-            format!("{} extrusions per run; {}", g(n.0), stat(&minus)),
-            vm,
-            wm,
-        ));
-        let (vd, wd) = verdict(&decoy);
-        claims.push(Claim::new(
-            control(rule),
-            format!("{} extrusions per run; {}", g(n.0), stat(&decoy)),
-            vd,
-            wd,
-        ));
+        for (k, per_seed) in enriched.iter().enumerate() {
+            let (v, why) = verdict(per_seed);
+            claims.push(Claim::new(
+                if k < 3 {
+                    claim(rule, k)
+                } else {
+                    control(rule)
+                },
+                format!(
+                    "{} extrusions per run (mean over seeds); {}",
+                    g(n.0),
+                    stat(per_seed)
+                ),
+                v,
+                why,
+            ));
+        }
     }
     let settings = format!(
         "- The paper's tissue (60 cells, R = 8, periodic 100², γ = 0.01, paper form) at ζ = 0.01 (active turbulence), with `[division] cycle_time = 300`, `growth_time = 50` and an extrusion rule: the stress-based rule `extrusion_pressure = 0.04` (a cell whose pressure p_i = Σφ_i P/Σφ_i, the isotropic stress at the cell, rises above it; the relaxed tissue's pressures are 0.005–0.013) or the area rule `extrusion = 0.3` (a cell below 30 % of its target area); seeds {}.\n\
          - 200 TU of relaxation, then {t} TU; dt = {}; frames every 10 TU, analysed; at these settings the cell count holds at about 53 (pressure rule) and 86 (area rule) instead of growing to the cap.\n\
-         - Statistic: for each extrusion, `d₊ − d₊,random` (and `d₋ − d₋,random`): its distance to the nearest +½ (−½) defect of the frame nearest in time, less the mean distance of a point of that frame's tissue (`analysis/cell_events.csv`); its mean over a run's extrusions, then mean ± standard error over seeds. Rule (issue 54's rule of an effect): the effect is how much closer than random the extrusions are, `−(d − d_random)`, and the smallest that counts is {MATERIAL} nodes (a quarter radius); holds when it is resolved by two standard errors and at least that, does not hold when it is below that by two standard errors, inconclusive otherwise.\n\
+         - Statistic (issue 49): the enrichment E of a run's extrusions within R = {RADIUS} nodes of a +½ defect (a −½ defect; the centre of a 5-fold cell, one with five touching neighbours) of the frame nearest in time: the number within R over the number expected if each were a random point of its frame's tissue, the sum of the shares of the tissue within R (`near_*_random` of `analysis/cell_events.csv`); then mean ± standard error over seeds. Rule (the rule of an effect, on E − 1): holds when E exceeds 1 by two standard errors and is at least {MATERIAL}; does not hold when E plus two standard errors is below {MATERIAL}; inconclusive otherwise. The mean distances `d − d_random` of the rule before issue 49 are kept in `extrusion.csv`.\n\
          - Control: the same statistic against decoys, as many nodes of the frame's tissue drawn at random (a hash of the frame's step) as it has +½ defects, in place of them (`d_plus_decoy`, `d_plus_decoy_random` of `cell_events.csv`); nothing draws extrusions to them, so its rule must read \"does not hold\".\n\
-         - Data: `extrusion.csv` (each run: extrusions, divisions, the two excesses and the decoys', the final cell count).",
+         - Data: `extrusion.csv` (each run: extrusions, divisions, the mean distance excesses (+½, −½, decoys), the enrichments `e_plus`, `e_minus`, `e_fivefold`, `e_decoy`, the final cell count).",
         seeds(p.scale),
         p.scale.own_dt(),
     );
@@ -276,24 +297,18 @@ mod tests {
 
     #[test]
     fn each_outcome_is_reached() {
-        // Closer than random by 4 ± 0.5 nodes: holds.
-        assert_eq!(verdict(&[-4.5, -3.5, -4.0, -4.2]).0, Verdict::Holds);
-        // As far as random within 0.3 nodes: an attraction of 2 nodes is excluded.
-        assert_eq!(verdict(&[0.2, -0.3, 0.1, 0.0]).0, Verdict::DoesNotHold);
-        // Farther than random: also does not hold.
-        assert_eq!(verdict(&[2.0, 2.5, 1.5]).0, Verdict::DoesNotHold);
-        // Seeds scattered over ±5 nodes: inconclusive.
-        assert_eq!(verdict(&[-5.0, 4.0, -3.0, 3.0]).0, Verdict::Inconclusive);
-        // Issue 54's case, −0.28 ± 0.14 nodes: closer by two standard errors, but by less
-        // than a quarter radius, which that excludes: "does not hold", and only that.
-        let case = [-0.14, -0.42, -0.28, -0.56, 0.0];
-        let (m, se) = mean_se(&case);
-        assert!(
-            (m + 0.28).abs() < 1e-12 && (se - 0.0989949).abs() < 1e-6,
-            "{m} {se}"
-        );
-        assert_eq!(verdict(&case).0, Verdict::DoesNotHold);
+        // Twice as often as random, seeds close: holds.
+        assert_eq!(verdict(&[2.1, 1.9, 2.0, 2.2]).0, Verdict::Holds);
+        // As often as random within 0.1: an enrichment of 1.5 is excluded.
+        assert_eq!(verdict(&[1.05, 0.95, 1.1, 1.0]).0, Verdict::DoesNotHold);
+        // Fewer than random: also does not hold.
+        assert_eq!(verdict(&[0.4, 0.5, 0.6]).0, Verdict::DoesNotHold);
+        // Seeds scattered over 0–4: inconclusive.
+        assert_eq!(verdict(&[0.0, 4.0, 0.5, 3.5]).0, Verdict::Inconclusive);
+        // Issue 49's case: a resolved but small enrichment (1.2 ± 0.05) is not 1.5: "does not
+        // hold", and only that.
+        assert_eq!(verdict(&[1.15, 1.25, 1.2, 1.1, 1.3]).0, Verdict::DoesNotHold);
         // NaN seeds (no extrusion) are left out; one seed left: inconclusive.
-        assert_eq!(verdict(&[f64::NAN, -4.0]).0, Verdict::Inconclusive);
+        assert_eq!(verdict(&[f64::NAN, 2.0]).0, Verdict::Inconclusive);
     }
 }

@@ -364,13 +364,26 @@ impl Accumulator {
         });
         // s1 = Σφ_i on the lattice: the tissue mask of the defects, a wound's gap and the
         // cover of the random points of `cell_events.csv`.
-        let (phi_sum, _) = frame.phi_sum_and_owner(shape.nx, shape.ny);
+        let (phi_sum, owner) = frame.phi_sum_and_owner(shape.nx, shape.ny);
         let phi_sum: Vec<f64> = phi_sum.iter().map(|&v| f64::from(v)).collect();
         let gap = wound.as_ref().map_or(f64::NAN, |band| {
             analysis::confinement::uncovered_fraction(&phi_sum, band)
         });
         let covered: Option<Vec<bool>> =
             lineage.then(|| phi_sum.iter().map(|&v| v >= 0.5).collect());
+        // The centres of the 5-fold cells (Loewe et al., PRL 2020: extrusion starts near the
+        // 5-fold disclinations of the triangulation of the centres), for `cell_events.csv`.
+        let fivefold: Vec<[f64; 2]> = if covered.is_some() {
+            let pairs = analysis::mixing::contacts(lattice, &owner);
+            analysis::mixing::neighbour_counts(&pairs, frame.centres.len())
+                .iter()
+                .zip(&frame.centres)
+                .filter(|(&c, _)| c == 5)
+                .map(|(_, &p)| p)
+                .collect()
+        } else {
+            Vec::new()
+        };
         let LoadedFrame {
             tissue,
             shapes,
@@ -410,8 +423,18 @@ impl Accumulator {
                 decoys(lattice, mask, plus.len(), step, 1),
                 decoys(lattice, mask, minus.len(), step, 2),
             ];
+            let share_stride = (radius / 4.0).max(1.0) as usize;
+            let share = |points: &[[f64; 2]]| {
+                analysis::proximity::share_within(lattice, mask, points, radius, share_stride)
+            };
             near.push(FrameDefects {
                 time,
+                near_random: [
+                    share(&plus),
+                    share(&minus),
+                    share(&decoys[0]),
+                    share(&fivefold),
+                ],
                 random: [
                     mean_nearest_over(lattice, mask, &plus, stride),
                     mean_nearest_over(lattice, mask, &minus, stride),
@@ -423,6 +446,7 @@ impl Accumulator {
                 decoys,
                 plus,
                 minus,
+                fivefold,
             });
         }
         avg.add(lattice, &crop_fields(&f), &found);
@@ -590,6 +614,12 @@ struct FrameDefects {
     random: [f64; 2],
     decoys: [Vec<[f64; 2]>; 2],
     decoy_random: [f64; 2],
+    /// The centres of the 5-fold cells (five touching neighbours).
+    fivefold: Vec<[f64; 2]>,
+    /// The share of the tissue within one cell radius of a +½ defect, a −½ defect, a +½
+    /// decoy and a 5-fold cell (`analysis::proximity::share_within`): the chance that a
+    /// random point of the tissue is near one.
+    near_random: [f64; 4],
 }
 
 /// `count` nodes where `mask` holds (index `x * ly + y`), drawn by a hash of `(step, salt,
@@ -627,7 +657,7 @@ fn write_cell_events(
     let mut csv = String::new();
     row!(
         csv,
-        "time,kind,id,x,y,frame_time,d_plus,d_minus,d_plus_random,d_minus_random,d_plus_decoy,d_minus_decoy,d_plus_decoy_random,d_minus_decoy_random"
+        "time,kind,id,x,y,frame_time,d_plus,d_minus,d_plus_random,d_minus_random,d_plus_decoy,d_minus_decoy,d_plus_decoy_random,d_minus_decoy_random,d_fivefold,near_plus_random,near_minus_random,near_plus_decoy_random,near_fivefold_random"
     );
     let (Some(first), Some(last)) = (frames.first(), frames.last()) else {
         return Ok(0);
@@ -666,7 +696,7 @@ fn write_cell_events(
         };
         row!(
             csv,
-            "{t},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{t},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             why.name(),
             r.id,
             r.place[0],
@@ -679,7 +709,12 @@ fn write_cell_events(
             shown(dd[0]),
             shown(dd[1]),
             shown(f.decoy_random[0]),
-            shown(f.decoy_random[1])
+            shown(f.decoy_random[1]),
+            shown(nearest(lattice, r.place, &f.fivefold)),
+            shown(f.near_random[0]),
+            shown(f.near_random[1]),
+            shown(f.near_random[2]),
+            shown(f.near_random[3])
         );
         let e = sums.entry(why.name()).or_default();
         if [d[0], d[1], f.random[0], f.random[1]]
