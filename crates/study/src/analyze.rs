@@ -645,7 +645,7 @@ fn decoys(lattice: Lattice, mask: &[bool], count: usize, step: u64, salt: u64) -
 }
 
 /// Writes `cell_events.csv` (every division, extrusion and death of `lineage.csv` within the
-/// analysed frames, at the frame nearest in time: the distance from where the cell ended to
+/// analysed frames, at the last frame at or before it: the distance from where the cell ended to
 /// the nearest +½ and −½ defect, and the same for a random point of the tissue) and
 /// `cell_events_summary.csv` (their means by kind). Returns the number of events.
 fn write_cell_events(
@@ -675,10 +675,15 @@ fn write_cell_events(
         if t < first.time - half || t > last.time + half {
             continue;
         }
+        // The last frame at or before the event, where the cell still was (the first frame
+        // for an event before it): in a frame after an extrusion its place may be a hole,
+        // where no random point of the tissue can be, which biased the null (issue 49: the
+        // decoys' enrichment read 0.5 at the nearest frame).
         let f = frames
             .iter()
-            .min_by(|a, b| (a.time - t).abs().total_cmp(&(b.time - t).abs()))
-            .expect("frames are not empty");
+            .rev()
+            .find(|f| f.time <= t + 1e-9)
+            .unwrap_or(first);
         let d = [
             nearest(lattice, r.place, &f.plus),
             nearest(lattice, r.place, &f.minus),
