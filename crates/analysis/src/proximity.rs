@@ -91,7 +91,9 @@ pub fn enrichment(near: &[bool], share: &[f64]) -> f64 {
         .iter()
         .zip(share)
         .filter(|(_, s)| s.is_finite())
-        .fold((0.0, 0.0), |(h, e), (&n, &s)| (h + f64::from(u8::from(n)), e + s));
+        .fold((0.0, 0.0), |(h, e), (&n, &s)| {
+            (h + f64::from(u8::from(n)), e + s)
+        });
     if expected > 0.0 {
         hits / expected
     } else {

@@ -253,11 +253,7 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         for (k, per_seed) in enriched.iter().enumerate() {
             let (v, why) = verdict(per_seed);
             claims.push(Claim::new(
-                if k < 3 {
-                    claim(rule, k)
-                } else {
-                    control(rule)
-                },
+                if k < 3 { claim(rule, k) } else { control(rule) },
                 format!(
                     "{} extrusions per run (mean over seeds); {}",
                     g(n.0),
@@ -307,7 +303,10 @@ mod tests {
         assert_eq!(verdict(&[0.0, 4.0, 0.5, 3.5]).0, Verdict::Inconclusive);
         // Issue 49's case: a resolved but small enrichment (1.2 ± 0.05) is not 1.5: "does not
         // hold", and only that.
-        assert_eq!(verdict(&[1.15, 1.25, 1.2, 1.1, 1.3]).0, Verdict::DoesNotHold);
+        assert_eq!(
+            verdict(&[1.15, 1.25, 1.2, 1.1, 1.3]).0,
+            Verdict::DoesNotHold
+        );
         // NaN seeds (no extrusion) are left out; one seed left: inconclusive.
         assert_eq!(verdict(&[f64::NAN, 2.0]).0, Verdict::Inconclusive);
     }

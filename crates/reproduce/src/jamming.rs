@@ -87,7 +87,7 @@ pub(crate) enum Phase {
 }
 
 impl Phase {
-    fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Self::Fluid => "fluid",
             Self::Solid => "solid",

@@ -18,6 +18,7 @@ mod defect_fields;
 mod defects;
 mod extrusion;
 mod flocking;
+mod friction;
 mod jamming;
 mod lengths;
 mod pipeline;
@@ -193,11 +194,13 @@ pub enum Figure {
     Jamming,
     /// Where extruded cells are found, against the defects (issue 41).
     Extrusion,
+    /// Whether friction between cells solidifies a tissue (issue 49).
+    Friction,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 15] = [
+    pub const ALL: [Figure; 16] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -213,6 +216,7 @@ impl Figure {
         Self::Sorting,
         Self::Jamming,
         Self::Extrusion,
+        Self::Friction,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -233,6 +237,7 @@ impl Figure {
             Self::Sorting => "sorting",
             Self::Jamming => "jamming",
             Self::Extrusion => "extrusion",
+            Self::Friction => "friction",
         }
     }
 
@@ -262,6 +267,7 @@ impl Figure {
                 "The solid–liquid transition of a tissue of self-propelled cells (issue 41)"
             }
             Self::Extrusion => "Extrusion against the ±1/2 defects (issue 41)",
+            Self::Friction => "Friction between cells and the solid–liquid transition (issue 49)",
         }
     }
 }
@@ -487,6 +493,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Sorting => sorting::make(p)?,
         Figure::Jamming => jamming::make(p)?,
         Figure::Extrusion => extrusion::make(p)?,
+        Figure::Friction => friction::make(p)?,
     };
     made.write_files(&dir)?;
     let wall_s = start.elapsed().as_secs_f64();
