@@ -157,3 +157,93 @@ fn the_nematic_is_refused_where_it_cannot_run() {
         assert!(!out.exists(), "nothing written");
     }
 }
+
+/// `analyze` finds the defects of the cells' own nematic field `M = Σ φ_i q_i`
+/// (`analysis/defects_nematic.csv`), as it finds the shape field's: axes dealt at random (the
+/// scene without `angle`) make ±½ defects of M at the start, of both signs (not in equal
+/// numbers: the initial discs do not cover the box, and defects outside the tissue are
+/// dropped); axes all along x make none. A scene without `[nematic]` writes no such file.
+#[test]
+fn analyze_finds_the_defects_of_the_cells_nematic() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(scene_path("nematic.toml")).unwrap();
+    let random: String = text
+        .lines()
+        .filter(|l| !l.starts_with("angle"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let path = dir.path().join("random.toml");
+    std::fs::write(&path, random).unwrap();
+    let first_frame_defects = |scene: &std::path::Path, name: &str| -> Vec<f64> {
+        let out = dir.path().join(name);
+        let o = bin()
+            .arg("run")
+            .arg(scene)
+            .arg("--out")
+            .arg(&out)
+            .args([
+                "--quiet",
+                "--set",
+                "run.relax_time=5",
+                "--set",
+                "run.time=10",
+            ])
+            .args(["--set", "run.output_every=5"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let o = bin()
+            .arg("analyze")
+            .arg(&out)
+            .arg("--quiet")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let csv = std::fs::read_to_string(out.join("analysis/defects_nematic.csv")).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(lines.next(), Some("frame,time,x,y,charge,angle"));
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        let first = rows.first().map(|r| r[0].to_string());
+        rows.iter()
+            .filter(|r| Some(r[0].to_string()) == first)
+            .map(|r| r[4].parse().unwrap())
+            .collect()
+    };
+    let charges = first_frame_defects(&path, "random");
+    assert!(charges.len() >= 2, "random axes make defects: {charges:?}");
+    assert!(
+        charges.iter().all(|&c| c == 0.5 || c == -0.5),
+        "{charges:?}"
+    );
+    assert!(
+        charges.contains(&0.5) && charges.contains(&-0.5),
+        "{charges:?}"
+    );
+    let aligned = first_frame_defects(&scene_path("nematic.toml"), "aligned");
+    assert!(aligned.is_empty(), "axes along x: {aligned:?}");
+    // Without [nematic]: no file.
+    let out = dir.path().join("plain");
+    let o = bin()
+        .arg("run")
+        .arg(scene_path("paper.toml"))
+        .arg("--out")
+        .arg(&out)
+        .args([
+            "--quiet",
+            "--set",
+            "run.relax_time=2",
+            "--set",
+            "run.time=2",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = bin()
+        .arg("analyze")
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!out.join("analysis/defects_nematic.csv").exists());
+}

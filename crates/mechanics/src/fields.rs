@@ -21,6 +21,9 @@ pub struct TissueFields {
     pub vy: Vec<f64>,
     /// `Q_xx = Σ_i φ_i S_i,xx` (`Q_yy = −Q_xx`).
     pub qxx: Vec<f64>,
+    /// With `[nematic]`, the cells' own nematic field `M = Σ_i φ_i q_i` (`[M_xx, M_xy]`,
+    /// docs/model.md §11.6), whose defects `analyze` finds as it finds `Q`'s.
+    pub cell_nematic: Option<[Vec<f64>; 2]>,
     /// `Q_xy = Σ_i φ_i S_i,xy`.
     pub qxy: Vec<f64>,
     /// The pressure `P` of the run's [`crate::PressureKind`].
@@ -38,13 +41,17 @@ impl<T: Real> Tissue<T> {
     /// Scatters the tissue velocity `Σ_i φ_i v_i` into the workspace, from the velocities
     /// of the last evaluation.
     pub(crate) fn scatter_velocity(&self, ws: &mut Workspace<T>) {
-        self.scatter_pair(ws, |c| [c.velocity.x, c.velocity.y]);
+        self.scatter_pair(ws, |c, _| [c.velocity.x, c.velocity.y]);
     }
 
-    /// Scatters `Σ_i φ_i a_i` of a per-cell pair `a_i = value(cell state)` of the last
+    /// Scatters `Σ_i φ_i a_i` of a per-cell pair `a_i = value(cell state, slot)` of the last
     /// evaluation into the workspace's two-field lattice buffer
     /// ([`Workspace::velocity_field`]).
-    fn scatter_pair(&self, ws: &mut Workspace<T>, value: impl Fn(&CellState) -> [f64; 2] + Sync) {
+    fn scatter_pair(
+        &self,
+        ws: &mut Workspace<T>,
+        value: impl Fn(&CellState, usize) -> [f64; 2] + Sync,
+    ) {
         let Workspace {
             cell_state,
             velocity_field,
@@ -56,7 +63,7 @@ impl<T: Real> Tissue<T> {
             self.cells.phi(),
             velocity_field,
             |i| {
-                let [a, b] = value(&cs[i]);
+                let [a, b] = value(&cs[i], i);
                 move |run: &StencilRun<'_, T>, sums| {
                     run.add_to([], |s, []| [s.c * a, s.c * b], sums)
                 }
@@ -93,8 +100,12 @@ impl<T: Real> Tissue<T> {
         f.sigma_yy = (0..n).map(|k| -f.pressure[k] + zeta * f.qxx[k]).collect();
         f.sigma_xy = (0..n).map(|k| -zeta * f.qxy[k]).collect();
         if mixed {
-            self.scatter_pair(ws, |c| c.shape.components());
+            self.scatter_pair(ws, |c, _| c.shape.components());
             [f.qxx, f.qxy] = ws.velocity_field();
+        }
+        if let Some((nem, theta)) = self.ext.terms.nematic() {
+            self.scatter_pair(ws, |_, slot| nem.tensor(theta[self.cell_id[slot]]));
+            f.cell_nematic = Some(ws.velocity_field());
         }
         f
     }

@@ -238,6 +238,8 @@ struct Accumulator {
     /// `polar_order`), known once a frame is read.
     term_columns: Option<Vec<&'static str>>,
     defects_csv: String,
+    /// With `[nematic]`, the defects of the cells' own nematic field `M` (`defects_nematic.csv`).
+    nematic_defects_csv: Option<String>,
     events_csv: String,
     ws: Option<Workspace>,
     corr: [Correlator; 3],
@@ -285,6 +287,11 @@ impl Accumulator {
             obs: String::new(),
             term_columns: None,
             defects_csv,
+            nematic_defects_csv: scene
+                .file()
+                .nematic
+                .is_some()
+                .then(|| "frame,time,x,y,charge,angle\n".to_string()),
             events_csv,
             ws: None,
             corr: [
@@ -326,6 +333,7 @@ impl Accumulator {
             obs,
             term_columns,
             defects_csv,
+            nematic_defects_csv,
             events_csv,
             ws,
             corr,
@@ -405,6 +413,23 @@ impl Accumulator {
         // space of a colony, a wound or a channel's wall `Q ≈ 0` and its angle is noise.
         let (_, found) = crate::region::in_tissue(lattice, box_side, &phi_sum, &sqxx, &sqxy)
             .map_err(|e| AnalyzeError::Options(e.to_string()))?;
+        // The cells' own nematic field's defects, found the same way (smoothed, in tissue).
+        if let (Some(csv), Some([mxx, mxy])) = (nematic_defects_csv.as_mut(), &f.cell_nematic) {
+            let (_, m_found) =
+                crate::region::in_tissue(lattice, box_side, &phi_sum, &smooth(mxx), &smooth(mxy))
+                    .map_err(|e| AnalyzeError::Options(e.to_string()))?;
+            for d in &m_found {
+                row!(
+                    csv,
+                    "{step},{:.6},{},{},{},{}",
+                    tissue.time(),
+                    d.x,
+                    d.y,
+                    d.charge,
+                    d.angle
+                );
+            }
+        }
         let tracks = tracker.push(&found);
         let time = tissue.time();
         let (creations, annihilations) =
@@ -506,6 +531,7 @@ impl Accumulator {
             term_columns,
             obs,
             defects_csv,
+            nematic_defects_csv,
             events_csv,
             corr,
             avg,
@@ -536,6 +562,9 @@ impl Accumulator {
         }
         write_file(&out.join("msd.csv"), msd_csv.as_bytes())?;
         write_file(&out.join("defects.csv"), defects_csv.as_bytes())?;
+        if let Some(csv) = nematic_defects_csv {
+            write_file(&out.join("defects_nematic.csv"), csv.as_bytes())?;
+        }
         write_file(&out.join("defect_events.csv"), events_csv.as_bytes())?;
         if let Some(lineage) = &lineage {
             info.cell_events = write_cell_events(out, lattice, lineage, &near)?;
