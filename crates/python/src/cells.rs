@@ -147,6 +147,9 @@ pub(crate) fn fields_dict<'py>(
         shaped(py, pair(&f.vx, &f.vy), &[l.lx, l.ly, 2])?,
     )?;
     d.set_item("Q", shaped(py, pair(&f.qxx, &f.qxy), &[l.lx, l.ly, 2])?)?;
+    if let Some([mxx, mxy]) = &f.cell_nematic {
+        d.set_item("M", shaped(py, pair(mxx, mxy), &[l.lx, l.ly, 2])?)?;
+    }
     let sigma: Vec<f64> = (0..l.len())
         .flat_map(|k| [f.sigma_xx[k], f.sigma_yy[k], f.sigma_xy[k]])
         .collect();

@@ -291,6 +291,16 @@ def test_the_cell_nematic_is_a_scene_key_with_columns(root):
     # The tensor's components xx and xy.
     assert np.allclose(cells["nematic.x"], np.cos(0.5))
     assert np.allclose(cells["nematic.y"], np.sin(0.5))
+    # The cells' nematic field M = Σφ_i q_i before any step: every axis at 0.25, so M is
+    # along 2θ = 0.5 wherever there is tissue, in proportion to Σφ_i.
+    fields = sim.fields()
+    m, phi = fields["M"], fields["phi_sum"]
+    assert m.shape == (100, 100, 2)
+    tissue = phi > 0.5
+    assert tissue.sum() > 1000
+    assert np.allclose(np.arctan2(m[..., 1], m[..., 0])[tissue], 0.5, atol=1e-6)
+    ratio = np.hypot(m[..., 0], m[..., 1])[tissue] / phi[tissue]
+    assert np.allclose(ratio, ratio[0], rtol=1e-5)
     sim.run(progress=False)
     assert sim.cells["fx"].shape == (60,)
     with pytest.raises(ValueError, match=r"\[nematic\].*elastic"):

@@ -181,7 +181,8 @@ class Simulation:
     def fields(self) -> Dict[str, np.ndarray]:
         """The lattice fields of the current state, arrays of shape ``(lx, ly[, k])``:
         ``phi_sum`` (Σφ), ``velocity`` (Σφᵢvᵢ), ``Q`` (Q_xx, Q_xy), ``pressure`` and
-        ``sigma`` (σ_xx, σ_yy, σ_xy). Read-only copies."""
+        ``sigma`` (σ_xx, σ_yy, σ_xy), and with ``[nematic]`` ``M`` (the cells' own nematic
+        field Σφᵢqᵢ). Read-only copies."""
         return self._sim.fields()
 
     def observables(self) -> Dict[str, float]:
