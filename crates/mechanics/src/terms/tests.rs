@@ -484,14 +484,13 @@ fn a_doublet_adheres_more_with_omega() {
     assert!(ws.cell(0).force.norm() < 1e-12, "{:?}", ws.cell(0).force);
 }
 
+/// What a doublet's populations are given (a pair matrix).
+type Give<'a> = &'a dyn Fn(Populations) -> Populations;
+
 /// The doublet of `a_doublet_adheres_more_with_omega` at adhesion `omega`, its two cells in
 /// the populations `pairs` (their assignment, and what to give the populations: a matrix),
 /// after 2000 steps of 0.2: its fields and `Σ_x (φ₀φ₁)^power` over the box.
-fn stepped_doublet(
-    omega: f64,
-    pairs: Option<(&[u16], &dyn Fn(Populations) -> Populations)>,
-    power: i32,
-) -> (Vec<f64>, f64) {
+fn stepped_doublet(omega: f64, pairs: Option<(&[u16], Give<'_>)>, power: i32) -> (Vec<f64>, f64) {
     let mut t = doublet(omega);
     if let Some((of_cell, give)) = pairs {
         let pops = Populations::from_assignment(vec![Population::new(); 2], of_cell.to_vec());
