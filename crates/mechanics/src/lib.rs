@@ -148,7 +148,7 @@ pub enum StepError {
     },
     /// A physics term's state relaxes too fast for the time step (its stiffness `k` with
     /// `k·dt > 2`, where Heun's step is unstable): the polarity's alignment rate, say.
-    #[error("at step {step} (t = {time:.3}) the {term} term of cell {cell} relaxes its state at a rate {stiffness:.3e} per time unit, and the step dt = {dt} is unstable above 2/dt = {limit:.3e}: lower the term's rate (for polarity: [polarity] align_rate, or the population's) by {factor:.1}× or more, or [integrator] dt", limit = 2.0 / dt, factor = stiffness * dt / 2.0)]
+    #[error("at step {step} (t = {time:.3}) the {term} term of cell {cell} relaxes its state at a rate {stiffness:.3e} per time unit, and the step dt = {dt} is unstable above 2/dt = {limit:.3e}: lower the term's rate (for the built-in polarity and nematic, [{term}] align_rate, or the population's) by {factor:.1}× or more, or [integrator] dt", limit = 2.0 / dt, factor = stiffness * dt / 2.0)]
     TermUnstable {
         /// Step at which it was found.
         step: u64,
