@@ -72,7 +72,8 @@ enum Command {
     /// on each claim of the paper that it tests.
     Reproduce {
         /// threshold, lengths, defects, defect-fields, contractile, scaling, stability, bloch,
-        /// run-length, channel, rotation, flocking, sorting, jamming, extrusion, friction, or all.
+        /// run-length, channel, rotation, flocking, sorting, jamming, extrusion, friction,
+        /// contractile-extensile, or all.
         figure: String,
         /// The output directory (created if missing; a second call resumes).
         #[arg(long)]

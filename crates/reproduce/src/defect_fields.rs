@@ -17,9 +17,9 @@ const CROP: usize = 61;
 const R: f64 = 8.0;
 
 /// The averaged crops of one run: `(n_plus, n_minus, plus[component], minus[component])`.
-type Crops = (f64, f64, Vec<Vec<f64>>, Vec<Vec<f64>>);
+pub(crate) type Crops = (f64, f64, Vec<Vec<f64>>, Vec<Vec<f64>>);
 
-fn read_crops(path: &Path) -> Result<Crops, SweepError> {
+pub(crate) fn read_crops(path: &Path) -> Result<Crops, SweepError> {
     let mut names: Vec<String> = vec!["n_plus".into(), "n_minus".into()];
     for prefix in ["plus", "minus"] {
         names.extend(COMPONENTS.iter().map(|c| format!("{prefix}_{c}")));
@@ -55,7 +55,7 @@ fn at(field: &[f64], u: f64, v: f64) -> f64 {
 }
 
 /// The mean of a crop over the disc of radius `r`.
-fn disc_mean(field: &[f64], r: f64) -> f64 {
+pub(crate) fn disc_mean(field: &[f64], r: f64) -> f64 {
     let h = (CROP / 2) as f64;
     let (mut s, mut n) = (0.0, 0.0);
     for k in 0..CROP * CROP {

@@ -14,6 +14,7 @@
 mod bloch;
 mod channel;
 mod contractile;
+mod contractile_extensile;
 mod defect_fields;
 mod defects;
 mod extrusion;
@@ -196,11 +197,13 @@ pub enum Figure {
     Extrusion,
     /// Whether friction between cells solidifies a tissue (issue 49).
     Friction,
+    /// Whether contractile cells can form an extensile monolayer (issue 49).
+    ContractileExtensile,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 16] = [
+    pub const ALL: [Figure; 17] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -217,6 +220,7 @@ impl Figure {
         Self::Jamming,
         Self::Extrusion,
         Self::Friction,
+        Self::ContractileExtensile,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -238,6 +242,7 @@ impl Figure {
             Self::Jamming => "jamming",
             Self::Extrusion => "extrusion",
             Self::Friction => "friction",
+            Self::ContractileExtensile => "contractile-extensile",
         }
     }
 
@@ -268,6 +273,9 @@ impl Figure {
             }
             Self::Extrusion => "Extrusion against the ±1/2 defects (issue 41)",
             Self::Friction => "Friction between cells and the solid–liquid transition (issue 49)",
+            Self::ContractileExtensile => {
+                "Contractile cells and an extensile monolayer, by the cells' own nematic (issue 49)"
+            }
         }
     }
 }
@@ -494,6 +502,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Jamming => jamming::make(p)?,
         Figure::Extrusion => extrusion::make(p)?,
         Figure::Friction => friction::make(p)?,
+        Figure::ContractileExtensile => contractile_extensile::make(p)?,
     };
     made.write_files(&dir)?;
     let wall_s = start.elapsed().as_secs_f64();
