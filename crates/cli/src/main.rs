@@ -73,7 +73,7 @@ enum Command {
     Reproduce {
         /// threshold, lengths, defects, defect-fields, contractile, scaling, stability, bloch,
         /// run-length, channel, rotation, flocking, sorting, jamming, extrusion, friction,
-        /// contractile-extensile, or all.
+        /// contractile-extensile, bend-splay, or all.
         figure: String,
         /// The output directory (created if missing; a second call resumes).
         #[arg(long)]

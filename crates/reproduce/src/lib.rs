@@ -11,6 +11,7 @@
 //!
 //! The settings of each figure are written at the top of its `verdict.md`.
 
+mod bend_splay;
 mod bloch;
 mod channel;
 mod contractile;
@@ -45,6 +46,7 @@ use study::{
     analyze_points, run_points, write_summary, Seeds, SweepError, SweepParams, SweepSpec, Vary,
 };
 
+pub use bend_splay::BEND_SPLAY_SCENE;
 pub use extrusion::EXTRUSION_SCENE;
 pub use flocking::POLAR_SCENE;
 pub use jamming::JAMMING_SCENE;
@@ -199,11 +201,14 @@ pub enum Figure {
     Friction,
     /// Whether contractile cells can form an extensile monolayer (issue 49).
     ContractileExtensile,
+    /// Whether a uniform director of extensile cells is unstable to bend, contractile to splay
+    /// (issue 49).
+    BendSplay,
 }
 
 impl Figure {
     /// Every figure, in the order `all` makes them.
-    pub const ALL: [Figure; 17] = [
+    pub const ALL: [Figure; 18] = [
         Self::Threshold,
         Self::Lengths,
         Self::Defects,
@@ -221,6 +226,7 @@ impl Figure {
         Self::Extrusion,
         Self::Friction,
         Self::ContractileExtensile,
+        Self::BendSplay,
     ];
 
     /// Its name, as given on the command line and as its directory.
@@ -243,6 +249,7 @@ impl Figure {
             Self::Extrusion => "extrusion",
             Self::Friction => "friction",
             Self::ContractileExtensile => "contractile-extensile",
+            Self::BendSplay => "bend-splay",
         }
     }
 
@@ -275,6 +282,9 @@ impl Figure {
             Self::Friction => "Friction between cells and the solid–liquid transition (issue 49)",
             Self::ContractileExtensile => {
                 "Contractile cells and an extensile monolayer, by the cells' own nematic (issue 49)"
+            }
+            Self::BendSplay => {
+                "Bend and splay instabilities of the cells' own nematic from a uniform director (issue 49)"
             }
         }
     }
@@ -503,6 +513,7 @@ pub fn reproduce(figure: Figure, p: &ReproduceParams) -> Result<FigureReport, Sw
         Figure::Extrusion => extrusion::make(p)?,
         Figure::Friction => friction::make(p)?,
         Figure::ContractileExtensile => contractile_extensile::make(p)?,
+        Figure::BendSplay => bend_splay::make(p)?,
     };
     made.write_files(&dir)?;
     let wall_s = start.elapsed().as_secs_f64();
