@@ -309,6 +309,11 @@ struct RenderCmd {
     /// three arms for -1/2.
     #[arg(long)]
     defects: bool,
+    /// Whose director and defects --director and --defects draw: shape (the cells' shapes'
+    /// Q) or nematic (the cells' own nematic field M = sum phi_i q_i, scenes with [nematic];
+    /// the defects of analysis/defects_nematic.csv).
+    #[arg(long, default_value = "shape")]
+    director_of: String,
     /// Arrows of the velocity field.
     #[arg(long)]
     flow: bool,
@@ -447,6 +452,7 @@ fn render_command(cmd: RenderCmd) -> Result<ExitCode> {
         colour,
         director,
         defects,
+        director_of,
         flow,
         axes,
         polarity,
@@ -477,6 +483,7 @@ fn render_command(cmd: RenderCmd) -> Result<ExitCode> {
         colour: colour.parse().map_err(anyhow::Error::msg)?,
         director,
         defects,
+        director_of: director_of.parse().map_err(anyhow::Error::msg)?,
         flow,
         axes,
         polarity,

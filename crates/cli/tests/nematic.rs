@@ -163,6 +163,8 @@ fn the_nematic_is_refused_where_it_cannot_run() {
 /// scene without `angle`) make ±½ defects of M at the start, of both signs (not in equal
 /// numbers: the initial discs do not cover the box, and defects outside the tissue are
 /// dropped); axes all along x make none. A scene without `[nematic]` writes no such file.
+/// `render --director-of nematic` draws M's director and defects, and is refused by name
+/// without `[nematic]`.
 #[test]
 fn analyze_finds_the_defects_of_the_cells_nematic() {
     let dir = tempfile::tempdir().unwrap();
@@ -230,4 +232,45 @@ fn analyze_finds_the_defects_of_the_cells_nematic() {
     let plain = analysed(&scene_path("paper.toml"), "plain");
     assert!(plain.join("defects.csv").exists());
     assert!(!plain.join("defects_nematic.csv").exists());
+    // `render --director-of nematic` draws M's director and defects, not the shapes' Q: the
+    // pictures of the random axes differ from those of the shapes. A run without [nematic] is
+    // refused by name, writing no picture; an unknown field is named.
+    let render = |run: &str, of: &str| -> (std::process::Output, std::path::PathBuf) {
+        let out = dir.path().join(format!("{run}-{of}-png"));
+        let o = bin()
+            .arg("render")
+            .arg(dir.path().join(run))
+            .arg("--out")
+            .arg(&out)
+            .args(["--quiet", "--director", "--defects", "--director-of", of])
+            .output()
+            .unwrap();
+        (o, out)
+    };
+    let pictures = |out: &std::path::Path| -> Vec<Vec<u8>> {
+        let mut files: Vec<_> = std::fs::read_dir(out)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        files.iter().map(|f| std::fs::read(f).unwrap()).collect()
+    };
+    let (o, shape) = render("random", "shape");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, nematic) = render("random", "nematic");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (a, b) = (pictures(&shape), pictures(&nematic));
+    assert!(!a.is_empty() && a.len() == b.len());
+    assert_ne!(a, b, "M's director and defects are drawn, not Q's");
+    let (o, out) = render("plain", "nematic");
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("--director-of nematic") && err.contains("[nematic]"),
+        "{err}"
+    );
+    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none());
+    let (o, _) = render("random", "flow");
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--director-of flow"), "{}", stderr(&o));
 }

@@ -132,6 +132,29 @@ impl FromStr for Colour {
     }
 }
 
+/// Which nematic field a picture's director and defects belong to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DirectorOf {
+    /// The cells' shapes: `Q = Σ φ_i S_i`.
+    Shape,
+    /// The cells' own nematic (`[nematic]`): `M = Σ φ_i q_i`.
+    Nematic,
+}
+
+impl std::str::FromStr for DirectorOf {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "shape" => Ok(Self::Shape),
+            "nematic" => Ok(Self::Nematic),
+            _ => Err(format!(
+                "--director-of {s}: use shape (the cells' shapes' Q) or nematic (the cells' own nematic field M, scenes with [nematic])"
+            )),
+        }
+    }
+}
+
 /// Options of [`render_run`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderOptions {
@@ -143,6 +166,10 @@ pub struct RenderOptions {
     pub director: bool,
     /// The ±½ defects of the smoothed `Q`.
     pub defects: bool,
+    /// Whose director and defects `director` and `defects` draw: the cells' shapes' `Q`
+    /// (the default) or the cells' own nematic field `M = Σ φ_i q_i` (scenes with `[nematic]`),
+    /// as `analysis/defects.csv` and `analysis/defects_nematic.csv` find them.
+    pub director_of: DirectorOf,
     /// Arrows of the velocity field `Σ φ_i v_i`.
     pub flow: bool,
     /// Each cell's principal deformation axis (with `Colour::None`: the paper's Fig. 1b).
@@ -175,6 +202,7 @@ impl Default for RenderOptions {
             colour: Colour::None,
             director: false,
             defects: false,
+            director_of: DirectorOf::Shape,
             flow: false,
             axes: false,
             polarity: false,
@@ -449,7 +477,16 @@ fn picture(
         if opts.director || opts.defects {
             let side = default_box(run.scene);
             let smooth = |v: &[f64]| box_smooth(l, v, side).expect("the box fits the lattice");
-            let (mut qxx, mut qxy) = (smooth(&f.qxx), smooth(&f.qxy));
+            let (fxx, fxy) = match (opts.director_of, &f.cell_nematic) {
+                (DirectorOf::Shape, _) => (&f.qxx, &f.qxy),
+                (DirectorOf::Nematic, Some([mxx, mxy])) => (mxx, mxy),
+                (DirectorOf::Nematic, None) => {
+                    return Err(ViewError::Options(
+                        "--director-of nematic draws the cells' own nematic field, and this run has no [nematic]: leave the option out, or run a scene with [nematic]".into(),
+                    ))
+                }
+            };
+            let (mut qxx, mut qxy) = (smooth(fxx), smooth(fxy));
             // Only where there is tissue: the director of Q, and its defects, mean nothing in
             // the empty gaps between cells (between the initial discs, |Q| ≈ 0 and its angle
             // is noise). Tissue is where cells cover at least TISSUE_COVER of the smoothing box
