@@ -870,6 +870,12 @@ fn render_options(
             match k.as_str() {
                 "size" => opts.size = Some(v.extract()?),
                 "range" => opts.range = Some(v.extract()?),
+                "director_of" => {
+                    let of: String = v.extract()?;
+                    opts.director_of = of.parse().map_err(|e: String| {
+                        PyValueError::new_err(e.replace("--director-of", "director_of"))
+                    })?;
+                }
                 flag => {
                     let on: bool = v.extract()?;
                     match flag {
@@ -883,7 +889,7 @@ fn render_options(
                         "events" => opts.events = on,
                         _ => {
                             return Err(PyValueError::new_err(format!(
-                            "render: no option {flag:?}; use size, range, director, defects, flow, axes, polarity, nematic, tracks or events"
+                            "render: no option {flag:?}; use size, range, director, defects, director_of, flow, axes, polarity, nematic, tracks or events"
                         )))
                         }
                     }

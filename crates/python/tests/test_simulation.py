@@ -303,6 +303,15 @@ def test_the_cell_nematic_is_a_scene_key_with_columns(root):
     assert np.allclose(ratio, ratio[0], rtol=1e-5)
     sim.run(progress=False)
     assert sim.cells["fx"].shape == (60,)
+    # The director and defects of M (director_of="nematic") are not those of the shapes' Q.
+    of_m = sim.render(director=True, defects=True, director_of="nematic")
+    of_q = sim.render(director=True, defects=True)
+    assert of_m.size == of_q.size and of_m.png != of_q.png
+    with pytest.raises(ValueError, match=r"director_of plaid"):
+        sim.render(director=True, director_of="plaid")
+    plain = ml.Simulation(single())
+    with pytest.raises(ValueError, match=r"no \[nematic\]"):
+        plain.render(director=True, director_of="nematic")
     with pytest.raises(ValueError, match=r"\[nematic\].*elastic"):
         scene.set("nematic.elastic", -1.0)
 

@@ -228,7 +228,9 @@ class Simulation:
         """The current state drawn as ``monolayer render`` draws a frame: ``colour`` is one
         of none, velocity, pressure, area, deformation, id, population, generation, lineage;
         ``options`` are ``director``, ``defects``, ``flow``, ``axes``, ``polarity``,
-        ``tracks``, ``events`` (booleans), ``size`` (pixels) and ``range`` (two numbers).
+        ``nematic``, ``tracks``, ``events`` (booleans), ``director_of`` (``"shape"``, the
+        default, or ``"nematic"``: whose director and defects are drawn, the shapes' Q or the
+        cells' own nematic field M), ``size`` (pixels) and ``range`` (two numbers).
         Drawn in memory; ``tracks`` needs a run's earlier frames (``Run.render``)."""
         return Image(self._sim.render(colour, **options), self.iteration)
 
