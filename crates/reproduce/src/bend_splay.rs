@@ -314,13 +314,7 @@ type Curves = (String, Vec<f64>, Vec<f64>, Vec<f64>);
 
 /// The `(time, P_x, P_y, S)` of every frame of a run, in time order.
 fn frames_of(run: &std::path::Path) -> Result<Vec<(f64, f64, f64, f64)>, SweepError> {
-    let frames = run.join("frames");
-    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(&frames)
-        .map_err(|e| SweepError::write("the director's modes", &frames, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "npz"))
-        .collect();
-    paths.sort();
+    let paths = super::pipeline::frame_paths(run, "the director's modes")?;
     let mut out = Vec::new();
     for path in &paths {
         let a = rundir::read_npz(path, &["time", "centre", "nematic.theta"]).map_err(|source| {

@@ -48,7 +48,8 @@ pub(crate) const CELLS: f64 = 0.1;
 /// of the defects' motion towards their head; the core flow over the rms speed).
 pub(crate) const MONOLAYER: f64 = 0.2;
 
-/// The side of the box and the radius of its cells (the core of a defect is the disc R).
+/// The side of the box ([`super::defect_fields::tissue_sets`]) and the radius of its cells
+/// (the core of a defect is the disc R).
 const L: f64 = 200.0;
 const R: f64 = 8.0;
 /// The side of the defect-centred crops.
@@ -464,13 +465,7 @@ fn cells_ratio(
     zeta: f64,
     zeta_q: f64,
 ) -> Result<f64, SweepError> {
-    let frames = run.join("frames");
-    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(&frames)
-        .map_err(|e| SweepError::write("the cells' dipoles", &frames, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "npz"))
-        .collect();
-    paths.sort();
+    let paths = super::pipeline::frame_paths(run, "the cells' dipoles")?;
     let (mut num, mut den) = (0.0, 0.0);
     for path in &paths {
         let a = rundir::read_npz(path, &["time", "shape_tensor", "nematic"]).map_err(|source| {
@@ -495,18 +490,12 @@ fn cells_ratio(
 
 /// The sweep's runs, measured.
 fn sweep_runs(p: &ReproduceParams, t: f64, from: f64) -> Result<Vec<Run>, SweepError> {
-    let mut sets = vec![
-        format!("domain.lx={L}"),
-        format!("domain.ly={L}"),
-        "cells.count=240".to_string(),
-        "model.gamma=0.014".into(),
+    let mut sets = super::defect_fields::tissue_sets(p.scale, t);
+    sets.extend([
         // The table's required key, which the sweep's axis sets at each point.
         format!("nematic.zeta={}", ZETA_Q[0]),
         "nematic.align=\"shape\"".into(),
-        format!("run.time={t}"),
-        "run.output_every=10".into(),
-    ];
-    sets.extend(p.scale.integrator());
+    ]);
     let res = super::sweep(
         p,
         SweepJob {

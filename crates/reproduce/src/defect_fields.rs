@@ -262,6 +262,21 @@ pub(super) fn make(p: &ReproduceParams) -> Result<Made, SweepError> {
         .table("defect_field_runs.csv", runs_csv))
 }
 
+/// The overrides of the paper's scene for the defect figures' tissue: 240 cells on 200² at
+/// γ = 0.014, `t` TU active, a frame every 10 TU, the scale's integrator.
+pub(crate) fn tissue_sets(scale: Scale, t: f64) -> Vec<String> {
+    let mut sets = vec![
+        "domain.lx=200".to_string(),
+        "domain.ly=200".into(),
+        "cells.count=240".into(),
+        "model.gamma=0.014".into(),
+        format!("run.time={t}"),
+        "run.output_every=10".into(),
+    ];
+    sets.extend(scale.integrator());
+    sets
+}
+
 /// The sweep: the paper's scene at ζ = 0.005, γ = 0.014, both pressure forms, with its
 /// active time `t` and the time `from` which the frames are analysed.
 fn sweep(p: &ReproduceParams) -> Result<(super::SweepResult, f64, f64), SweepError> {
@@ -270,16 +285,8 @@ fn sweep(p: &ReproduceParams) -> Result<(super::SweepResult, f64, f64), SweepErr
         Scale::Paper => 1000.0,
     };
     let from = 200.0 + 0.5 * t;
-    let mut sets = vec![
-        "domain.lx=200".to_string(),
-        "domain.ly=200".into(),
-        "cells.count=240".into(),
-        "model.zeta=0.005".into(),
-        "model.gamma=0.014".into(),
-        format!("run.time={t}"),
-        "run.output_every=10".into(),
-    ];
-    sets.extend(p.scale.integrator());
+    let mut sets = tissue_sets(p.scale, t);
+    sets.push("model.zeta=0.005".into());
     let res = super::sweep(
         p,
         SweepJob {

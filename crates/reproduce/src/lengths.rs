@@ -618,13 +618,7 @@ pub(crate) fn verdicts_from_tables(dir: &Path) -> Result<Vec<(String, Verdict)>,
 /// cell velocity `U = ⟨v_i⟩_i`, the rms cell speed over the same frames, and the number of
 /// cells.
 fn net_flow(run: &Path, from: f64) -> Result<(f64, f64, usize), SweepError> {
-    let frames = run.join("frames");
-    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(&frames)
-        .map_err(|e| SweepError::write("the net flow", &frames, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "npz"))
-        .collect();
-    paths.sort();
+    let paths = super::pipeline::frame_paths(run, "the net flow")?;
     let (mut sum, mut speed2, mut k, mut n) = ([0.0f64; 2], 0.0, 0usize, 0usize);
     for path in &paths {
         let a =

@@ -146,6 +146,19 @@ impl Csv {
     }
 }
 
+/// The frames of a run directory (`RUN/frames/*.npz`), in step order; `what` names the
+/// measurement in the error when the directory cannot be read.
+pub(crate) fn frame_paths(run: &Path, what: &str) -> Result<Vec<std::path::PathBuf>, SweepError> {
+    let frames = run.join("frames");
+    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(&frames)
+        .map_err(|e| SweepError::write(what, &frames, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "npz"))
+        .collect();
+    paths.sort();
+    Ok(paths)
+}
+
 /// A measured value as a CSV cell, to every digit (`{:e}`).
 pub(crate) fn sci(v: f64) -> String {
     format!("{v:e}")
